@@ -1,0 +1,60 @@
+"""Tafel core: representations, blackboard, modules and the module manager.
+
+Depends on nothing else in the project; everything else depends on it.
+"""
+
+from core.access import ReadOnlyArray
+from core.errors import (
+    ConflictingProvidersError,
+    DependencyCycleError,
+    MissingProviderError,
+    ModuleDefinitionError,
+    ModuleGraphError,
+    ReadOnlyRepresentationError,
+    RepresentationDefinitionError,
+    TafelError,
+    UnknownModuleError,
+)
+from core.graph import prune_unsatisfiable
+from core.manager import Blackboard, ModuleManager, ModuleTiming
+from core.module import Module, Requirements, provides, requires, uses
+from core.naming import snake_case
+from core.representation import (
+    array,
+    fields_of,
+    get_representation,
+    is_representation,
+    registered_representations,
+    representation,
+    values_equal,
+)
+
+__all__ = [
+    "Blackboard",
+    "ConflictingProvidersError",
+    "DependencyCycleError",
+    "MissingProviderError",
+    "Module",
+    "ModuleDefinitionError",
+    "ModuleGraphError",
+    "ModuleManager",
+    "ModuleTiming",
+    "ReadOnlyArray",
+    "ReadOnlyRepresentationError",
+    "RepresentationDefinitionError",
+    "Requirements",
+    "TafelError",
+    "UnknownModuleError",
+    "array",
+    "fields_of",
+    "get_representation",
+    "is_representation",
+    "prune_unsatisfiable",
+    "provides",
+    "registered_representations",
+    "representation",
+    "requires",
+    "snake_case",
+    "uses",
+    "values_equal",
+]

@@ -1,0 +1,262 @@
+"""The module graph: who provides what, which modules run, and in which order.
+
+Pure functions over module classes; the ``ModuleManager`` builds a ``Plan`` whenever its configuration
+changes and only swaps it in when it is valid, so a broken change never touches the running graph.
+"""
+
+from __future__ import annotations
+
+import heapq
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+
+from core.errors import (
+    ConflictingProvidersError,
+    DependencyCycleError,
+    MissingProviderError,
+    ModuleDefinitionError,
+    UnknownModuleError,
+)
+from core.module import Module
+from core.naming import did_you_mean
+from core.representation import is_representation, registered_representations
+
+
+@dataclass
+class Plan:
+    """A valid configuration: active modules in execution order and the provider of each representation."""
+
+    order: list[type]
+    #: representation class -> providing module class, or None when it comes from outside
+    provider: dict[type, type | None]
+    #: representation class -> every enabled module class that could provide it
+    candidates: dict[type, list[type]]
+    #: enabled modules that do not run because they were chosen as provider of nothing
+    idle: list[type] = field(default_factory=list)
+
+    def representations(self) -> list[type]:
+        return list(self.provider)
+
+
+def module_names(modules: Sequence[type]) -> dict[str, type]:
+    """Module classes by name; rejects non-modules and duplicate names."""
+    by_name: dict[str, type] = {}
+    for cls in modules:
+        if not (isinstance(cls, type) and issubclass(cls, Module)):
+            raise ModuleDefinitionError(f"module lists take Module subclasses, got {cls!r}")
+        other = by_name.get(cls.__name__)
+        if other is not None and other is not cls:
+            raise ModuleDefinitionError(
+                f"two modules are named {cls.__name__}: {other.__module__} and {cls.__module__}; "
+                "module names must be unique within a manager"
+            )
+        by_name[cls.__name__] = cls
+    return by_name
+
+
+def resolve_module(name: str, by_name: Mapping[str, type], what: str = "module") -> type:
+    try:
+        return by_name[name]
+    except KeyError:
+        raise UnknownModuleError(f"unknown {what} {name!r}: {did_you_mean(name, by_name)}") from None
+
+
+def resolve_representation(name: str, known: Iterable[type] = ()) -> type:
+    known_by_name = {r.__name__: r for r in known} or registered_representations()
+    if name in known_by_name:
+        return known_by_name[name]
+    raise UnknownModuleError(f"unknown representation {name!r}: {did_you_mean(name, known_by_name)}")
+
+
+def build_plan(
+    modules: Sequence[type],
+    *,
+    external: Iterable[type] = (),
+    providers: Mapping[str, str] | None = None,
+    disabled: Iterable[str] = (),
+) -> Plan:
+    """Check a configuration and compute its execution order; raise a ``ModuleGraphError`` if broken."""
+    by_name = module_names(modules)
+    external = list(dict.fromkeys(external))
+    for rep in external:
+        if not is_representation(rep):
+            raise ModuleDefinitionError(f"external representations must be representation classes, got {rep!r}")
+    disabled = set(disabled)
+    for name in disabled:
+        resolve_module(name, by_name)
+    enabled = [m for m in modules if m.__name__ not in disabled]
+    declared = {m: m.requirements() for m in modules}
+
+    candidates: dict[type, list[type]] = {}
+    for m in enabled:
+        for rep in declared[m].provides:
+            candidates.setdefault(rep, []).append(m)
+
+    chosen = _choose_providers(modules, by_name, enabled, declared, candidates, external, providers or {})
+    provider: dict[type, type | None] = {rep: None for rep in external}
+    provider.update(chosen)
+
+    active = [m for m in enabled if not declared[m].provides or any(chosen.get(r) is m for r in declared[m].provides)]
+    idle = [m for m in enabled if m not in active]
+    _check_missing(active, declared, provider, modules, disabled, candidates)
+    order = _topological_order(active, declared, provider)
+    return Plan(order=order, provider=provider, candidates=candidates, idle=idle)
+
+
+def _choose_providers(
+    modules: Sequence[type],
+    by_name: Mapping[str, type],
+    enabled: list[type],
+    declared: Mapping[type, object],
+    candidates: dict[type, list[type]],
+    external: list[type],
+    providers: Mapping[str, str],
+) -> dict[type, type]:
+    all_reps = {r.__name__: r for m in modules for r in declared[m].provides}  # type: ignore[attr-defined]
+    choices: dict[type, type] = {}
+    for rep_name, module_name in providers.items():
+        if rep_name not in all_reps:
+            raise UnknownModuleError(
+                f"providers names {rep_name!r}, but no module in this manager provides a representation "
+                f"of that name: {did_you_mean(rep_name, all_reps)}"
+            )
+        rep = all_reps[rep_name]
+        module = resolve_module(module_name, by_name)
+        able = [m.__name__ for m in modules if rep in declared[m].provides]  # type: ignore[attr-defined]
+        if module.__name__ not in able:
+            raise UnknownModuleError(
+                f"providers chooses {module_name} for {rep_name}, but {module_name} does not provide "
+                f"{rep_name}; modules that do: {', '.join(able)}"
+            )
+        if module not in enabled:
+            raise ConflictingProvidersError(
+                f"providers chooses {module_name} for {rep_name}, but {module_name} is disabled; enable it "
+                f"or choose one of {', '.join(m.__name__ for m in candidates.get(rep, [])) or 'nothing else'}"
+            )
+        choices[rep] = module
+
+    chosen: dict[type, type] = {}
+    for rep, able in candidates.items():
+        if rep in external:
+            raise ConflictingProvidersError(
+                f"{rep.__name__} is provided from outside this manager (platform or other context) and by "
+                f"{', '.join(m.__name__ for m in able)}; disable the module, or stop providing "
+                f"{rep.__name__} externally"
+            )
+        if rep in choices:
+            chosen[rep] = choices[rep]
+        elif len(able) == 1:
+            chosen[rep] = able[0]
+        else:
+            names = [m.__name__ for m in able]
+            raise ConflictingProvidersError(
+                f"{rep.__name__} is provided by {' and '.join(names)}; choose one with "
+                f'providers={{"{rep.__name__}": "{names[0]}"}} (in configuration: '
+                f'[providers] {rep.__name__} = "{names[0]}"), or disable the others'
+            )
+    return chosen
+
+
+def _check_missing(
+    active: list[type],
+    declared: Mapping[type, object],
+    provider: Mapping[type, type | None],
+    modules: Sequence[type],
+    disabled: set[str],
+    candidates: Mapping[type, list[type]],
+) -> None:
+    problems = []
+    for m in active:
+        req = declared[m]
+        for kind, reps in (("requires", req.requires), ("uses", req.uses)):  # type: ignore[attr-defined]
+            for rep in reps:
+                if rep in provider:
+                    continue
+                off = [o.__name__ for o in modules if o.__name__ in disabled and rep in declared[o].provides]  # type: ignore[attr-defined]
+                hint = f" ({', '.join(off)} would, but is disabled)" if off else ""
+                problems.append(
+                    f"{m.__name__} {kind} {rep.__name__}, but no module provides it{hint} and it is not "
+                    "provided from outside"
+                )
+    if problems:
+        raise MissingProviderError(
+            "; ".join(problems)
+            + ". Add a module that provides it, enable the one that does, or let the platform provide it."
+        )
+
+
+def _topological_order(active: list[type], declared: Mapping[type, object], provider: Mapping[type, type | None]) -> list[type]:
+    index = {m: i for i, m in enumerate(active)}
+    successors: dict[type, list[tuple[type, type]]] = {m: [] for m in active}
+    indegree = {m: 0 for m in active}
+    for m in active:
+        for rep in declared[m].requires:  # type: ignore[attr-defined]
+            source = provider.get(rep)
+            if source is not None and source is not m and source in index:
+                successors[source].append((m, rep))
+                indegree[m] += 1
+    ready = [(index[m], m.__name__) for m in active if indegree[m] == 0]
+    heapq.heapify(ready)
+    by_name = {m.__name__: m for m in active}
+    order: list[type] = []
+    while ready:
+        _, name = heapq.heappop(ready)
+        m = by_name[name]
+        order.append(m)
+        for succ, _rep in successors[m]:
+            indegree[succ] -= 1
+            if indegree[succ] == 0:
+                heapq.heappush(ready, (index[succ], succ.__name__))
+    if len(order) < len(active):
+        remaining = [m for m in active if m not in order]
+        raise _cycle_error(remaining, successors)
+    return order
+
+
+def _cycle_error(remaining: list[type], successors: Mapping[type, list[tuple[type, type]]]) -> DependencyCycleError:
+    """Find one cycle among the modules left over by the sort and describe it as a path."""
+    left = set(remaining)
+    start = remaining[0]
+    path: list[tuple[type, type]] = []
+    seen_at: dict[type, int] = {}
+    node = start
+    while node not in seen_at:
+        seen_at[node] = len(path)
+        succ, rep = next((s, r) for s, r in successors[node] if s in left)
+        path.append((node, rep))
+        node = succ
+    cycle = path[seen_at[node]:]
+    text = " -> ".join(f"{m.__name__}.{rep.__name__}" for m, rep in cycle) + f" -> {cycle[0][0].__name__}"
+    return DependencyCycleError(
+        f"dependency cycle: {text} (each module provides the representation that the next one requires). "
+        "Break it by declaring one of these requirements with @uses instead of @requires (the module "
+        "then reads the previous frame's value), or by choosing another provider.",
+        [(m.__name__, rep.__name__) for m, rep in cycle],
+    )
+
+
+def prune_unsatisfiable(
+    modules: Sequence[type], external: Iterable[type], disabled: Iterable[str] = ()
+) -> dict[str, list[str]]:
+    """Modules that cannot run because something they read is provided by nobody, transitively.
+
+    Returns module name -> names of the representations it misses. A webcam platform, for example,
+    provides no joint data, so every module that needs joints (and everything downstream) is pruned.
+    """
+    available_external = set(external)
+    off = set(disabled)
+    pruned: dict[str, list[str]] = {}
+    remaining = [m for m in modules if m.__name__ not in off]
+    while True:
+        available = set(available_external)
+        for m in remaining:
+            available.update(m.requirements().provides)
+        newly = {}
+        for m in remaining:
+            missing = [r.__name__ for r in m.requirements().reads() if r not in available]
+            if missing:
+                newly[m.__name__] = missing
+        if not newly:
+            return pruned
+        pruned.update(newly)
+        remaining = [m for m in remaining if m.__name__ not in newly]

@@ -1,0 +1,391 @@
+"""The blackboard and the module manager that runs one context (cognition or motion) frame by frame."""
+
+from __future__ import annotations
+
+import logging
+import time
+import traceback
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any, TypeVar
+
+from core.access import AccessMark, read_view, undo_writes, writer_view
+from core.errors import ModuleDefinitionError, UnknownModuleError
+from core.graph import Plan, build_plan, module_names, resolve_module
+from core.module import Module
+from core.naming import did_you_mean, snake_case
+from core.parameters import make_parameters
+from core.representation import reset
+
+R = TypeVar("R")
+
+#: frames over which mean and max execution times are computed
+TIMING_WINDOW = 100
+
+
+class Blackboard:
+    """One instance of each representation of a context, looked up by class or by name.
+
+    Instances are never replaced while modules run (modules hold views of them); values that arrive
+    from outside are copied into them.
+    """
+
+    def __init__(self) -> None:
+        self._by_type: dict[type, Any] = {}
+        self._by_name: dict[str, type] = {}
+
+    def __getitem__(self, rep: type[R]) -> R:
+        try:
+            return self._by_type[rep]
+        except KeyError:
+            name = getattr(rep, "__name__", repr(rep))
+            raise KeyError(
+                f"{name} is not on this blackboard; {did_you_mean(name, self._by_name)}"
+            ) from None
+
+    def __contains__(self, rep: object) -> bool:
+        return rep in self._by_type
+
+    def __iter__(self) -> Iterator[type]:
+        return iter(self._by_type)
+
+    def __len__(self) -> int:
+        return len(self._by_type)
+
+    def get(self, name: str) -> Any:
+        """The instance of the representation named ``name``."""
+        if name not in self._by_name:
+            raise KeyError(f"no representation {name!r} on this blackboard; {did_you_mean(name, self._by_name)}")
+        return self._by_type[self._by_name[name]]
+
+    def names(self) -> list[str]:
+        return sorted(self._by_name)
+
+    def ensure(self, rep: type[R]) -> R:
+        """The instance of ``rep``, created with its defaults if it is not there yet."""
+        instance = self._by_type.get(rep)
+        if instance is None:
+            instance = self._by_type[rep] = rep()
+            self._by_name[rep.__name__] = rep
+        return instance
+
+    def set(self, value: Any) -> None:
+        """Copy the fields of ``value`` into this blackboard's instance of its class (shallow)."""
+        self[type(value)].__dict__.update(value.__dict__)
+
+
+@dataclass(frozen=True)
+class ModuleTiming:
+    """Execution time of one module in microseconds over the last ``TIMING_WINDOW`` frames."""
+
+    last_us: float
+    mean_us: float
+    max_us: float
+    frames: int
+    errors: int
+
+
+class _Slot:
+    """Everything the manager keeps for one running module; plain slots keep the frame loop fast."""
+
+    __slots__ = ("name", "cls", "instance", "run", "times", "first_frame", "errors", "last_error",
+                 "undo", "read_marks", "write_marks", "chosen")
+
+    def __init__(self, cls: type, frame: int) -> None:
+        self.name = cls.__name__
+        self.cls = cls
+        self.instance: Any = None
+        self.run: Callable[[], None] = lambda: None
+        self.times = [0] * TIMING_WINDOW
+        self.first_frame = frame
+        self.errors = 0
+        self.last_error = ""
+        self.undo: list[tuple[Any, str, Any]] = []
+        self.read_marks: list[tuple[str, AccessMark]] = []
+        self.write_marks: list[tuple[str, AccessMark]] = []
+        self.chosen: frozenset[type] = frozenset()
+
+
+def _chosen_outputs(cls: type, plan: Plan) -> frozenset[type]:
+    """The representations ``cls`` writes to the blackboard under ``plan``."""
+    return frozenset(r for r in cls.requirements().provides if plan.provider.get(r) is cls)
+
+
+class ModuleManager:
+    """Runs a list of module classes in dependency order on its own blackboard.
+
+    ``external`` names the representations that something outside provides (a platform, the other
+    context); ``providers`` picks a module where several provide one representation (by names). Broken
+    configurations raise a ``ModuleGraphError`` subclass here and in ``set_provider``/``set_enabled``.
+    With ``strict`` an exception in a module propagates out of ``execute``; otherwise it is logged,
+    counted, and the frame goes on with the module's representations at their previous values.
+    """
+
+    def __init__(
+        self,
+        modules: Sequence[type],
+        *,
+        name: str = "cognition",
+        external: Iterable[type] = (),
+        providers: Mapping[str, str] | None = None,
+        strict: bool = False,
+        parameters: Mapping[str, Mapping[str, Any]] | None = None,
+    ) -> None:
+        self.name = name
+        self.strict = strict
+        self.frame = 0
+        self.blackboard = Blackboard()
+        self.log = logging.getLogger(f"tafel.{name}")
+        #: called before and after each frame (for example debug commands between frames)
+        self.before_frame: list[Callable[[], None]] = []
+        self.after_frame: list[Callable[[], None]] = []
+        self._modules = list(modules)
+        self._by_name = module_names(self._modules)
+        self._external = list(dict.fromkeys(external))
+        self._providers = dict(providers or {})
+        self._disabled: set[str] = set()
+        self._parameters = {name: dict(values) for name, values in (parameters or {}).items()}
+        for module_name in self._parameters:
+            resolve_module(module_name, self._by_name)
+        self._slots: list[_Slot] = []
+        self._marks: list[AccessMark] = []
+        self._plan = self._apply(build_plan(self._modules, external=self._external, providers=self._providers), {})
+
+    # ------------------------------------------------------------------ running
+    def execute(self) -> None:
+        """Run one frame: every active module once, in order."""
+        for hook in self.before_frame:
+            hook()
+        self.frame += 1
+        for mark in self._marks:
+            mark.touched = False
+        clock = time.perf_counter_ns
+        index = self.frame % TIMING_WINDOW
+        last = clock()
+        for slot in self._slots:
+            try:
+                slot.run()
+            except Exception as exc:
+                self._failed(slot, exc)
+            else:
+                if slot.undo:
+                    slot.undo.clear()
+            now = clock()
+            slot.times[index] = now - last
+            last = now
+        for hook in self.after_frame:
+            hook()
+
+    def _failed(self, slot: _Slot, exc: Exception) -> None:
+        undo_writes(slot.undo)
+        if self.strict:
+            raise exc
+        slot.errors += 1
+        slot.last_error = f"{type(exc).__name__}: {exc}"
+        self.log.error(
+            "%s: module %s failed in frame %d (%d errors so far): %s\n%s",
+            self.name, slot.name, self.frame, slot.errors, slot.last_error,
+            "".join(traceback.format_exception(exc)).rstrip(),
+        )
+
+    # ------------------------------------------------------------------ inspection
+    @property
+    def order(self) -> list[str]:
+        """Names of the active modules in execution order."""
+        return [slot.name for slot in self._slots]
+
+    @property
+    def modules(self) -> list[str]:
+        """Names of all modules known to this manager, active or not."""
+        return [m.__name__ for m in self._modules]
+
+    @property
+    def external(self) -> list[type]:
+        return list(self._external)
+
+    def module(self, name: str) -> Any:
+        """The running instance of module ``name``."""
+        for slot in self._slots:
+            if slot.name == name:
+                return slot.instance
+        resolve_module(name, self._by_name)
+        raise KeyError(f"module {name} is not running in {self.name} (disabled or not chosen as provider)")
+
+    def is_enabled(self, name: str) -> bool:
+        resolve_module(name, self._by_name)
+        return name not in self._disabled
+
+    def provider_of(self, rep_name: str) -> str | None:
+        """Name of the module providing ``rep_name``; None when it comes from outside."""
+        for rep, module in self._plan.provider.items():
+            if rep.__name__ == rep_name:
+                return module.__name__ if module else None
+        raise UnknownModuleError(f"{rep_name} is not on the {self.name} blackboard; {did_you_mean(rep_name, self.blackboard.names())}")
+
+    def alternatives(self, rep_name: str) -> list[str]:
+        """Every module that could provide ``rep_name`` (enabled or not)."""
+        return [m.__name__ for m in self._modules if any(r.__name__ == rep_name for r in m.requirements().provides)]
+
+    def provided_representations(self) -> list[type]:
+        """Representations some module of this manager provides (not the external ones)."""
+        return [rep for rep, module in self._plan.provider.items() if module is not None]
+
+    def read_representations(self) -> list[type]:
+        """Representations some active module requires or uses."""
+        active = {slot.cls for slot in self._slots}
+        return list(dict.fromkeys(r for m in self._modules if m in active for r in m.requirements().reads()))
+
+    def timings(self) -> dict[str, ModuleTiming]:
+        """Execution times per running module (window of the last ``TIMING_WINDOW`` frames)."""
+        result = {}
+        for slot in self._slots:
+            runs = self.frame - slot.first_frame
+            n = min(runs, TIMING_WINDOW)
+            recent = [slot.times[(self.frame - i) % TIMING_WINDOW] for i in range(n)]
+            result[slot.name] = ModuleTiming(
+                last_us=recent[0] / 1e3 if recent else 0.0,
+                mean_us=sum(recent) / n / 1e3 if n else 0.0,
+                max_us=max(recent) / 1e3 if recent else 0.0,
+                frames=runs,
+                errors=slot.errors,
+            )
+        return result
+
+    def errors(self) -> dict[str, tuple[int, str]]:
+        """Module name -> (error count, last error) for modules that failed at least once."""
+        return {s.name: (s.errors, s.last_error) for s in self._slots if s.errors}
+
+    def access(self) -> dict[str, dict[str, list[str]]]:
+        """Per representation, which modules read it and which wrote it in the last frame."""
+        result: dict[str, dict[str, list[str]]] = {
+            rep.__name__: {"readers": [], "writers": []} for rep in self.blackboard
+        }
+        for slot in self._slots:
+            for rep_name, mark in slot.read_marks:
+                if mark.touched:
+                    result[rep_name]["readers"].append(slot.name)
+            for rep_name, mark in slot.write_marks:
+                if mark.touched:
+                    result[rep_name]["writers"].append(slot.name)
+        return result
+
+    def graph(self) -> dict[str, Any]:
+        """The module graph as plain data (for tools, the debug server and ``tafel modules``)."""
+        active = {slot.name for slot in self._slots}
+        modules = []
+        for m in self._modules:
+            req = m.requirements()
+            modules.append({
+                "name": m.__name__,
+                "enabled": m.__name__ not in self._disabled,
+                "active": m.__name__ in active,
+                "requires": [r.__name__ for r in req.requires],
+                "uses": [r.__name__ for r in req.uses],
+                "provides": [r.__name__ for r in req.provides],
+            })
+        representations = {
+            rep.__name__: {
+                "provider": module.__name__ if module else None,
+                "alternatives": self.alternatives(rep.__name__),
+            }
+            for rep, module in self._plan.provider.items()
+        }
+        return {
+            "name": self.name,
+            "order": self.order,
+            "modules": modules,
+            "representations": representations,
+            "external": [r.__name__ for r in self._external],
+        }
+
+    def to_dot(self) -> str:
+        """Graphviz DOT text of the graph: modules as boxes, representations as ellipses."""
+        from core.dot import manager_dot
+
+        return manager_dot(self.graph())
+
+    # ------------------------------------------------------------------ reconfiguration
+    def set_provider(self, rep_name: str, module_name: str) -> None:
+        """Make ``module_name`` the provider of ``rep_name``; raises and changes nothing if invalid."""
+        providers = {**self._providers, rep_name: module_name}
+        plan = build_plan(self._modules, external=self._external, providers=providers, disabled=self._disabled)
+        self._plan = self._apply(plan, self._plan.provider)
+        self._providers = providers
+
+    def set_enabled(self, module_name: str, enabled: bool) -> None:
+        """Enable or disable a module; raises and changes nothing if the graph would break."""
+        resolve_module(module_name, self._by_name)
+        disabled = self._disabled - {module_name} if enabled else self._disabled | {module_name}
+        providers = {r: m for r, m in self._providers.items() if m not in disabled}
+        plan = build_plan(self._modules, external=self._external, providers=providers, disabled=disabled)
+        self._plan = self._apply(plan, self._plan.provider)
+        self._disabled, self._providers = disabled, providers
+
+    @property
+    def providers(self) -> dict[str, str]:
+        """The explicit provider choices (representation name -> module name)."""
+        return dict(self._providers)
+
+    @property
+    def disabled(self) -> set[str]:
+        return set(self._disabled)
+
+    # ------------------------------------------------------------------ internals
+    def _apply(self, plan: Plan, old_provider: Mapping[type, type | None]) -> Plan:
+        """Switch to a checked plan: keep running instances, create new ones, reset changed outputs.
+
+        New instances are built before anything changes, so a failing constructor leaves the running
+        graph as it was.
+        """
+        for rep in plan.provider:
+            self.blackboard.ensure(rep)
+        for m in plan.order:
+            for rep in m.requirements().reads():
+                self.blackboard.ensure(rep)
+        kept = {slot.cls: slot for slot in self._slots}
+        slots = []
+        for m in plan.order:
+            slot = kept.get(m)
+            if slot is None or slot.chosen != _chosen_outputs(m, plan):
+                slot = _Slot(m, self.frame)
+                self._instantiate(slot, plan)
+            slots.append(slot)
+        for rep, module in plan.provider.items():
+            if rep in old_provider and old_provider[rep] is not module:
+                reset(self.blackboard[rep])
+        self._slots = slots
+        self._marks = [mark for s in slots for _, mark in (*s.read_marks, *s.write_marks)]
+        return plan
+
+    def _instantiate(self, slot: _Slot, plan: Plan) -> None:
+        cls = slot.cls
+        instance = cls.__new__(cls)
+        req = cls.requirements()
+        for rep in req.reads():
+            mark = AccessMark()
+            object.__setattr__(instance, snake_case(rep.__name__), read_view(self.blackboard[rep], cls.__name__, mark))
+            slot.read_marks.append((rep.__name__, mark))
+        for rep in req.provides:
+            # A module running as provider of something else writes unchosen outputs to a private copy.
+            target = self.blackboard[rep] if plan.provider.get(rep) is cls else rep()
+            mark = AccessMark()
+            object.__setattr__(instance, snake_case(rep.__name__), writer_view(target, mark, slot.undo))
+            slot.write_marks.append((rep.__name__, mark))
+        object.__setattr__(instance, "parameters", make_parameters(cls, self._parameters.get(cls.__name__)))
+        try:
+            instance.__init__()
+        except Exception as exc:
+            rule = " (a module's constructor takes no arguments)" if isinstance(exc, TypeError) else ""
+            raise ModuleDefinitionError(f"constructing {cls.__name__} failed{rule}: {exc}") from exc
+        slot.chosen = _chosen_outputs(cls, plan)
+        slot.instance = instance
+        slot.run = instance.execute
+
+
+def make_module(cls: type, **attributes: Any) -> Module:
+    """A module instance wired to plain objects, bypassing the blackboard (for baselines and tools)."""
+    instance = cls.__new__(cls)
+    for name, value in attributes.items():
+        object.__setattr__(instance, name, value)
+    instance.__init__()
+    return instance

@@ -1,0 +1,161 @@
+"""Modules: the executable units. They declare what they read and write, and nothing else.
+
+    @requires(BallPercept)
+    @provides(BallModel)
+    class SimpleBallModeler(Module):
+        def execute(self) -> None:
+            self.ball_model.x_mm = self.ball_percept.x_mm
+
+``requires`` gives read access and orders the module after the provider; ``uses`` gives read access
+without an ordering edge (the previous frame's value when the provider runs later: feedback loops);
+``provides`` gives write access. Each representation is reached as the snake_case attribute of its
+class name. The declarations are static: ``SimpleBallModeler.requirements()`` reads them without
+running anything.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, TypeVar
+
+from core.errors import ModuleDefinitionError
+from core.naming import snake_case
+from core.representation import is_representation
+
+M = TypeVar("M", bound=type)
+
+_KINDS = ("requires", "uses", "provides")
+
+
+@dataclass(frozen=True)
+class Requirements:
+    """What a module class declares, in declaration order."""
+
+    requires: tuple[type, ...]
+    uses: tuple[type, ...]
+    provides: tuple[type, ...]
+
+    def attribute_names(self) -> dict[str, type]:
+        """Attribute name on the module -> representation class, for everything declared."""
+        return {snake_case(r.__name__): r for r in (*self.requires, *self.uses, *self.provides)}
+
+    def reads(self) -> tuple[type, ...]:
+        return self.requires + self.uses
+
+
+class Module:
+    """Base class of all modules. Subclasses implement ``execute``; the constructor takes no arguments."""
+
+    __tafel_requires__: tuple[type, ...] = ()
+    __tafel_uses__: tuple[type, ...] = ()
+    __tafel_provides__: tuple[type, ...] = ()
+
+    def execute(self) -> None:
+        """Called once per frame, after every module whose representations this one requires."""
+        raise NotImplementedError(f"{type(self).__name__} must implement execute(self)")
+
+    @classmethod
+    def requirements(cls) -> Requirements:
+        """The representations this class (and its base classes) requires, uses and provides."""
+        collected: dict[str, list[type]] = {k: [] for k in _KINDS}
+        for klass in reversed(cls.__mro__):
+            for kind in _KINDS:
+                for rep in klass.__dict__.get(f"__tafel_{kind}__", ()):
+                    if rep not in collected[kind]:
+                        collected[kind].append(rep)
+        return Requirements(*(tuple(collected[k]) for k in _KINDS))
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        reps = _attribute_names(type(self))
+        if name in reps:
+            raise AttributeError(
+                f"{type(self).__name__}.{name} is the blackboard's {reps[name].__name__} and cannot be "
+                f"replaced; assign its fields instead (self.{name}.field = value)"
+            )
+        object.__setattr__(self, name, value)
+
+
+
+class _Unbound:
+    """Class-level placeholder for a declared representation; the manager's instance value hides it.
+
+    A non-data descriptor, so reading the bound attribute costs nothing extra.
+    """
+
+    def __init__(self, rep: type) -> None:
+        self.rep = rep
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    def __get__(self, instance: Any, owner: type) -> Any:
+        if instance is None:
+            return self
+        raise AttributeError(
+            f"{owner.__name__}.{snake_case(self.rep.__name__)} is not connected to a blackboard: modules "
+            "get their representations from a ModuleManager; in tests use the run_module fixture or "
+            "core.testing.ModuleHarness"
+        )
+
+
+_ATTRIBUTE_NAMES: dict[type, dict[str, type]] = {}
+
+
+def _attribute_names(cls: type) -> dict[str, type]:
+    names = _ATTRIBUTE_NAMES.get(cls)
+    if names is None:
+        names = _ATTRIBUTE_NAMES[cls] = cls.requirements().attribute_names()
+    return names
+
+
+def _declare(kind: str, reps: tuple[type, ...]) -> Callable[[M], M]:
+    for rep in reps:
+        if not is_representation(rep):
+            raise ModuleDefinitionError(
+                f"@{kind}() takes representation classes (decorated with @representation), got {rep!r}"
+            )
+
+    def decorate(cls: M) -> M:
+        if not (isinstance(cls, type) and issubclass(cls, Module)):
+            raise ModuleDefinitionError(f"@{kind} decorates Module subclasses, not {cls!r}")
+        own = list(cls.__dict__.get(f"__tafel_{kind}__", ()))
+        current = cls.requirements()
+        for rep in reps:
+            for other in _KINDS:
+                if other != kind and rep in getattr(current, other):
+                    raise ModuleDefinitionError(
+                        f"{cls.__name__} declares {rep.__name__} both in @{kind} and in @{other}; "
+                        "a module requires or uses what others provide, or provides it itself, not both"
+                    )
+            if rep not in own:
+                own.append(rep)
+        for rep in reps:
+            attribute = snake_case(rep.__name__)
+            clash = getattr(cls, attribute, None)
+            if clash is not None and not isinstance(clash, _Unbound):
+                raise ModuleDefinitionError(
+                    f"{cls.__name__}.{attribute} is already defined, but it is also the attribute name of "
+                    f"{rep.__name__}; rename the method or attribute"
+                )
+            setattr(cls, attribute, _Unbound(rep))
+        setattr(cls, f"__tafel_{kind}__", tuple(own))
+        _ATTRIBUTE_NAMES.clear()
+        return cls
+
+    return decorate
+
+
+def requires(*reps: type) -> Callable[[M], M]:
+    """Read access to ``reps``; the module runs after their providers."""
+    return _declare("requires", reps)
+
+
+def uses(*reps: type) -> Callable[[M], M]:
+    """Read access to ``reps`` without an ordering edge (last frame's value if the provider runs later)."""
+    return _declare("uses", reps)
+
+
+def provides(*reps: type) -> Callable[[M], M]:
+    """Write access to ``reps``; this module computes them."""
+    return _declare("provides", reps)

@@ -1,0 +1,9 @@
+"""Representations: the data that modules exchange, grouped by area.
+
+Coordinate convention (the only one in Tafel):
+- Robot frame: origin on the ground between the feet, x forward, y left, z up (right-handed).
+- Field frame: origin at the centre spot, x towards the opponent goal, y left.
+- Lengths in millimetres (mm), angles in radians (rad), time in seconds (s) unless a field name says
+  otherwise (``time_ns``). Image coordinates in pixels (px), origin at the top-left corner, x right,
+  y down.
+"""

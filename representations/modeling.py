@@ -1,0 +1,24 @@
+"""Representations of the world model: what the robot believes beyond a single frame."""
+
+from __future__ import annotations
+
+from core import representation
+
+
+@representation
+class BallModel:
+    """The believed ball state in the robot frame.
+
+    ``x``/``y`` in mm, ``vx``/``vy`` in mm/s, ``position_std`` the standard deviation of the position
+    (mm). ``valid`` while the ball was seen recently enough to be trusted; ``seen`` when it was seen in
+    this frame; ``time_since_seen`` in s.
+    """
+
+    valid: bool = False
+    seen: bool = False
+    x: float = 0.0
+    y: float = 0.0
+    vx: float = 0.0
+    vy: float = 0.0
+    position_std: float = 0.0
+    time_since_seen: float = 0.0
