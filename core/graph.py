@@ -214,18 +214,28 @@ def _topological_order(active: list[type], declared: Mapping[type, object], prov
 
 
 def _cycle_error(remaining: list[type], successors: Mapping[type, list[tuple[type, type]]]) -> DependencyCycleError:
-    """Find one cycle among the modules left over by the sort and describe it as a path."""
+    """Find one cycle among the modules left over by the sort and describe it as a path.
+
+    Every left-over module still has a left-over predecessor (that is why it was left over), so walking
+    predecessors must come back to a module already visited; that loop is a cycle.
+    """
     left = set(remaining)
-    start = remaining[0]
-    path: list[tuple[type, type]] = []
+    predecessors: dict[type, tuple[type, type]] = {}
+    for source in remaining:
+        for target, rep in successors[source]:
+            if target in left:
+                predecessors.setdefault(target, (source, rep))
+    walk: list[type] = []
     seen_at: dict[type, int] = {}
-    node = start
+    node = remaining[0]
     while node not in seen_at:
-        seen_at[node] = len(path)
-        succ, rep = next((s, r) for s, r in successors[node] if s in left)
-        path.append((node, rep))
-        node = succ
-    cycle = path[seen_at[node]:]
+        seen_at[node] = len(walk)
+        walk.append(node)
+        node = predecessors[node][0]
+    loop = list(reversed(walk[seen_at[node]:]))  # in edge direction: loop[i] provides to loop[i + 1]
+    first = min(range(len(loop)), key=lambda i: remaining.index(loop[i]))
+    loop = loop[first:] + loop[:first]
+    cycle = [(m, predecessors[loop[(i + 1) % len(loop)]][1]) for i, m in enumerate(loop)]
     text = " -> ".join(f"{m.__name__}.{rep.__name__}" for m, rep in cycle) + f" -> {cycle[0][0].__name__}"
     return DependencyCycleError(
         f"dependency cycle: {text} (each module provides the representation that the next one requires). "
