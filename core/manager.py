@@ -119,6 +119,8 @@ class ModuleManager:
     configurations raise a ``ModuleGraphError`` subclass here and in ``set_provider``/``set_enabled``.
     With ``strict`` an exception in a module propagates out of ``execute``; otherwise it is logged,
     counted, and the frame goes on with the module's representations at their previous values.
+    ``parameters`` maps module names to parameter values (see ``core.parameters``); ``disabled``
+    names modules that start switched off.
     """
 
     def __init__(
@@ -130,6 +132,7 @@ class ModuleManager:
         providers: Mapping[str, str] | None = None,
         strict: bool = False,
         parameters: Mapping[str, Mapping[str, Any]] | None = None,
+        disabled: Iterable[str] = (),
     ) -> None:
         self.name = name
         self.strict = strict
@@ -143,13 +146,14 @@ class ModuleManager:
         self._by_name = module_names(self._modules)
         self._external = list(dict.fromkeys(external))
         self._providers = dict(providers or {})
-        self._disabled: set[str] = set()
+        self._disabled: set[str] = set(disabled)
         self._parameters = {name: dict(values) for name, values in (parameters or {}).items()}
         for module_name in self._parameters:
             resolve_module(module_name, self._by_name)
         self._slots: list[_Slot] = []
         self._marks: list[AccessMark] = []
-        self._plan = self._apply(build_plan(self._modules, external=self._external, providers=self._providers), {})
+        plan = build_plan(self._modules, external=self._external, providers=self._providers, disabled=self._disabled)
+        self._plan = self._apply(plan, {})
 
     # ------------------------------------------------------------------ running
     def execute(self) -> None:

@@ -51,6 +51,10 @@ class Module:
     __tafel_uses__: tuple[type, ...] = ()
     __tafel_provides__: tuple[type, ...] = ()
 
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        _KNOWN[cls.__name__] = cls
+
     def execute(self) -> None:
         """Called once per frame, after every module whose representations this one requires."""
         raise NotImplementedError(f"{type(self).__name__} must implement execute(self)")
@@ -100,6 +104,37 @@ class _Unbound:
 
 
 _ATTRIBUTE_NAMES: dict[type, dict[str, type]] = {}
+_KNOWN: dict[str, type] = {}
+
+
+def known_modules() -> dict[str, type]:
+    """Every Module subclass defined so far, by class name (the newest definition of a name wins).
+
+    Configuration names modules by class name; ``tools`` imports the ``modules`` package so that all
+    of them are known. A name of the form ``package.module:ClassName`` is imported on demand.
+    """
+    return dict(_KNOWN)
+
+
+def find_module(name: str) -> type:
+    """The module class called ``name`` (or ``package.module:ClassName``), with suggestions if unknown."""
+    from core.errors import UnknownModuleError
+    from core.naming import did_you_mean
+
+    if ":" in name:
+        import importlib
+
+        path, _, attribute = name.partition(":")
+        try:
+            cls = getattr(importlib.import_module(path), attribute)
+        except (ImportError, AttributeError) as exc:
+            raise UnknownModuleError(f"cannot import module class {name!r}: {exc}") from None
+        if not (isinstance(cls, type) and issubclass(cls, Module)):
+            raise UnknownModuleError(f"{name!r} is not a Module subclass")
+        return cls
+    if name in _KNOWN:
+        return _KNOWN[name]
+    raise UnknownModuleError(f"unknown module {name!r}: {did_you_mean(name, _KNOWN)}")
 
 
 def _attribute_names(cls: type) -> dict[str, type]:

@@ -16,3 +16,9 @@ class FrameInfo:
     def time_s(self) -> float:
         """``time_ns`` in seconds."""
         return self.time_ns * 1e-9
+
+
+# Provided by the runtime to motion; defined in core because the runtime fills it.
+from core.status import CognitionStatus  # noqa: E402
+
+__all__ = ["CognitionStatus", "FrameInfo"]

@@ -1,0 +1,173 @@
+"""Layered TOML configuration: general -> platform/<name> -> robot/<name> -> private -> --set.
+
+Each layer is optional and overrides what came before, table by table; lists are replaced whole.
+A configuration file looks like::
+
+    [runtime]
+    cognition_hz = 30
+    motion_hz = 100
+
+    [cognition]
+    modules = ["BallDetector", "KalmanBallModeler", "SimpleBallModeler"]
+    disabled = []
+    [cognition.providers]
+    BallModel = "KalmanBallModeler"
+
+    [parameters.KalmanBallModeler]
+    friction = 0.5
+"""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from collections.abc import Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+from core.errors import TafelError
+
+CONTEXTS = ("cognition", "motion")
+PRIVATE_FILE = "private/private.toml"
+
+
+class ConfigError(TafelError, ValueError):
+    """A configuration file or override that cannot be used as written."""
+
+
+def layer_paths(config_dir: Path, platform: str, robot: str | None) -> list[Path]:
+    """The layer files in override order (only those that exist are read)."""
+    paths = [config_dir / "general.toml", config_dir / "platform" / f"{platform}.toml"]
+    if robot:
+        paths.append(config_dir / "robot" / f"{robot}.toml")
+    paths.append(config_dir / PRIVATE_FILE)
+    return paths
+
+
+def read_toml(path: Path) -> dict[str, Any]:
+    try:
+        with path.open("rb") as handle:
+            return tomllib.load(handle)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{path}: not valid TOML: {exc}") from None
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot read: {exc.strerror}") from None
+
+
+def merge(base: dict[str, Any], layer: Mapping[str, Any]) -> dict[str, Any]:
+    """``layer`` merged into a copy of ``base``: tables recursively, everything else replaced."""
+    result = copy.deepcopy(base)
+    for key, value in layer.items():
+        if isinstance(value, Mapping) and isinstance(result.get(key), dict):
+            result[key] = merge(result[key], value)
+        else:
+            result[key] = copy.deepcopy(value)
+    return result
+
+
+def parse_override(text: str) -> tuple[list[str], Any]:
+    """``runtime.cognition_hz=15`` -> (["runtime", "cognition_hz"], 15). Values are TOML, else strings."""
+    key, sep, raw = text.partition("=")
+    key = key.strip()
+    if not sep or not key or any(not part for part in key.split(".")):
+        raise ConfigError(f"--set takes KEY=VALUE with a dotted key, e.g. runtime.cognition_hz=15; got {text!r}")
+    raw = raw.strip()
+    try:
+        value = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw
+    return key.split("."), value
+
+
+def apply_overrides(config: dict[str, Any], overrides: Iterable[str]) -> dict[str, Any]:
+    result = copy.deepcopy(config)
+    for text in overrides:
+        path, value = parse_override(text)
+        node = result
+        for part in path[:-1]:
+            child = node.setdefault(part, {})
+            if not isinstance(child, dict):
+                raise ConfigError(f"--set {text}: {part} is a value, not a table")
+            node = child
+        node[path[-1]] = value
+    return result
+
+
+def load_config(
+    config_dir: Path, platform: str, robot: str | None = None, overrides: Iterable[str] = ()
+) -> dict[str, Any]:
+    """The merged configuration for a platform (and robot), with ``--set`` overrides applied last."""
+    if not config_dir.is_dir():
+        raise ConfigError(f"configuration folder {config_dir} does not exist; pass --config DIR")
+    config: dict[str, Any] = {}
+    sources = []
+    for path in layer_paths(config_dir, platform, robot):
+        if path.is_file():
+            config = merge(config, read_toml(path))
+            sources.append(str(path))
+    config = apply_overrides(config, overrides)
+    config["_sources"] = sources
+    return config
+
+
+def context_section(config: Mapping[str, Any], context: str) -> dict[str, Any]:
+    """The ``[cognition]`` or ``[motion]`` table with checked types."""
+    section = config.get(context, {})
+    if not isinstance(section, Mapping):
+        raise ConfigError(f"[{context}] must be a table")
+    modules = section.get("modules", [])
+    disabled = section.get("disabled", [])
+    providers = section.get("providers", {})
+    if not (isinstance(modules, list) and all(isinstance(m, str) for m in modules)):
+        raise ConfigError(f"{context}.modules must be a list of module names")
+    if not (isinstance(disabled, list) and all(isinstance(m, str) for m in disabled)):
+        raise ConfigError(f"{context}.disabled must be a list of module names")
+    if not (isinstance(providers, Mapping) and all(isinstance(v, str) for v in providers.values())):
+        raise ConfigError(f"{context}.providers must map representation names to module names")
+    return {"modules": list(modules), "disabled": list(disabled), "providers": dict(providers)}
+
+
+def store_private(config_dir: Path, path: list[str], value: Any) -> Path:
+    """Write one value into the private layer (``config/private/private.toml``), keeping the rest."""
+    target = config_dir / PRIVATE_FILE
+    data = read_toml(target) if target.is_file() else {}
+    node = data
+    for part in path[:-1]:
+        node = node.setdefault(part, {})
+    node[path[-1]] = value
+    target.parent.mkdir(parents=True, exist_ok=True)
+    target.write_text(dump_toml(data))
+    return target
+
+
+def dump_toml(data: Mapping[str, Any], prefix: str = "") -> str:
+    """Minimal TOML writer for configuration data (tables, strings, numbers, booleans, lists)."""
+    lines: list[str] = []
+    tables = []
+    for key, value in data.items():
+        if isinstance(value, Mapping):
+            tables.append((key, value))
+        else:
+            lines.append(f"{_key(key)} = {_value(value)}")
+    text = "\n".join(lines) + ("\n" if lines else "")
+    for key, value in tables:
+        name = f"{prefix}.{_key(key)}" if prefix else _key(key)
+        body = dump_toml(value, name)
+        text += f"\n[{name}]\n{body}" if any(not isinstance(v, Mapping) for v in value.values()) or not value else body
+    return text
+
+
+def _key(key: str) -> str:
+    return key if key.replace("_", "").replace("-", "").isalnum() else _value(key)
+
+
+def _value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return repr(value)
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_value(v) for v in value) + "]"
+    raise ConfigError(f"cannot store {value!r} in TOML")

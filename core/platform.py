@@ -1,0 +1,107 @@
+"""The platform interface: everything a robot program knows about where it runs.
+
+A platform declares, per context, the representations it provides (sensors) and consumes (actuators).
+The runtime registers them as external inputs of the managers; modules never see the platform itself.
+Each frame the runtime calls ``sense`` before the context's modules run and ``act`` after them, as in
+NaoTH: cognition runs after sensing, motion before acting.
+
+Two kinds of clock:
+- ``clock = "simulated"``: the runtime owns time (lockstep, deterministic). ``advance(time_ns)`` moves
+  the world to the given time before the frames of that tick run.
+- ``clock = "own"``: the platform's data arrives at its own pace (a robot, a webcam). ``sense`` blocks
+  until the next frame's data is there; both contexts run at once (the concurrent runtime).
+
+Platforms register under the entry point group ``tafel.platforms``: one class, one line in the
+distribution's metadata, so other packages can add platforms too.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Mapping
+from importlib.metadata import entry_points
+from typing import Any, ClassVar
+
+from core.errors import TafelError, UnknownModuleError
+from core.manager import Blackboard
+from core.naming import did_you_mean
+
+ENTRY_POINT_GROUP = "tafel.platforms"
+
+
+class PlatformError(TafelError, RuntimeError):
+    """A platform cannot start or cannot go on (missing device, unreadable file, lost connection)."""
+
+
+class EndOfData(TafelError):
+    """The platform has no more data (end of a video or log without --loop): stop cleanly."""
+
+
+class Platform:
+    """Base class of all platforms. Subclasses fill ``provides`` and ``consumes`` and the methods."""
+
+    #: the name used with ``tafel run --platform NAME``
+    name: ClassVar[str] = ""
+    #: one line for ``tafel platforms``
+    description: ClassVar[str] = ""
+    #: "simulated" (lockstep, runtime-owned time) or "own" (data arrives at its own pace)
+    clock: ClassVar[str] = "simulated"
+    #: context -> representation classes the platform writes (sensors)
+    provides: ClassVar[Mapping[str, tuple[type, ...]]] = {}
+    #: context -> representation classes the platform reads (actuators)
+    consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {}
+
+    def __init__(self, options: Mapping[str, Any] | None = None) -> None:
+        self.options = dict(options or {})
+
+    @classmethod
+    def add_arguments(cls, parser: argparse.ArgumentParser) -> None:
+        """Command-line options of this platform (for ``tafel run``); values arrive in ``options``."""
+
+    def rates(self) -> Mapping[str, float] | None:
+        """Frame rates (Hz) the platform imposes per context, or None to use the configured ones."""
+        return None
+
+    def start(self, contexts: frozenset[str]) -> None:
+        """Open devices and files for ``contexts`` (called in the process that runs them)."""
+
+    def advance(self, time_ns: int) -> None:
+        """Simulated clock only: move the world forward to ``time_ns`` (physics, synthetic data)."""
+
+    def sense(self, context: str, blackboard: Blackboard, frame_number: int, time_ns: int) -> None:
+        """Write this frame's sensor representations of ``context`` into ``blackboard``.
+
+        With an own clock this blocks until the data is there and may update the time it was taken
+        (see ``frame_time_ns``); it raises ``EndOfData`` when the source is exhausted.
+        """
+
+    def act(self, context: str, blackboard: Blackboard) -> None:
+        """Read the actuator representations of ``context`` from ``blackboard`` and apply them."""
+
+    def frame_time_ns(self, context: str) -> int | None:
+        """Own clock only: the platform's time of the last ``sense``; None to use the wall clock."""
+        return None
+
+    def stop(self) -> None:
+        """Release everything (also called after errors); must not raise."""
+
+    # Debug hooks: name -> (description, handler(args) -> answer text). Filled by platforms with
+    # commands such as moving the ball; the debug server exposes them.
+    def commands(self) -> Mapping[str, tuple[str, Any]]:
+        return {}
+
+
+def available_platforms() -> dict[str, Any]:
+    """Name -> entry point of every registered platform (not yet imported)."""
+    return {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)}
+
+
+def load_platform(name: str) -> type[Platform]:
+    """The platform class registered as ``name``; ``UnknownModuleError`` with suggestions otherwise."""
+    known = available_platforms()
+    if name not in known:
+        raise UnknownModuleError(f"unknown platform {name!r}: {did_you_mean(name, known)}")
+    cls = known[name].load()
+    if not (isinstance(cls, type) and issubclass(cls, Platform)):
+        raise PlatformError(f"entry point {name!r} of group {ENTRY_POINT_GROUP} is {cls!r}, not a Platform subclass")
+    return cls

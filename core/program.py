@@ -1,0 +1,161 @@
+"""A robot program: the contexts, their modules and what crosses between them and the platform.
+
+``plan_program`` turns a merged configuration and a platform class into one ``ContextPlan`` per
+context: the module classes, provider choices and parameters, what the platform provides and
+consumes, which representations are handed over from the other context, and which modules had to be
+pruned because nothing can provide what they read. Plans are plain picklable data, so the concurrent
+runtime can send them to the processes that run the contexts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from core.config import CONTEXTS, ConfigError, context_section
+from core.errors import ConflictingProvidersError, MissingProviderError
+from core.manager import ModuleManager
+from core.module import find_module
+from core.platform import Platform
+from core.status import CognitionStatus
+
+DEFAULT_RATES = {"cognition": 30.0, "motion": 100.0}
+
+
+@dataclass
+class ContextPlan:
+    """Everything needed to build one context's manager, in this or another process."""
+
+    name: str
+    rate_hz: float
+    modules: list[type]
+    providers: dict[str, str]
+    disabled: list[str]
+    parameters: dict[str, dict[str, Any]]
+    platform_provides: list[type]
+    platform_consumes: list[type]
+    handover_in: list[type] = field(default_factory=list)
+    handover_out: list[type] = field(default_factory=list)
+    #: module name -> representations it reads that nothing can provide here
+    pruned: dict[str, list[str]] = field(default_factory=dict)
+    #: representations the platform consumes but no module provides (the platform gets defaults)
+    unfed: list[str] = field(default_factory=list)
+
+    @property
+    def external(self) -> list[type]:
+        extra = [CognitionStatus] if self.name == "motion" else []
+        return list(dict.fromkeys([*self.platform_provides, *self.handover_in, *extra]))
+
+    @property
+    def runs(self) -> bool:
+        """A context runs when it has modules or platform data to process."""
+        return bool(self.active_modules() or self.platform_provides)
+
+    def active_modules(self) -> list[type]:
+        off = set(self.disabled) | set(self.pruned)
+        return [m for m in self.modules if m.__name__ not in off]
+
+    def build_manager(self, strict: bool = False) -> ModuleManager:
+        parameters = {m: v for m, v in self.parameters.items() if m in {c.__name__ for c in self.modules}}
+        return ModuleManager(
+            self.modules,
+            name=self.name,
+            external=self.external,
+            providers=self.providers,
+            strict=strict,
+            parameters=parameters,
+            disabled=[*self.disabled, *self.pruned],
+        )
+
+
+def plan_program(config: Mapping[str, Any], platform: type[Platform], *, strict: bool = False) -> dict[str, ContextPlan]:
+    """Context plans for ``config`` on ``platform``; raises ``ModuleGraphError``/``ConfigError`` if broken.
+
+    With ``strict``, a module that the platform cannot feed is an error instead of being pruned.
+    """
+    runtime = config.get("runtime", {})
+    parameters = config.get("parameters", {})
+    if not isinstance(parameters, Mapping):
+        raise ConfigError("[parameters] must be a table of module tables")
+    plans: dict[str, ContextPlan] = {}
+    for context in CONTEXTS:
+        section = context_section(config, context)
+        modules = [find_module(name) for name in section["modules"]]
+        for name in section["disabled"]:
+            find_module(name)
+        rate = float(runtime.get(f"{context}_hz", DEFAULT_RATES[context]))
+        if rate <= 0:
+            raise ConfigError(f"runtime.{context}_hz must be positive, got {rate}")
+        plans[context] = ContextPlan(
+            name=context,
+            rate_hz=rate,
+            modules=modules,
+            providers=section["providers"],
+            disabled=section["disabled"],
+            parameters={k: dict(v) for k, v in parameters.items() if isinstance(v, Mapping)},
+            platform_provides=list(platform.provides.get(context, ())),
+            platform_consumes=list(platform.consumes.get(context, ())),
+        )
+    _check_single_provider(plans)
+    _route(plans)
+    if strict:
+        problems = [
+            f"{plan.name}: {module} needs {', '.join(missing)}"
+            for plan in plans.values()
+            for module, missing in plan.pruned.items()
+        ]
+        if problems:
+            raise MissingProviderError(
+                f"platform {platform.name!r} cannot feed these modules (--strict): " + "; ".join(problems)
+                + ". Remove them from the configuration of this platform, or run without --strict to prune them."
+            )
+    return plans
+
+
+def _provided(modules: list[type]) -> set[type]:
+    return {rep for m in modules for rep in m.requirements().provides}
+
+
+def _check_single_provider(plans: Mapping[str, ContextPlan]) -> None:
+    cognition, motion = plans["cognition"], plans["motion"]
+    both = _provided(cognition.active_modules()) & _provided(motion.active_modules())
+    if both:
+        names = ", ".join(sorted(r.__name__ for r in both))
+        raise ConflictingProvidersError(
+            f"{names} is provided in both contexts, by cognition and by motion modules; a representation "
+            "has one provider in one context and is handed over to the other. Remove one provider."
+        )
+
+
+def _route(plans: Mapping[str, ContextPlan]) -> None:
+    """Decide hand-overs and prune modules whose inputs nobody provides, until nothing changes."""
+    pruned: dict[str, dict[str, list[str]]] = {c: {} for c in plans}
+    while True:
+        remaining = {c: [m for m in p.modules if m.__name__ not in set(p.disabled) | set(pruned[c])] for c, p in plans.items()}
+        local = {c: set(plans[c].platform_provides) | _provided(remaining[c]) for c in plans}
+        if "motion" in local:
+            local["motion"].add(CognitionStatus)
+        changed = False
+        for context, plan in plans.items():
+            other = "motion" if context == "cognition" else "cognition"
+            available = local[context] | local[other]
+            for module in remaining[context]:
+                missing = [r.__name__ for r in module.requirements().reads() if r not in available]
+                if missing:
+                    pruned[context][module.__name__] = missing
+                    changed = True
+        if not changed:
+            break
+    for context, plan in plans.items():
+        other = "motion" if context == "cognition" else "cognition"
+        plan.pruned = pruned[context]
+        reads = {r for m in plan.active_modules() for r in m.requirements().reads()}
+        plan.handover_in = sorted(
+            (r for r in reads if r not in local[context] and r in local[other]), key=lambda r: r.__name__
+        )
+        provided = _provided(plan.active_modules())
+        plan.unfed = sorted(r.__name__ for r in plan.platform_consumes if r not in provided)
+    for context, plan in plans.items():
+        other = "motion" if context == "cognition" else "cognition"
+        plan.handover_out = list(plans[other].handover_in)

@@ -1,0 +1,489 @@
+"""The runtimes: how the contexts of a program are driven frame by frame.
+
+- ``LockstepRuntime`` (simulated clocks): one thread; motion runs on every motion tick and cognition
+  whenever simulated time has passed its next tick, so a 30/100 Hz program gets exactly 3 cognition
+  frames per 10 motion frames over whole seconds, deterministically. Paced to the wall clock by
+  ``speed`` (1 = real time, None = as fast as possible).
+- ``ConcurrentRuntime`` (own clocks, or forced): each context in its own process, so Python-heavy
+  cognition cannot take the interpreter lock from motion; motion asks for SCHED_FIFO. Hand-overs go
+  through shared memory, and motion sees in ``CognitionStatus`` when cognition stalls or dies.
+
+Both call the same ``ContextRunner.step`` per frame: sense, take hand-overs, execute, act, publish.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import multiprocessing
+import os
+import pickle
+import signal
+import statistics
+import sys
+import threading
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from fractions import Fraction
+from typing import Any
+
+from core.handover import Bundle, LocalChannel, SharedChannel, apply_bundle, make_bundle
+from core.manager import ModuleManager
+from core.platform import EndOfData, Platform, PlatformError
+from core.program import ContextPlan
+from core.status import CognitionStatus
+
+log = logging.getLogger("tafel.runtime")
+
+#: the context that drives the frame count (``--frames``) when both run
+MAIN_CONTEXT_ORDER = ("motion", "cognition")
+
+
+@dataclass
+class Limits:
+    """When to stop: after ``frames`` frames of the main context, ``seconds`` of platform time, or never."""
+
+    frames: int | None = None
+    seconds: float | None = None
+    #: pace factor against the wall clock; None runs as fast as possible
+    speed: float | None = 1.0
+
+
+@dataclass
+class ContextStats:
+    """What a context reports about itself (sent between processes, so plain data)."""
+
+    name: str
+    frames: int = 0
+    wall_s: float = 0.0
+    module_errors: int = 0
+    errors_by_module: dict[str, int] = field(default_factory=dict)
+    period_errors_ms: list[float] = field(default_factory=list)
+    missed_periods: int = 0
+    realtime: str = ""
+    frames_without_cognition: int = 0
+    digest: str = ""
+    finished: bool = False
+    failure: str = ""
+
+    @property
+    def rate_hz(self) -> float:
+        return self.frames / self.wall_s if self.wall_s > 0 else 0.0
+
+    def period_error_percentiles(self) -> dict[str, float]:
+        errors = sorted(self.period_errors_ms)
+        if not errors:
+            return {"p50_ms": 0.0, "p99_ms": 0.0, "max_ms": 0.0}
+        return {
+            "p50_ms": statistics.median(errors),
+            "p99_ms": errors[min(len(errors) - 1, int(round(0.99 * (len(errors) - 1))))],
+            "max_ms": errors[-1],
+        }
+
+
+def state_digest(manager: ModuleManager) -> str:
+    """A short fingerprint of every representation on a blackboard (equal states, equal digests)."""
+    digest = hashlib.blake2b(digest_size=8)
+    for name in manager.blackboard.names():
+        digest.update(name.encode())
+        digest.update(pickle.dumps(manager.blackboard.get(name).__dict__, protocol=5))
+    return digest.hexdigest()
+
+
+class ContextRunner:
+    """One context's frame: sense, take the other context's hand-over, execute, act, publish."""
+
+    def __init__(self, plan: ContextPlan, manager: ModuleManager, platform: Platform,
+                 inbox: Any = None, outbox: Any = None) -> None:
+        self.plan = plan
+        self.name = plan.name
+        self.manager = manager
+        self.platform = platform
+        self.inbox = inbox
+        self.outbox = outbox
+        self.last_bundle: Bundle | None = None
+        self.time_ns = 0
+
+    @property
+    def frames(self) -> int:
+        return self.manager.frame
+
+    def step(self, time_ns: int) -> None:
+        blackboard = self.manager.blackboard
+        frame_number = self.manager.frame + 1
+        self.platform.sense(self.name, blackboard, frame_number, time_ns)
+        own_time = self.platform.frame_time_ns(self.name)
+        self.time_ns = own_time if own_time is not None else time_ns
+        if self.inbox is not None:
+            bundle = self.inbox.latest()
+            if bundle is not None and bundle is not self.last_bundle:
+                apply_bundle(bundle, blackboard, self.plan.handover_in)
+                self.last_bundle = bundle
+        self.manager.execute()
+        self.platform.act(self.name, blackboard)
+        if self.outbox is not None and self.plan.handover_out:
+            self.outbox.publish(make_bundle(blackboard, self.plan.handover_out, self.manager.frame, self.time_ns))
+
+    def stats(self, wall_s: float) -> ContextStats:
+        errors = {name: count for name, (count, _) in self.manager.errors().items()}
+        return ContextStats(
+            name=self.name, frames=self.frames, wall_s=wall_s,
+            module_errors=sum(errors.values()), errors_by_module=errors,
+        )
+
+
+class StopFlag:
+    """Set by a signal handler or another thread; the loops check it between frames."""
+
+    def __init__(self) -> None:
+        self._event = threading.Event()
+
+    def set(self) -> None:
+        self._event.set()
+
+    def is_set(self) -> bool:
+        return self._event.is_set()
+
+
+def install_signal_handlers(stop: Any, on_force: Callable[[], None] | None = None) -> None:
+    """First Ctrl-C or SIGTERM asks for a clean stop; a second Ctrl-C forces (KeyboardInterrupt)."""
+
+    def handle(signum: int, _frame: Any) -> None:
+        if stop.is_set() and signum == signal.SIGINT:
+            if on_force is not None:
+                on_force()
+            raise KeyboardInterrupt
+        stop.set()
+        if signum == signal.SIGINT:
+            print("\nstopping (Ctrl-C again to force)", file=sys.stderr, flush=True)
+
+    signal.signal(signal.SIGINT, handle)
+    signal.signal(signal.SIGTERM, handle)
+
+
+# ---------------------------------------------------------------------------------------- lockstep
+class LockstepRuntime:
+    """Deterministic single-threaded runtime for platforms with a simulated clock."""
+
+    def __init__(self, plans: Mapping[str, ContextPlan], platform: Platform, *, strict: bool = False) -> None:
+        self.platform = platform
+        self.plans = {name: plan for name, plan in plans.items() if plan.runs}
+        if not self.plans:
+            raise PlatformError("nothing to run: no context has modules or platform data")
+        channels = {name: LocalChannel() for name in self.plans}
+        self.runners: dict[str, ContextRunner] = {}
+        for name, plan in self.plans.items():
+            other = "motion" if name == "cognition" else "cognition"
+            self.runners[name] = ContextRunner(
+                plan, plan.build_manager(strict), platform,
+                inbox=channels.get(other) if plan.handover_in else None,
+                outbox=channels[name],
+            )
+        self.main = next(name for name in MAIN_CONTEXT_ORDER if name in self.runners)
+        self.time_ns = 0
+        self.wall_s = 0.0
+        self.stop = StopFlag()
+        self.end_reason = ""
+        #: called after every tick with the runtime (status lines, debug commands between frames)
+        self.after_tick: list[Callable[[LockstepRuntime], None]] = []
+
+    @property
+    def managers(self) -> dict[str, ModuleManager]:
+        return {name: runner.manager for name, runner in self.runners.items()}
+
+    def run(self, limits: Limits) -> dict[str, ContextStats]:
+        main_rate = Fraction(str(self.plans[self.main].rate_hz))
+        cognition = self.runners.get("cognition") if self.main == "motion" else None
+        cognition_rate = Fraction(str(self.plans["cognition"].rate_hz)) if cognition else None
+        motion_status = self._cognition_status()
+        self.platform.start(frozenset(self.runners))
+        start = time.monotonic()
+        tick = 0
+        try:
+            while not self.stop.is_set():
+                if limits.frames is not None and tick >= limits.frames:
+                    self.end_reason = f"{limits.frames} {self.main} frames"
+                    break
+                time_ns = int(Fraction(tick * 10**9) / main_rate)
+                if limits.seconds is not None and time_ns >= limits.seconds * 1e9:
+                    self.end_reason = f"{limits.seconds:g} s"
+                    break
+                if limits.speed:
+                    delay = start + time_ns * 1e-9 / limits.speed - time.monotonic()
+                    if delay > 0:
+                        time.sleep(delay)
+                self.time_ns = time_ns
+                self.platform.advance(time_ns)
+                main = self.runners[self.main]
+                if motion_status is not None and cognition is not None:
+                    motion_status.alive = True
+                    motion_status.frame_number = cognition.frames
+                    motion_status.age = (time_ns - cognition.time_ns) * 1e-9 if cognition.frames else 0.0
+                main.step(time_ns)
+                # cognition tick k is due at k / cognition_rate seconds: compare exactly
+                if cognition is not None and tick * cognition_rate >= cognition.frames * main_rate:
+                    cognition.step(time_ns)
+                tick += 1
+                for hook in self.after_tick:
+                    hook(self)
+        except EndOfData as exc:
+            self.end_reason = str(exc) or "end of data"
+        finally:
+            self.time_ns = int(Fraction(tick * 10**9) / main_rate)  # platform time covered by the ticks run
+            self.wall_s = time.monotonic() - start
+            self.platform.stop()
+        if self.stop.is_set() and not self.end_reason:
+            self.end_reason = "stopped"
+        return self.stats()
+
+    def _cognition_status(self) -> CognitionStatus | None:
+        runner = self.runners.get("motion")
+        if runner is None or CognitionStatus not in runner.manager.blackboard:
+            return None
+        return runner.manager.blackboard[CognitionStatus]
+
+    def stats(self) -> dict[str, ContextStats]:
+        result = {}
+        for name, runner in self.runners.items():
+            stats = runner.stats(self.wall_s)
+            stats.digest = state_digest(runner.manager)
+            stats.finished = True
+            result[name] = stats
+        return result
+
+
+# -------------------------------------------------------------------------------------- concurrent
+@dataclass
+class WorkerSpec:
+    """What a context process needs; pickled to the child (module classes travel by reference)."""
+
+    plan: ContextPlan
+    platform_class: type[Platform]
+    platform_options: dict[str, Any]
+    strict: bool
+    limits: Limits
+    is_main: bool
+    inbox_name: str | None
+    outbox_name: str | None
+    stall_timeout_s: float
+    realtime_priority: int = 50
+
+
+def try_realtime(priority: int) -> str:
+    """Ask for SCHED_FIFO for the calling thread; returns a sentence saying what was granted."""
+    if not hasattr(os, "sched_setscheduler"):
+        return "SCHED_FIFO not available on this system"
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    except PermissionError:
+        return "SCHED_FIFO not permitted (run as root or grant CAP_SYS_NICE / rtprio); normal scheduling"
+    except OSError as exc:
+        return f"SCHED_FIFO refused ({exc.strerror}); normal scheduling"
+    return f"SCHED_FIFO priority {priority} granted"
+
+
+def run_context_loop(
+    runner: ContextRunner,
+    limits: Limits,
+    stop: Any,
+    *,
+    is_main: bool,
+    report: Callable[[ContextStats], None],
+    cognition_watch: Callable[[], tuple[bool, int, float]] | None = None,
+    realtime: str = "",
+) -> ContextStats:
+    """Run one context at its own pace until ``stop``, the limits, or the end of the data.
+
+    With a simulated or wall clock the loop sleeps to absolute deadlines (``deadline += period``), and
+    a late frame never shifts the beat; with a platform clock ``sense`` blocks and sets the pace.
+    """
+    plan = runner.plan
+    own_clock = runner.platform.clock == "own"
+    period_ns = int(1e9 / plan.rate_hz)
+    status = runner.manager.blackboard[CognitionStatus] if CognitionStatus in runner.manager.blackboard else None
+    stats = ContextStats(name=plan.name, realtime=realtime)
+    start_ns = time.monotonic_ns()
+    deadline = start_ns
+    last_report = start_ns
+    try:
+        while not stop.is_set():
+            if is_main and limits.frames is not None and runner.frames >= limits.frames:
+                break
+            now = time.monotonic_ns()
+            if is_main and limits.seconds is not None and now - start_ns >= limits.seconds * 1e9:
+                break
+            if not own_clock:
+                if now < deadline:
+                    time.sleep((deadline - now) * 1e-9)
+                    now = time.monotonic_ns()
+                stats.period_errors_ms.append((now - deadline) / 1e6)
+                deadline += period_ns
+                while deadline < now - period_ns:  # a whole period lost: skip it, keep the beat
+                    deadline += period_ns
+                    stats.missed_periods += 1
+            if status is not None and cognition_watch is not None:
+                alive, frame_number, age = cognition_watch()
+                status.alive, status.frame_number, status.age = alive, frame_number, age
+                if not alive:
+                    stats.frames_without_cognition += 1
+            runner.step(now - start_ns)
+            if now - last_report >= 1e9:
+                last_report = now
+                report(_snapshot_stats(runner, stats, start_ns))
+    except EndOfData:
+        pass
+    except Exception as exc:  # noqa: BLE001 - a platform failure ends this context with a report
+        stats.failure = f"{type(exc).__name__}: {exc}"
+        log.exception("%s loop failed", plan.name)
+    final = _snapshot_stats(runner, stats, start_ns)
+    final.finished = True
+    report(final)
+    return final
+
+
+def _snapshot_stats(runner: ContextRunner, stats: ContextStats, start_ns: int) -> ContextStats:
+    own = runner.stats((time.monotonic_ns() - start_ns) * 1e-9)
+    own.period_errors_ms = list(stats.period_errors_ms)
+    own.missed_periods = stats.missed_periods
+    own.realtime = stats.realtime
+    own.frames_without_cognition = stats.frames_without_cognition
+    own.failure = stats.failure
+    return own
+
+
+def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
+    """Entry point of a context process."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the supervisor decides when to stop
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    logging.basicConfig(level=logging.WARNING, format=f"[{spec.plan.name}] %(levelname)s %(message)s")
+    realtime = try_realtime(spec.realtime_priority) if spec.plan.name == "motion" else ""
+    inbox = SharedChannel.attach(spec.inbox_name) if spec.inbox_name else None
+    outbox = SharedChannel.attach(spec.outbox_name) if spec.outbox_name else None
+    platform = spec.platform_class(spec.platform_options)
+
+    def send(stats: ContextStats) -> None:
+        try:
+            reports.send(stats)
+        except (BrokenPipeError, OSError):
+            stop.set()
+
+    try:
+        platform.start(frozenset({spec.plan.name}))
+        manager = spec.plan.build_manager(spec.strict)
+        runner = ContextRunner(spec.plan, manager, platform, inbox=inbox, outbox=outbox)
+        watch = cognition_watcher(inbox, spec.stall_timeout_s) if spec.plan.name == "motion" and inbox else None
+        if spec.plan.name == "motion" and watch is None:
+            watch = lambda: (False, 0, 0.0)  # noqa: E731 - no cognition context at all
+        final = run_context_loop(runner, spec.limits, stop, is_main=spec.is_main, report=send,
+                                 cognition_watch=watch, realtime=realtime)
+        final.digest = state_digest(manager)
+        send(final)
+    except Exception as exc:  # noqa: BLE001 - report instead of dying silently
+        log.exception("%s context failed to start", spec.plan.name)
+        send(ContextStats(name=spec.plan.name, finished=True, failure=f"{type(exc).__name__}: {exc}"))
+    finally:
+        platform.stop()
+        for channel in (inbox, outbox):
+            if channel is not None:
+                channel.close()
+        if spec.is_main:
+            stop.set()
+
+
+def cognition_watcher(channel: Any, timeout_s: float) -> Callable[[], tuple[bool, int, float]]:
+    """Motion's view of cognition: alive while bundles keep arriving within ``timeout_s``."""
+    started = time.monotonic_ns()
+    state = {"frame": 0, "seen_ns": started}
+
+    def watch() -> tuple[bool, int, float]:
+        bundle = channel.latest()
+        now = time.monotonic_ns()
+        if bundle is not None and bundle.frame_number != state["frame"]:
+            state["frame"], state["seen_ns"] = bundle.frame_number, now
+        age = (now - state["seen_ns"]) * 1e-9
+        return age < timeout_s, state["frame"], age
+
+    return watch
+
+
+class ConcurrentRuntime:
+    """Each context in its own process; the calling process supervises, reports and shuts down."""
+
+    def __init__(self, plans: Mapping[str, ContextPlan], platform_class: type[Platform],
+                 platform_options: Mapping[str, Any], *, strict: bool = False, stall_timeout_s: float = 1.0) -> None:
+        self.plans = {name: plan for name, plan in plans.items() if plan.runs}
+        if not self.plans:
+            raise PlatformError("nothing to run: no context has modules or platform data")
+        self.platform_class = platform_class
+        self.platform_options = dict(platform_options)
+        self.strict = strict
+        self.stall_timeout_s = stall_timeout_s
+        self.main = next(name for name in MAIN_CONTEXT_ORDER if name in self.plans)
+        self.stats: dict[str, ContextStats] = {name: ContextStats(name=name) for name in self.plans}
+        self.exit_codes: dict[str, int | None] = {}
+        self.notices: list[str] = []
+        self.on_report: list[Callable[[ConcurrentRuntime], None]] = []
+        self._mp = multiprocessing.get_context("spawn")
+        self.stop = self._mp.Event()
+        self.processes: dict[str, Any] = {}
+
+    def run(self, limits: Limits) -> dict[str, ContextStats]:
+        channels = {name: SharedChannel() for name in self.plans}
+        connections = {}
+        try:
+            for name, plan in self.plans.items():
+                other = "motion" if name == "cognition" else "cognition"
+                watch_cognition = name == "motion" and "cognition" in channels
+                spec = WorkerSpec(
+                    plan=plan, platform_class=self.platform_class, platform_options=self.platform_options,
+                    strict=self.strict, limits=limits, is_main=name == self.main,
+                    inbox_name=channels[other].name if (plan.handover_in or watch_cognition) and other in channels else None,
+                    outbox_name=channels[name].name, stall_timeout_s=self.stall_timeout_s,
+                )
+                receiver, sender = self._mp.Pipe(duplex=False)
+                process = self._mp.Process(target=_worker_main, args=(spec, self.stop, sender), name=f"tafel-{name}", daemon=True)
+                process.start()
+                sender.close()
+                connections[name] = receiver
+                self.processes[name] = process
+            self._supervise(connections)
+        finally:
+            self.stop.set()
+            for process in self.processes.values():
+                process.join(timeout=5)
+                if process.is_alive():
+                    process.kill()
+                    process.join(timeout=2)
+            for channel in channels.values():
+                channel.close()
+        return self.stats
+
+    def _supervise(self, connections: dict[str, Any]) -> None:
+        from multiprocessing.connection import wait
+
+        reported_dead: set[str] = set()
+        open_connections = dict(connections)
+        while open_connections:
+            ready = wait(list(open_connections.values()), timeout=0.2)
+            for name, connection in list(open_connections.items()):
+                if connection in ready:
+                    try:
+                        self.stats[name] = connection.recv()
+                    except (EOFError, OSError):
+                        del open_connections[name]
+                        continue
+                    for hook in self.on_report:
+                        hook(self)
+            for name, process in self.processes.items():
+                if not process.is_alive() and name not in reported_dead:
+                    reported_dead.add(name)
+                    self.exit_codes[name] = process.exitcode
+                    if not self.stats[name].finished:
+                        self.notices.append(f"{name} process died (exit code {process.exitcode}); the other context keeps running")
+                        log.error(self.notices[-1])
+                        open_connections.pop(name, None)
+            if self.stop.is_set() and all(not p.is_alive() for p in self.processes.values()):
+                break
+            if not self.processes[self.main].is_alive() and self.main in reported_dead:
+                self.stop.set()

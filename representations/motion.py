@@ -1,0 +1,80 @@
+"""Representations of the motion context: joint and inertial sensors, joint targets and commands.
+
+Every 25-element joint array is in ``JOINT_NAMES`` order (the order of the NAO's LoLA interface).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from core import array, representation
+
+JOINT_NAMES: tuple[str, ...] = (
+    "HeadYaw", "HeadPitch",
+    "LShoulderPitch", "LShoulderRoll", "LElbowYaw", "LElbowRoll", "LWristYaw",
+    "LHipYawPitch", "LHipRoll", "LHipPitch", "LKneePitch", "LAnklePitch", "LAnkleRoll",
+    "RHipRoll", "RHipPitch", "RKneePitch", "RAnklePitch", "RAnkleRoll",
+    "RShoulderPitch", "RShoulderRoll", "RElbowYaw", "RElbowRoll", "RWristYaw",
+    "LHand", "RHand",
+)
+JOINT_COUNT = len(JOINT_NAMES)
+JOINT_INDEX: dict[str, int] = {name: i for i, name in enumerate(JOINT_NAMES)}
+HEAD_YAW, HEAD_PITCH = JOINT_INDEX["HeadYaw"], JOINT_INDEX["HeadPitch"]
+
+
+def joint_array() -> np.ndarray:
+    return np.zeros(JOINT_COUNT)
+
+
+@representation
+class JointSensorData:
+    """Measured joint state: ``position`` (rad; hands 0..1 open), ``stiffness`` (0..1), ``current`` (A),
+    ``temperature`` (deg C), in ``JOINT_NAMES`` order."""
+
+    position: np.ndarray = array((JOINT_COUNT,))
+    stiffness: np.ndarray = array((JOINT_COUNT,))
+    current: np.ndarray = array((JOINT_COUNT,))
+    temperature: np.ndarray = array((JOINT_COUNT,))
+
+
+@representation
+class InertialSensorData:
+    """The IMU in the robot frame: ``accelerometer`` (m/s^2, about +9.81 on z when upright),
+    ``gyroscope`` (rad/s about x, y, z), ``angles`` (torso roll and pitch, rad)."""
+
+    accelerometer: np.ndarray = array((3,))
+    gyroscope: np.ndarray = array((3,))
+    angles: np.ndarray = array((2,))
+
+
+@representation
+class FsrData:
+    """Foot pressure (kg): left foot front-left, front-right, rear-left, rear-right, then the right foot."""
+
+    pressure: np.ndarray = array((8,))
+
+
+@representation
+class HeadJointTargets:
+    """Where the head motion wants the head joints now (rad), and the stiffness to hold them (0..1)."""
+
+    yaw: float = 0.0
+    pitch: float = 0.0
+    stiffness: float = 0.0
+
+
+@representation
+class BodyJointTargets:
+    """Targets of all joints but the head from the body motion (rad, ``JOINT_NAMES`` order; the head
+    entries are ignored), with stiffness per joint (0..1)."""
+
+    position: np.ndarray = array((JOINT_COUNT,))
+    stiffness: np.ndarray = array((JOINT_COUNT,))
+
+
+@representation
+class JointCommand:
+    """What the actuators get this motion frame: ``position`` (rad) and ``stiffness`` (0..1) per joint."""
+
+    position: np.ndarray = array((JOINT_COUNT,))
+    stiffness: np.ndarray = array((JOINT_COUNT,))

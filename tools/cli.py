@@ -1,0 +1,295 @@
+"""The ``tafel`` command line: the one place that wires core, platforms, modules and debugging together."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import logging
+import pkgutil
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any, NoReturn
+
+from core.config import load_config
+from core.dot import contexts_dot
+from core.errors import TafelError
+from core.platform import Platform, PlatformError, available_platforms, load_platform
+from core.program import ContextPlan, plan_program
+from core.runtime import ConcurrentRuntime, ContextStats, Limits, LockstepRuntime, install_signal_handlers
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+DEFAULT_CONFIG = REPO_ROOT / "config"
+FALLBACK_PLATFORM = "dummy"
+
+
+class UsageError(Exception):
+    """Wrong names or arguments: exit status 2 with a message saying what would have been right."""
+
+
+def discover_modules() -> None:
+    """Import every module file under ``modules/`` so configuration can name them."""
+    import modules
+
+    for info in pkgutil.walk_packages(modules.__path__, prefix="modules."):
+        importlib.import_module(info.name)
+
+
+def parse_speed(text: str) -> float | None:
+    if text == "max":
+        return None
+    try:
+        speed = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--speed takes a positive number or 'max', got {text!r}") from None
+    if speed <= 0:
+        raise argparse.ArgumentTypeError(f"--speed must be positive, got {text!r}")
+    return speed
+
+
+def positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected at least 1, got {value}")
+    return value
+
+
+def positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {value}")
+    return value
+
+
+def add_program_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--platform", help="where to run (see 'tafel platforms'); default from configuration")
+    parser.add_argument("--config", type=Path, default=DEFAULT_CONFIG, help="configuration folder (default: %(default)s)")
+    parser.add_argument("--robot", help="robot layer config/robot/NAME.toml")
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                        help="override a configuration value, e.g. runtime.cognition_hz=15 (repeatable)")
+    parser.add_argument("--strict", action="store_true",
+                        help="modules the platform cannot feed are an error instead of being pruned")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="tafel", description="Run and inspect Tafel robot control programs.")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND")
+    commands.required = True
+
+    run = commands.add_parser("run", help="run the program on a platform")
+    add_program_arguments(run)
+    limit = run.add_mutually_exclusive_group()
+    limit.add_argument("--seconds", type=positive_float, help="stop after this much platform time")
+    limit.add_argument("--frames", type=positive_int, help="stop after N frames of the main context (motion, else cognition)")
+    run.add_argument("--speed", type=parse_speed, default=1.0, help="pace against the wall clock: a factor, or 'max'")
+    run.add_argument("--concurrent", action="store_true", help="run the contexts in parallel processes")
+    run.add_argument("--status-interval", type=positive_float, default=2.0, metavar="S",
+                     help="seconds between status lines (default: %(default)s)")
+    run.add_argument("-v", "--verbose", action="store_true", help="log informational messages")
+
+    platforms = commands.add_parser("platforms", help="list the platforms and what they provide and consume")
+    platforms.add_argument("--verbose", "-v", action="store_true")
+
+    modules = commands.add_parser("modules", help="show the module graph of both contexts")
+    add_program_arguments(modules)
+    modules.add_argument("--dot", action="store_true", help="print Graphviz DOT of both contexts and their hand-overs")
+    return parser
+
+
+def fail(message: str) -> NoReturn:
+    raise UsageError(message)
+
+
+def resolve_platform(args: argparse.Namespace, config_dir: Path) -> type[Platform]:
+    name = args.platform
+    if name is None:
+        general = config_dir / "general.toml"
+        name = FALLBACK_PLATFORM
+        if general.is_file():
+            from core.config import read_toml
+
+            name = read_toml(general).get("runtime", {}).get("default_platform", FALLBACK_PLATFORM)
+        args.platform = name
+    return load_platform(name)
+
+
+def prepare(args: argparse.Namespace, extra: Sequence[str]) -> tuple[type[Platform], dict[str, Any], dict[str, ContextPlan], dict[str, Any]]:
+    """Platform class, platform options, context plans and configuration for ``run`` and ``modules``."""
+    platform_class = resolve_platform(args, args.config)
+    platform_parser = argparse.ArgumentParser(prog=f"tafel {args.command} --platform {platform_class.name}", add_help=False)
+    platform_class.add_arguments(platform_parser)
+    options, unknown = platform_parser.parse_known_args(list(extra))
+    if unknown:
+        known = [a for action in platform_parser._actions for a in action.option_strings]
+        hint = f"; options of platform {platform_class.name}: {', '.join(known)}" if known else ""
+        fail(f"unrecognized arguments: {' '.join(unknown)}{hint}")
+    discover_modules()
+    config = load_config(args.config, platform_class.name, args.robot, args.overrides)
+    plans = plan_program(config, platform_class, strict=args.strict)
+    return platform_class, vars(options), plans, config
+
+
+# ----------------------------------------------------------------------------------------- run
+def format_status(platform: str, elapsed_s: float, stats: dict[str, ContextStats], notices: Sequence[str] = ()) -> str:
+    parts = [f"[tafel] {platform} t={elapsed_s:.1f}s"]
+    for name, s in stats.items():
+        parts.append(f"{name} {s.rate_hz:.1f} Hz {s.frames} frames")
+    errors = sum(s.module_errors for s in stats.values())
+    parts.append(f"module errors {errors}")
+    parts.extend(notices)
+    return " | ".join(parts)
+
+
+def print_summary(platform: str, mode: str, stats: dict[str, ContextStats], wall_s: float, sim_s: float | None, reason: str) -> None:
+    time_text = f"{sim_s:.3f} s of platform time" if sim_s is not None else f"{wall_s:.3f} s"
+    print(f"platform {platform} ({mode}): ran {time_text}" + (f", stopped after {reason}" if reason else ""))
+    for name, s in stats.items():
+        errors = ", ".join(f"{m} {n}" for m, n in sorted(s.errors_by_module.items())) or "none"
+        line = f"  {name}: {s.frames} frames, module errors: {errors}"
+        if s.digest:
+            line += f", state {s.digest}"
+        if s.failure:
+            line += f", FAILED: {s.failure}"
+        print(line)
+    rates = ", ".join(f"{n} {s.rate_hz:.1f} Hz" for n, s in stats.items())
+    sys.stdout.flush()
+    print(f"wall time {wall_s:.2f} s ({rates})", file=sys.stderr)
+
+
+def command_run(args: argparse.Namespace, extra: Sequence[str]) -> int:
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(name)s %(levelname)s: %(message)s")
+    platform_class, options, plans, config = prepare(args, extra)
+    report_pruned(plans)
+    limits = Limits(frames=args.frames, seconds=args.seconds, speed=args.speed)
+    concurrent = args.concurrent or platform_class.clock == "own"
+    stall = float(config.get("runtime", {}).get("stall_timeout_s", 1.0))
+    started = time.monotonic()
+    if concurrent:
+        runtime = ConcurrentRuntime(plans, platform_class, options, strict=args.strict, stall_timeout_s=stall)
+        last = [started]
+
+        def on_report(rt: ConcurrentRuntime) -> None:
+            now = time.monotonic()
+            if now - last[0] >= args.status_interval:
+                last[0] = now
+                print(format_status(platform_class.name, now - started, rt.stats, rt.notices), file=sys.stderr, flush=True)
+
+        runtime.on_report.append(on_report)
+        install_signal_handlers(runtime.stop, on_force=lambda: [p.kill() for p in runtime.processes.values()])
+        stats = runtime.run(limits)
+        realtime = stats.get("motion", ContextStats("motion")).realtime
+        if realtime:
+            print(f"motion: {realtime}", file=sys.stderr)
+        for notice in runtime.notices:
+            print(f"notice: {notice}", file=sys.stderr)
+        print_summary(platform_class.name, "concurrent", stats, time.monotonic() - started, None, "")
+        failed = [s.failure for s in stats.values() if s.failure]
+        return 1 if failed else 0
+
+    platform = platform_class(options)
+    runtime = LockstepRuntime(plans, platform, strict=args.strict)
+    install_signal_handlers(runtime.stop)
+    last = [started]
+
+    def status(rt: LockstepRuntime) -> None:
+        now = time.monotonic()
+        if now - last[0] >= args.status_interval:
+            last[0] = now
+            stats = {name: r.stats(now - started) for name, r in rt.runners.items()}
+            print(format_status(platform_class.name, rt.time_ns * 1e-9, stats), file=sys.stderr, flush=True)
+
+    runtime.after_tick.append(status)
+    stats = runtime.run(limits)
+    print_summary(platform_class.name, "lockstep", stats, runtime.wall_s, runtime.time_ns * 1e-9, runtime.end_reason)
+    return 0
+
+
+def report_pruned(plans: dict[str, ContextPlan]) -> None:
+    for plan in plans.values():
+        for module, missing in plan.pruned.items():
+            print(f"{plan.name}: {module} disabled, platform provides no {', '.join(missing)}", file=sys.stderr)
+
+
+# ----------------------------------------------------------------------------------- platforms
+def command_platforms(args: argparse.Namespace, extra: Sequence[str]) -> int:
+    for name in sorted(available_platforms()):
+        try:
+            cls = load_platform(name)
+        except Exception as exc:  # noqa: BLE001 - one broken platform must not hide the others
+            print(f"{name}: cannot load ({type(exc).__name__}: {exc})")
+            continue
+        print(f"{name}: {cls.description} [{cls.clock} clock]")
+        for context in ("cognition", "motion"):
+            provided = ", ".join(r.__name__ for r in cls.provides.get(context, ())) or "-"
+            consumed = ", ".join(r.__name__ for r in cls.consumes.get(context, ())) or "-"
+            print(f"  {context}: provides {provided}; consumes {consumed}")
+    return 0
+
+
+# ------------------------------------------------------------------------------------- modules
+def command_modules(args: argparse.Namespace, extra: Sequence[str]) -> int:
+    platform_class, _options, plans, _config = prepare(args, extra)
+    managers = {name: plan.build_manager() for name, plan in plans.items() if plan.runs}
+    if args.dot:
+        handovers = [(rep.__name__, plan.name, other) for other, p in plans.items() if p.runs
+                     for plan in plans.values() if plan.name != other for rep in p.handover_in]
+        print(contexts_dot([m.graph() for m in managers.values()], handovers), end="")
+        return 0
+    print(f"platform {platform_class.name}")
+    for name, plan in plans.items():
+        manager = managers.get(name)
+        print(f"\n{name} ({plan.rate_hz:g} Hz)")
+        if manager is None:
+            print("  not running: no modules and no platform data")
+            continue
+        print("  order: " + (" -> ".join(manager.order) or "(no modules)"))
+        graph = manager.graph()
+        for rep, info in sorted(graph["representations"].items()):
+            if info["provider"] and len(info["alternatives"]) > 1:
+                others = [a for a in info["alternatives"] if a != info["provider"]]
+                print(f"  provider {rep}: {info['provider']} (alternatives: {', '.join(others)})")
+        if plan.platform_provides:
+            print("  from platform: " + ", ".join(r.__name__ for r in plan.platform_provides))
+        if plan.platform_consumes:
+            print("  to platform: " + ", ".join(r.__name__ for r in plan.platform_consumes))
+        other = "motion" if name == "cognition" else "cognition"
+        for rep in plan.handover_in:
+            print(f"  hand-over in: {rep.__name__} from {other}")
+        for rep in plan.handover_out:
+            print(f"  hand-over out: {rep.__name__} to {other}")
+        for module, missing in plan.pruned.items():
+            print(f"  pruned: {module} (missing {', '.join(missing)})")
+        for rep in plan.unfed:
+            print(f"  warning: the platform consumes {rep}, but no module provides it (defaults are sent)")
+        for module in sorted(set(plan.disabled)):
+            print(f"  disabled by configuration: {module}")
+    return 0
+
+
+COMMANDS = {"run": command_run, "platforms": command_platforms, "modules": command_modules}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args, extra = parser.parse_known_args(argv)
+    if extra and args.command == "platforms":
+        parser.error(f"unrecognized arguments: {' '.join(extra)}")
+    try:
+        return COMMANDS[args.command](args, extra)
+    except UsageError as exc:
+        parser.exit(2, f"tafel {args.command}: error: {exc}\n")
+    except (TafelError, KeyError) as exc:
+        message = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
+        status = 1 if isinstance(exc, PlatformError) else 2
+        parser.exit(status, f"tafel {args.command}: error: {message}\n")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
