@@ -129,17 +129,20 @@ def _check_single_provider(plans: Mapping[str, ContextPlan]) -> None:
 
 
 def _route(plans: Mapping[str, ContextPlan]) -> None:
-    """Decide hand-overs and prune modules whose inputs nobody provides, until nothing changes."""
+    """Decide hand-overs and prune modules whose inputs nobody provides, until nothing changes.
+
+    Only what modules compute crosses between contexts; platform data stays in the context it is
+    given to (each context has its own clock in ``FrameInfo``, for example).
+    """
     pruned: dict[str, dict[str, list[str]]] = {c: {} for c in plans}
     while True:
         remaining = {c: [m for m in p.modules if m.__name__ not in set(p.disabled) | set(pruned[c])] for c, p in plans.items()}
-        local = {c: set(plans[c].platform_provides) | _provided(remaining[c]) for c in plans}
-        if "motion" in local:
-            local["motion"].add(CognitionStatus)
+        computed = {c: _provided(remaining[c]) for c in plans}
+        local = {c: set(plans[c].platform_provides) | computed[c] for c in plans}
+        local["motion"].add(CognitionStatus)
         changed = False
-        for context, plan in plans.items():
-            other = "motion" if context == "cognition" else "cognition"
-            available = local[context] | local[other]
+        for context in plans:
+            available = local[context] | computed[_other(context)]
             for module in remaining[context]:
                 missing = [r.__name__ for r in module.requirements().reads() if r not in available]
                 if missing:
@@ -148,14 +151,16 @@ def _route(plans: Mapping[str, ContextPlan]) -> None:
         if not changed:
             break
     for context, plan in plans.items():
-        other = "motion" if context == "cognition" else "cognition"
         plan.pruned = pruned[context]
         reads = {r for m in plan.active_modules() for r in m.requirements().reads()}
         plan.handover_in = sorted(
-            (r for r in reads if r not in local[context] and r in local[other]), key=lambda r: r.__name__
+            (r for r in reads if r not in local[context] and r in computed[_other(context)]), key=lambda r: r.__name__
         )
         provided = _provided(plan.active_modules())
         plan.unfed = sorted(r.__name__ for r in plan.platform_consumes if r not in provided)
     for context, plan in plans.items():
-        other = "motion" if context == "cognition" else "cognition"
-        plan.handover_out = list(plans[other].handover_in)
+        plan.handover_out = list(plans[_other(context)].handover_in)
+
+
+def _other(context: str) -> str:
+    return "motion" if context == "cognition" else "cognition"

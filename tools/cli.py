@@ -158,6 +158,11 @@ def print_summary(platform: str, mode: str, stats: dict[str, ContextStats], wall
         if s.failure:
             line += f", FAILED: {s.failure}"
         print(line)
+        if s.period_errors_ms:
+            timing = s.period_error_percentiles()
+            print(f"    timing: period error p50 {timing['p50_ms']:.2f} ms, p99 {timing['p99_ms']:.2f} ms, "
+                  f"max {timing['max_ms']:.2f} ms, missed_periods={s.missed_periods}"
+                  + (f", frames_without_cognition={s.frames_without_cognition}" if name == "motion" else ""))
     rates = ", ".join(f"{n} {s.rate_hz:.1f} Hz" for n, s in stats.items())
     sys.stdout.flush()
     print(f"wall time {wall_s:.2f} s ({rates})", file=sys.stderr)

@@ -1,0 +1,68 @@
+"""Cognition modules that misbehave on purpose, for the runtime's crash and stall tests.
+
+Configuration names them as ``tests.support.runtime_faults:ClassName``.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass
+
+from core import Module, requires
+from representations.infrastructure import FrameInfo
+
+
+@requires(FrameInfo)
+class CrashCognitionProcess(Module):
+    """Ends its process abruptly (as a segfault would) after ``after_frames`` frames."""
+
+    @dataclass
+    class Parameters:
+        after_frames: int = 10
+
+    def execute(self) -> None:
+        if self.frame_info.frame_number >= self.parameters.after_frames:
+            os._exit(3)
+
+
+@requires(FrameInfo)
+class StallCognition(Module):
+    """Blocks for ``stall`` seconds once, after ``after_frames`` frames."""
+
+    @dataclass
+    class Parameters:
+        after_frames: int = 10
+        stall: float = 2.5
+
+    def __init__(self) -> None:
+        self.stalled = False
+
+    def execute(self) -> None:
+        if not self.stalled and self.frame_info.frame_number >= self.parameters.after_frames:
+            self.stalled = True
+            time.sleep(self.parameters.stall)
+
+
+@requires(FrameInfo)
+class RaiseEveryFrame(Module):
+    """Raises in every frame: the loop must go on and count the errors."""
+
+    def execute(self) -> None:
+        raise RuntimeError(f"deliberate failure in frame {self.frame_info.frame_number}")
+
+
+@requires(FrameInfo)
+class PythonHeavyLoad(Module):
+    """Pure-Python work that holds the interpreter lock for about ``milliseconds`` per frame."""
+
+    @dataclass
+    class Parameters:
+        milliseconds: float = 20.0
+
+    def execute(self) -> None:
+        end = time.perf_counter() + self.parameters.milliseconds / 1000.0
+        total = 0
+        while time.perf_counter() < end:
+            for i in range(200):
+                total += i * i

@@ -1,0 +1,114 @@
+"""Layered configuration: merging, overrides, the private layer."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from core.config import (
+    ConfigError,
+    apply_overrides,
+    context_section,
+    dump_toml,
+    load_config,
+    merge,
+    parse_override,
+    store_private,
+)
+
+
+def write(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+
+
+@pytest.fixture
+def config_dir(tmp_path: Path) -> Path:
+    write(tmp_path / "general.toml", '[runtime]\ncognition_hz = 30\nmotion_hz = 100\n[cognition]\nmodules = ["A", "B"]\n[cognition.providers]\nX = "A"\n')
+    write(tmp_path / "platform" / "sim.toml", '[runtime]\ncognition_hz = 20\n[cognition.providers]\nY = "B"\n')
+    write(tmp_path / "robot" / "nao1.toml", '[cognition]\nmodules = ["C"]\n')
+    write(tmp_path / "private" / "private.toml", "[runtime]\nmotion_hz = 50\n")
+    return tmp_path
+
+
+def test_layers_override_in_order(config_dir: Path) -> None:
+    config = load_config(config_dir, "sim", "nao1")
+    assert config["runtime"] == {"cognition_hz": 20, "motion_hz": 50}
+    assert config["cognition"]["modules"] == ["C"]  # lists are replaced whole
+    assert config["cognition"]["providers"] == {"X": "A", "Y": "B"}  # tables merge
+    assert [Path(p).name for p in config["_sources"]] == ["general.toml", "sim.toml", "nao1.toml", "private.toml"]
+
+
+def test_missing_layers_are_skipped(config_dir: Path) -> None:
+    config = load_config(config_dir, "other")
+    assert config["runtime"]["cognition_hz"] == 30 and config["cognition"]["modules"] == ["A", "B"]
+
+
+def test_overrides_come_last_and_parse_toml_values(config_dir: Path) -> None:
+    config = load_config(config_dir, "sim", overrides=["runtime.cognition_hz=15", 'cognition.modules=["Z"]', "parameters.M.name=hello"])
+    assert config["runtime"]["cognition_hz"] == 15
+    assert config["cognition"]["modules"] == ["Z"]
+    assert config["parameters"]["M"]["name"] == "hello"
+
+
+@pytest.mark.parametrize("text", ["novalue", "=3", "a..b=1", ""])
+def test_malformed_overrides_say_what_is_expected(text: str) -> None:
+    with pytest.raises(ConfigError, match="KEY=VALUE"):
+        parse_override(text)
+
+
+def test_override_through_a_value_fails() -> None:
+    with pytest.raises(ConfigError, match="is a value, not a table"):
+        apply_overrides({"runtime": {"cognition_hz": 30}}, ["runtime.cognition_hz.x=1"])
+
+
+def test_invalid_toml_names_the_file(tmp_path: Path) -> None:
+    write(tmp_path / "general.toml", "[runtime\n")
+    with pytest.raises(ConfigError, match="general.toml: not valid TOML"):
+        load_config(tmp_path, "sim")
+
+
+def test_missing_folder_is_an_error(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match="does not exist"):
+        load_config(tmp_path / "nope", "sim")
+
+
+def test_context_section_checks_types() -> None:
+    assert context_section({}, "cognition") == {"modules": [], "disabled": [], "providers": {}}
+    with pytest.raises(ConfigError, match="cognition.modules must be a list"):
+        context_section({"cognition": {"modules": "A"}}, "cognition")
+    with pytest.raises(ConfigError, match="providers must map"):
+        context_section({"motion": {"providers": {"X": 1}}}, "motion")
+
+
+def test_store_private_keeps_other_values(config_dir: Path) -> None:
+    store_private(config_dir, ["cognition", "providers", "BallModel"], "SimpleBallModeler")
+    config = load_config(config_dir, "sim")
+    assert config["cognition"]["providers"]["BallModel"] == "SimpleBallModeler"
+    assert config["runtime"]["motion_hz"] == 50
+
+
+def test_merge_does_not_modify_its_inputs() -> None:
+    base = {"a": {"b": 1}}
+    merged = merge(base, {"a": {"c": 2}})
+    assert base == {"a": {"b": 1}} and merged == {"a": {"b": 1, "c": 2}}
+
+
+toml_keys = st.text(alphabet="abcdefgxyz_0123", min_size=1, max_size=8)
+toml_scalars = st.one_of(
+    st.booleans(), st.integers(-(2**40), 2**40), st.floats(allow_nan=False, allow_infinity=False), st.text(max_size=10)
+)
+toml_tables = st.recursive(
+    st.dictionaries(toml_keys, st.one_of(toml_scalars, st.lists(toml_scalars.filter(lambda v: not isinstance(v, bool)), max_size=3)), max_size=4),
+    lambda inner: st.dictionaries(toml_keys, inner, max_size=3),
+    max_leaves=10,
+)
+
+
+@given(toml_tables)
+def test_dump_toml_round_trips(data: dict) -> None:
+    assert tomllib.loads(dump_toml(data)) == data

@@ -1,0 +1,137 @@
+"""Hand-over channels: a consumer never observes a torn value, whatever the interleaving."""
+
+from __future__ import annotations
+
+import multiprocessing
+import threading
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from core import ModuleManager, Module, provides, representation
+from core.handover import HandoverError, LocalChannel, SharedChannel, apply_bundle, make_bundle, snapshot
+
+
+@representation
+class HoConsistent:
+    """Fields that must agree: b == 2 * a, every element of samples == a, label == str(a)."""
+
+    a: int
+    b: int
+    samples: np.ndarray
+    label: str
+
+
+@provides(HoConsistent)
+class HoWriter(Module):
+    def __init__(self) -> None:
+        self.value = 0
+
+    def execute(self) -> None:
+        rep = self.ho_consistent
+        rep.a = self.value
+        rep.b = 2 * self.value
+        rep.samples = np.full(20_000, self.value, dtype=np.int64)  # large enough to make copies slow
+        rep.label = str(self.value)
+
+
+def consistent(values: dict) -> bool:
+    a = values["a"]
+    return values["b"] == 2 * a and values["label"] == str(a) and bool((values["samples"] == a).all())
+
+
+def _publish_all(name: str, sequence: list[int], done) -> None:
+    channel = SharedChannel.attach(name)
+    manager = ModuleManager([HoWriter])
+    writer = manager.module("HoWriter")
+    for frame, value in enumerate(sequence, start=1):
+        writer.value = value
+        manager.execute()
+        channel.publish(make_bundle(manager.blackboard, [HoConsistent], frame, frame))
+    done.set()
+    channel.close()
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.lists(st.integers(-(2**40), 2**40), min_size=50, max_size=300))
+def test_shared_channel_never_shows_a_torn_value(sequence: list[int]) -> None:
+    channel = SharedChannel()
+    context = multiprocessing.get_context("fork")
+    done = context.Event()
+    writer = context.Process(target=_publish_all, args=(channel.name, sequence, done))
+    writer.start()
+    observed = 0
+    last_frame = 0
+    try:
+        while not done.is_set() or observed == 0:
+            bundle = channel.latest()
+            if bundle is None:
+                continue
+            values = bundle.values["HoConsistent"]
+            assert consistent(values), values["a"]
+            assert bundle.frame_number >= last_frame  # never goes back in time
+            assert values["a"] == sequence[bundle.frame_number - 1]
+            last_frame = bundle.frame_number
+            observed += 1
+        final = channel.latest()
+        assert final is not None and final.frame_number == len(sequence)
+    finally:
+        writer.join(timeout=10)
+        channel.close()
+    assert observed > 0
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.lists(st.integers(-1000, 1000), min_size=20, max_size=200))
+def test_local_channel_between_threads_never_shows_a_torn_value(sequence: list[int]) -> None:
+    channel = LocalChannel()
+    manager = ModuleManager([HoWriter])
+    done = threading.Event()
+
+    def publish() -> None:
+        for frame, value in enumerate(sequence, start=1):
+            manager.module("HoWriter").value = value
+            manager.execute()
+            channel.publish(make_bundle(manager.blackboard, [HoConsistent], frame, frame))
+        done.set()
+
+    thread = threading.Thread(target=publish)
+    thread.start()
+    consumer = HoConsistent()
+    from core.manager import Blackboard
+
+    board = Blackboard()
+    board.ensure(HoConsistent)
+    while not done.is_set():
+        bundle = channel.latest()
+        if bundle is not None:
+            apply_bundle(bundle, board, [HoConsistent])
+            assert consistent(board[HoConsistent].__dict__)
+    thread.join()
+    assert consumer == HoConsistent()
+
+
+def test_snapshots_do_not_change_with_the_producer() -> None:
+    rep = HoConsistent(a=1, b=2, samples=np.ones(3, dtype=np.int64), label="1")
+    copy = snapshot(rep)
+    rep.samples[0] = 5
+    assert copy["samples"].tolist() == [1, 1, 1]
+
+
+def test_oversized_bundles_are_refused_with_advice() -> None:
+    channel = SharedChannel(capacity=1024)
+    try:
+        manager = ModuleManager([HoWriter])
+        manager.execute()
+        with pytest.raises(HandoverError, match="exceeds the channel capacity"):
+            channel.publish(make_bundle(manager.blackboard, [HoConsistent], 1, 1))
+        assert channel.latest() is None
+    finally:
+        channel.close()
+
+
+def test_attaching_a_missing_channel_fails_clearly() -> None:
+    with pytest.raises(HandoverError, match="cannot attach hand-over channel"):
+        SharedChannel.attach("tafel-no-such-channel")
