@@ -50,19 +50,3 @@ class RaiseEveryFrame(Module):
 
     def execute(self) -> None:
         raise RuntimeError(f"deliberate failure in frame {self.frame_info.frame_number}")
-
-
-@requires(FrameInfo)
-class PythonHeavyLoad(Module):
-    """Pure-Python work that holds the interpreter lock for about ``milliseconds`` per frame."""
-
-    @dataclass
-    class Parameters:
-        milliseconds: float = 20.0
-
-    def execute(self) -> None:
-        end = time.perf_counter() + self.parameters.milliseconds / 1000.0
-        total = 0
-        while time.perf_counter() < end:
-            for i in range(200):
-                total += i * i
