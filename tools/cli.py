@@ -48,24 +48,19 @@ def parse_speed(text: str) -> float | None:
     return speed
 
 
-def positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected at least 1, got {value}")
-    return value
+def positive(kind: type) -> Any:
+    """An argparse type accepting numbers of ``kind`` greater than zero."""
 
+    def parse(text: str) -> Any:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a {'whole ' if kind is int else ''}number, got {text!r}") from None
+        if value <= 0:
+            raise argparse.ArgumentTypeError(f"expected a number greater than zero, got {text}")
+        return value
 
-def positive_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if value <= 0:
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {value}")
-    return value
+    return parse
 
 
 def add_program_arguments(parser: argparse.ArgumentParser) -> None:
@@ -86,11 +81,11 @@ def build_parser() -> argparse.ArgumentParser:
     run = commands.add_parser("run", help="run the program on a platform")
     add_program_arguments(run)
     limit = run.add_mutually_exclusive_group()
-    limit.add_argument("--seconds", type=positive_float, help="stop after this much platform time")
-    limit.add_argument("--frames", type=positive_int, help="stop after N frames of the main context (motion, else cognition)")
+    limit.add_argument("--seconds", type=positive(float), help="stop after this much platform time")
+    limit.add_argument("--frames", type=positive(int), help="stop after N frames of the main context (motion, else cognition)")
     run.add_argument("--speed", type=parse_speed, default=1.0, help="pace against the wall clock: a factor, or 'max'")
     run.add_argument("--concurrent", action="store_true", help="run the contexts in parallel processes")
-    run.add_argument("--status-interval", type=positive_float, default=2.0, metavar="S",
+    run.add_argument("--status-interval", type=positive(float), default=2.0, metavar="S",
                      help="seconds between status lines (default: %(default)s)")
     run.add_argument("-v", "--verbose", action="store_true", help="log informational messages")
 
