@@ -50,6 +50,8 @@ class Platform:
     provides: ClassVar[Mapping[str, tuple[type, ...]]] = {}
     #: context -> representation classes the platform reads (actuators)
     consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {}
+    #: True when ``next_step`` decides which contexts run when (log replay); else rates decide
+    drives_schedule: ClassVar[bool] = False
 
     def __init__(self, options: Mapping[str, Any] | None = None) -> None:
         self.options = dict(options or {})
@@ -77,6 +79,13 @@ class Platform:
 
     def act(self, context: str, blackboard: Blackboard) -> None:
         """Read the actuator representations of ``context`` from ``blackboard`` and apply them."""
+
+    def next_step(self) -> tuple[int, frozenset[str]] | None:
+        """With ``drives_schedule``: the time and the contexts of the next step, None while paused.
+
+        Raises ``EndOfData`` when there is nothing more to run.
+        """
+        raise NotImplementedError
 
     def frame_time_ns(self, context: str) -> int | None:
         """Own clock only: the platform's time of the last ``sense``; None to use the wall clock."""

@@ -41,6 +41,8 @@ class ContextPlan:
     pruned: dict[str, list[str]] = field(default_factory=dict)
     #: representations the platform consumes but no module provides (the platform gets defaults)
     unfed: list[str] = field(default_factory=list)
+    #: module name -> representations it would provide that come from the platform instead
+    replaced: dict[str, list[str]] = field(default_factory=dict)
 
     @property
     def external(self) -> list[type]:
@@ -53,26 +55,32 @@ class ContextPlan:
         return bool(self.active_modules() or self.platform_provides)
 
     def active_modules(self) -> list[type]:
-        off = set(self.disabled) | set(self.pruned)
+        off = set(self.disabled) | set(self.pruned) | set(self.replaced)
         return [m for m in self.modules if m.__name__ not in off]
 
     def build_manager(self, strict: bool = False) -> ModuleManager:
         parameters = {m: v for m, v in self.parameters.items() if m in {c.__name__ for c in self.modules}}
+        off = {*self.disabled, *self.pruned, *self.replaced}
+        from_platform = {r.__name__ for r in self.platform_provides}
+        providers = {r: m for r, m in self.providers.items() if m not in off and r not in from_platform}
         return ModuleManager(
             self.modules,
             name=self.name,
             external=self.external,
-            providers=self.providers,
+            providers=providers,
             strict=strict,
             parameters=parameters,
-            disabled=[*self.disabled, *self.pruned],
+            disabled=[*self.disabled, *self.pruned, *self.replaced],
         )
 
 
-def plan_program(config: Mapping[str, Any], platform: type[Platform], *, strict: bool = False) -> dict[str, ContextPlan]:
+def plan_program(config: Mapping[str, Any], platform: type[Platform] | Platform, *, strict: bool = False) -> dict[str, ContextPlan]:
     """Context plans for ``config`` on ``platform``; raises ``ModuleGraphError``/``ConfigError`` if broken.
 
-    With ``strict``, a module that the platform cannot feed is an error instead of being pruned.
+    ``platform`` is a class, or an instance where what it provides depends on its options (a log).
+    A module whose outputs all come from the platform instead (a replayed ``BallPercept``) is switched
+    off and reported as replaced. With ``strict``, a module that the platform cannot feed is an error
+    instead of being pruned.
     """
     runtime = config.get("runtime", {})
     parameters = config.get("parameters", {})
@@ -97,6 +105,12 @@ def plan_program(config: Mapping[str, Any], platform: type[Platform], *, strict:
             platform_provides=list(platform.provides.get(context, ())),
             platform_consumes=list(platform.consumes.get(context, ())),
         )
+    for plan in plans.values():
+        from_platform = set(plan.platform_provides)
+        for module in plan.modules:
+            outputs = module.requirements().provides
+            if module.__name__ not in plan.disabled and outputs and any(r in from_platform for r in outputs):
+                plan.replaced[module.__name__] = [r.__name__ for r in outputs if r in from_platform]
     _check_single_provider(plans)
     _route(plans)
     if strict:
@@ -136,7 +150,7 @@ def _route(plans: Mapping[str, ContextPlan]) -> None:
     """
     pruned: dict[str, dict[str, list[str]]] = {c: {} for c in plans}
     while True:
-        remaining = {c: [m for m in p.modules if m.__name__ not in set(p.disabled) | set(pruned[c])] for c, p in plans.items()}
+        remaining = {c: [m for m in p.modules if m.__name__ not in {*p.disabled, *p.replaced, *pruned[c]}] for c, p in plans.items()}
         computed = {c: _provided(remaining[c]) for c in plans}
         local = {c: set(plans[c].platform_provides) | computed[c] for c in plans}
         local["motion"].add(CognitionStatus)

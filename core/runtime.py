@@ -32,6 +32,7 @@ from core.handover import Bundle, LocalChannel, SharedChannel, apply_bundle, mak
 from core.manager import ModuleManager
 from core.platform import EndOfData, Platform, PlatformError
 from core.program import ContextPlan
+from core.recording import QueueSink, Recorder
 from core.status import CognitionStatus
 
 log = logging.getLogger("tafel.runtime")
@@ -64,6 +65,7 @@ class ContextStats:
     realtime: str = ""
     frames_without_cognition: int = 0
     digest: str = ""
+    record_dropped: int = 0
     finished: bool = False
     failure: str = ""
 
@@ -80,6 +82,13 @@ class ContextStats:
             "p99_ms": errors[min(len(errors) - 1, int(round(0.99 * (len(errors) - 1))))],
             "max_ms": errors[-1],
         }
+
+
+def recorder_hook(recorder: Recorder) -> Callable[[ContextRunner], None]:
+    def record(runner: ContextRunner) -> None:
+        recorder.record(runner.name, runner.manager.blackboard, runner.manager.frame, runner.time_ns)
+
+    return record
 
 
 def state_digest(manager: ModuleManager) -> str:
@@ -104,6 +113,8 @@ class ContextRunner:
         self.outbox = outbox
         self.last_bundle: Bundle | None = None
         self.time_ns = 0
+        #: called after every frame (recording, debug data)
+        self.after_step: list[Callable[[ContextRunner], None]] = []
 
     @property
     def frames(self) -> int:
@@ -124,6 +135,8 @@ class ContextRunner:
         self.platform.act(self.name, blackboard)
         if self.outbox is not None and self.plan.handover_out:
             self.outbox.publish(make_bundle(blackboard, self.plan.handover_out, self.manager.frame, self.time_ns))
+        for hook in self.after_step:
+            hook(self)
 
     def stats(self, wall_s: float) -> ContextStats:
         errors = {name: count for name, (count, _) in self.manager.errors().items()}
@@ -166,8 +179,10 @@ def install_signal_handlers(stop: Any, on_force: Callable[[], None] | None = Non
 class LockstepRuntime:
     """Deterministic single-threaded runtime for platforms with a simulated clock."""
 
-    def __init__(self, plans: Mapping[str, ContextPlan], platform: Platform, *, strict: bool = False) -> None:
+    def __init__(self, plans: Mapping[str, ContextPlan], platform: Platform, *, strict: bool = False,
+                 recorder: Recorder | None = None) -> None:
         self.platform = platform
+        self.recorder = recorder
         self.plans = {name: plan for name, plan in plans.items() if plan.runs}
         if not self.plans:
             raise PlatformError("nothing to run: no context has modules or platform data")
@@ -181,6 +196,9 @@ class LockstepRuntime:
                 outbox=channels[name],
             )
         self.main = next(name for name in MAIN_CONTEXT_ORDER if name in self.runners)
+        if recorder is not None:
+            for runner in self.runners.values():
+                runner.after_step.append(recorder_hook(recorder))
         self.time_ns = 0
         self.wall_s = 0.0
         self.stop = StopFlag()
@@ -193,11 +211,30 @@ class LockstepRuntime:
         return {name: runner.manager for name, runner in self.runners.items()}
 
     def run(self, limits: Limits) -> dict[str, ContextStats]:
+        self.platform.start(frozenset(self.runners))
+        start = time.monotonic()
+        try:
+            if self.platform.drives_schedule:
+                self._run_platform_schedule(limits)
+            else:
+                self._run_rate_schedule(limits)
+        except EndOfData as exc:
+            self.end_reason = str(exc) or "end of data"
+        finally:
+            self.wall_s = time.monotonic() - start
+            self.platform.stop()
+            if self.recorder is not None:
+                self.recorder.stop()
+        if self.stop.is_set() and not self.end_reason:
+            self.end_reason = "stopped"
+        return self.stats()
+
+    def _run_rate_schedule(self, limits: Limits) -> None:
+        """Motion on every tick, cognition whenever simulated time has passed its next tick."""
         main_rate = Fraction(str(self.plans[self.main].rate_hz))
         cognition = self.runners.get("cognition") if self.main == "motion" else None
         cognition_rate = Fraction(str(self.plans["cognition"].rate_hz)) if cognition else None
         motion_status = self._cognition_status()
-        self.platform.start(frozenset(self.runners))
         start = time.monotonic()
         tick = 0
         try:
@@ -215,27 +252,55 @@ class LockstepRuntime:
                         time.sleep(delay)
                 self.time_ns = time_ns
                 self.platform.advance(time_ns)
-                main = self.runners[self.main]
                 if motion_status is not None and cognition is not None:
                     motion_status.alive = True
                     motion_status.frame_number = cognition.frames
                     motion_status.age = (time_ns - cognition.time_ns) * 1e-9 if cognition.frames else 0.0
-                main.step(time_ns)
+                self.runners[self.main].step(time_ns)
                 # cognition tick k is due at k / cognition_rate seconds: compare exactly
                 if cognition is not None and tick * cognition_rate >= cognition.frames * main_rate:
                     cognition.step(time_ns)
                 tick += 1
                 for hook in self.after_tick:
                     hook(self)
-        except EndOfData as exc:
-            self.end_reason = str(exc) or "end of data"
         finally:
             self.time_ns = int(Fraction(tick * 10**9) / main_rate)  # platform time covered by the ticks run
-            self.wall_s = time.monotonic() - start
-            self.platform.stop()
-        if self.stop.is_set() and not self.end_reason:
-            self.end_reason = "stopped"
-        return self.stats()
+
+    def _run_platform_schedule(self, limits: Limits) -> None:
+        """The platform says which contexts run next and at what time (log replay)."""
+        origin: tuple[float, int] | None = None  # (wall, platform time) pacing starts from
+        first_ns: int | None = None
+        while not self.stop.is_set():
+            main = self.runners[self.main]
+            if limits.frames is not None and main.frames >= limits.frames:
+                self.end_reason = f"{limits.frames} {self.main} frames"
+                break
+            step = self.platform.next_step()
+            if step is None:  # paused
+                origin = None
+                time.sleep(0.01)
+                for hook in self.after_tick:
+                    hook(self)
+                continue
+            time_ns, contexts = step
+            first_ns = time_ns if first_ns is None else first_ns
+            if limits.seconds is not None and time_ns - first_ns >= limits.seconds * 1e9:
+                self.end_reason = f"{limits.seconds:g} s"
+                break
+            if limits.speed:
+                if origin is None or time_ns < origin[1]:
+                    origin = (time.monotonic(), time_ns)
+                delay = origin[0] + (time_ns - origin[1]) * 1e-9 / limits.speed - time.monotonic()
+                if delay > 0:
+                    time.sleep(delay)
+            self.time_ns = time_ns
+            for name in MAIN_CONTEXT_ORDER:
+                if name in contexts and name in self.runners:
+                    self.runners[name].step(time_ns)
+            for hook in self.after_tick:
+                hook(self)
+        if first_ns is not None:
+            self.time_ns -= first_ns
 
     def _cognition_status(self) -> CognitionStatus | None:
         runner = self.runners.get("motion")
@@ -268,6 +333,8 @@ class WorkerSpec:
     outbox_name: str | None
     stall_timeout_s: float
     realtime_priority: int = 50
+    record: list[Any] = field(default_factory=list)
+    record_queue: Any = None
 
 
 def try_realtime(priority: int) -> str:
@@ -372,12 +439,19 @@ def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
         platform.start(frozenset({spec.plan.name}))
         manager = spec.plan.build_manager(spec.strict)
         runner = ContextRunner(spec.plan, manager, platform, inbox=inbox, outbox=outbox)
+        sink = None
+        if spec.record and spec.record_queue is not None:
+            recorder = Recorder(spec.record)
+            sink = QueueSink(spec.record_queue)
+            recorder.attach(sink)
+            runner.after_step.append(recorder_hook(recorder))
         watch = cognition_watcher(inbox, spec.stall_timeout_s) if spec.plan.name == "motion" and inbox else None
         if spec.plan.name == "motion" and watch is None:
             watch = lambda: (False, 0, 0.0)  # noqa: E731 - no cognition context at all
         final = run_context_loop(runner, spec.limits, stop, is_main=spec.is_main, report=send,
                                  cognition_watch=watch, realtime=realtime)
         final.digest = state_digest(manager)
+        final.record_dropped = sink.dropped if sink else 0
         send(final)
     except Exception as exc:  # noqa: BLE001 - report instead of dying silently
         log.exception("%s context failed to start", spec.plan.name)
@@ -411,7 +485,9 @@ class ConcurrentRuntime:
     """Each context in its own process; the calling process supervises, reports and shuts down."""
 
     def __init__(self, plans: Mapping[str, ContextPlan], platform_class: type[Platform],
-                 platform_options: Mapping[str, Any], *, strict: bool = False, stall_timeout_s: float = 1.0) -> None:
+                 platform_options: Mapping[str, Any], *, strict: bool = False, stall_timeout_s: float = 1.0,
+                 recorder: Recorder | None = None) -> None:
+        self.recorder = recorder
         self.plans = {name: plan for name, plan in plans.items() if plan.runs}
         if not self.plans:
             raise PlatformError("nothing to run: no context has modules or platform data")
@@ -431,6 +507,10 @@ class ConcurrentRuntime:
     def run(self, limits: Limits) -> dict[str, ContextStats]:
         channels = {name: SharedChannel() for name in self.plans}
         connections = {}
+        record_queue = self._mp.Queue(maxsize=8192) if self.recorder is not None else None
+        drain = threading.Thread(target=self._drain, args=(record_queue,), daemon=True) if record_queue else None
+        if drain:
+            drain.start()
         try:
             for name, plan in self.plans.items():
                 other = "motion" if name == "cognition" else "cognition"
@@ -440,6 +520,7 @@ class ConcurrentRuntime:
                     strict=self.strict, limits=limits, is_main=name == self.main,
                     inbox_name=channels[other].name if (plan.handover_in or watch_cognition) and other in channels else None,
                     outbox_name=channels[name].name, stall_timeout_s=self.stall_timeout_s,
+                    record=self.recorder.by_context.get(name, []) if self.recorder else [], record_queue=record_queue,
                 )
                 receiver, sender = self._mp.Pipe(duplex=False)
                 process = self._mp.Process(target=_worker_main, args=(spec, self.stop, sender), name=f"tafel-{name}", daemon=True)
@@ -457,7 +538,23 @@ class ConcurrentRuntime:
                     process.join(timeout=2)
             for channel in channels.values():
                 channel.close()
+            if drain is not None and record_queue is not None:
+                record_queue.put(None)
+                drain.join(timeout=30)
+            if self.recorder is not None:
+                self.recorder.forward_dropped += sum(s.record_dropped for s in self.stats.values())
+                self.recorder.stop()
         return self.stats
+
+    def _drain(self, record_queue: Any) -> None:
+        """Supervisor thread: write what the context processes recorded into the one log file."""
+        while True:
+            item = record_queue.get()
+            if item is None:
+                return
+            sink = self.recorder.sink if self.recorder else None
+            if sink is not None:
+                sink.write(*item)
 
     def _supervise(self, connections: dict[str, Any]) -> None:
         from multiprocessing.connection import wait

@@ -17,6 +17,7 @@ from core.dot import contexts_dot
 from core.errors import TafelError
 from core.platform import Platform, PlatformError, available_platforms, load_platform
 from core.program import ContextPlan, plan_program
+from core.recording import Recorder, select
 from core.runtime import ConcurrentRuntime, ContextStats, Limits, LockstepRuntime, install_signal_handlers
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
@@ -29,11 +30,13 @@ class UsageError(Exception):
 
 
 def discover_modules() -> None:
-    """Import every module file under ``modules/`` so configuration can name them."""
+    """Import every file under ``representations/`` and ``modules/`` so configuration and logs can name them."""
     import modules
+    import representations
 
-    for info in pkgutil.walk_packages(modules.__path__, prefix="modules."):
-        importlib.import_module(info.name)
+    for package in (representations, modules):
+        for info in pkgutil.walk_packages(package.__path__, prefix=package.__name__ + "."):
+            importlib.import_module(info.name)
 
 
 def parse_speed(text: str) -> float | None:
@@ -88,6 +91,12 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--status-interval", type=positive(float), default=2.0, metavar="S",
                      help="seconds between status lines (default: %(default)s)")
     run.add_argument("-v", "--verbose", action="store_true", help="log informational messages")
+    run.add_argument("--record", type=Path, metavar="FILE.mcap", help="record representations into an MCAP log")
+    run.add_argument("--record-reps", metavar="A,B", help="what to record (default: sensor data and [recording] representations)")
+
+    from tools.log_tools import add_log_commands
+
+    add_log_commands(commands)
 
     platforms = commands.add_parser("platforms", help="list the platforms and what they provide and consume")
     platforms.add_argument("--verbose", "-v", action="store_true")
@@ -115,8 +124,8 @@ def resolve_platform(args: argparse.Namespace, config_dir: Path) -> type[Platfor
     return load_platform(name)
 
 
-def prepare(args: argparse.Namespace, extra: Sequence[str]) -> tuple[type[Platform], dict[str, Any], dict[str, ContextPlan], dict[str, Any]]:
-    """Platform class, platform options, context plans and configuration for ``run`` and ``modules``."""
+def prepare(args: argparse.Namespace, extra: Sequence[str]) -> tuple[Platform, dict[str, Any], dict[str, ContextPlan], dict[str, Any]]:
+    """Platform, platform options, context plans and configuration for ``run`` and ``modules``."""
     platform_class = resolve_platform(args, args.config)
     platform_parser = argparse.ArgumentParser(prog=f"tafel {args.command} --platform {platform_class.name}", add_help=False)
     platform_class.add_arguments(platform_parser)
@@ -126,9 +135,11 @@ def prepare(args: argparse.Namespace, extra: Sequence[str]) -> tuple[type[Platfo
         hint = f"; options of platform {platform_class.name}: {', '.join(known)}" if known else ""
         fail(f"unrecognized arguments: {' '.join(unknown)}{hint}")
     discover_modules()
-    config = load_config(args.config, platform_class.name, args.robot, args.overrides)
-    plans = plan_program(config, platform_class, strict=args.strict)
-    return platform_class, vars(options), plans, config
+    platform = platform_class(vars(options))
+    overrides = [f"runtime.{context}_hz={hz}" for context, hz in (platform.rates() or {}).items()]
+    config = load_config(args.config, platform_class.name, args.robot, [*overrides, *args.overrides])
+    plans = plan_program(config, platform, strict=args.strict)
+    return platform, vars(options), plans, config
 
 
 # ----------------------------------------------------------------------------------------- run
@@ -165,14 +176,17 @@ def print_summary(platform: str, mode: str, stats: dict[str, ContextStats], wall
 
 def command_run(args: argparse.Namespace, extra: Sequence[str]) -> int:
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(name)s %(levelname)s: %(message)s")
-    platform_class, options, plans, config = prepare(args, extra)
+    platform, options, plans, config = prepare(args, extra)
+    platform_class = type(platform)
     report_pruned(plans)
+    recorder = make_recorder(args, plans, config, platform_class.name)
     limits = Limits(frames=args.frames, seconds=args.seconds, speed=args.speed)
     concurrent = args.concurrent or platform_class.clock == "own"
     stall = float(config.get("runtime", {}).get("stall_timeout_s", 1.0))
     started = time.monotonic()
     if concurrent:
-        runtime = ConcurrentRuntime(plans, platform_class, options, strict=args.strict, stall_timeout_s=stall)
+        platform.stop()  # each context process makes its own
+        runtime = ConcurrentRuntime(plans, platform_class, options, strict=args.strict, stall_timeout_s=stall, recorder=recorder)
         last = [started]
 
         def on_report(rt: ConcurrentRuntime) -> None:
@@ -190,11 +204,11 @@ def command_run(args: argparse.Namespace, extra: Sequence[str]) -> int:
         for notice in runtime.notices:
             print(f"notice: {notice}", file=sys.stderr)
         print_summary(platform_class.name, "concurrent", stats, time.monotonic() - started, None, "")
+        report_recording(recorder)
         failed = [s.failure for s in stats.values() if s.failure]
         return 1 if failed else 0
 
-    platform = platform_class(options)
-    runtime = LockstepRuntime(plans, platform, strict=args.strict)
+    runtime = LockstepRuntime(plans, platform, strict=args.strict, recorder=recorder)
     install_signal_handlers(runtime.stop)
     last = [started]
 
@@ -208,7 +222,35 @@ def command_run(args: argparse.Namespace, extra: Sequence[str]) -> int:
     runtime.after_tick.append(status)
     stats = runtime.run(limits)
     print_summary(platform_class.name, "lockstep", stats, runtime.wall_s, runtime.time_ns * 1e-9, runtime.end_reason)
+    report_recording(recorder)
     return 0
+
+
+def make_recorder(args: argparse.Namespace, plans: dict[str, ContextPlan], config: dict[str, Any], platform: str) -> Recorder | None:
+    """A recorder for --record, started; None without it."""
+    if args.record is None and not args.record_reps:
+        return None
+    if args.record is None:
+        fail("--record-reps needs --record FILE.mcap")
+    names = (
+        [n.strip() for n in args.record_reps.split(",") if n.strip()] if args.record_reps
+        else list(config.get("recording", {}).get("representations", []))
+    )
+    selections = select(plans, names, include_sensors=not args.record_reps)
+    metadata = {"platform": platform, **{f"{c}_hz": str(p.rate_hz) for c, p in plans.items()}}
+    recorder = Recorder(selections, metadata)
+    # Without a beat to keep (lockstep at --speed max) recording waits for the writer rather than drop.
+    recorder.start(args.record, blocking=args.speed is None and not args.concurrent)
+    return recorder
+
+
+def report_recording(recorder: Recorder | None) -> None:
+    if recorder is None:
+        return
+    status = recorder.status()
+    frames = ", ".join(f"{c} {n}" for c, n in sorted(status["frames"].items()))
+    print(f"recorded {recorder.path}: frames {frames}; {recorder.dropped_total()} messages dropped"
+          + (f"; problems: {status['error']}" if status["error"] else ""))
 
 
 def report_pruned(plans: dict[str, ContextPlan]) -> None:
@@ -235,7 +277,8 @@ def command_platforms(args: argparse.Namespace, extra: Sequence[str]) -> int:
 
 # ------------------------------------------------------------------------------------- modules
 def command_modules(args: argparse.Namespace, extra: Sequence[str]) -> int:
-    platform_class, _options, plans, _config = prepare(args, extra)
+    platform, _options, plans, _config = prepare(args, extra)
+    platform_class = type(platform)
     managers = {name: plan.build_manager() for name, plan in plans.items() if plan.runs}
     if args.dot:
         handovers = [(rep.__name__, plan.name, other) for other, p in plans.items() if p.runs
@@ -273,7 +316,15 @@ def command_modules(args: argparse.Namespace, extra: Sequence[str]) -> int:
     return 0
 
 
-COMMANDS = {"run": command_run, "platforms": command_platforms, "modules": command_modules}
+def command_log(args: argparse.Namespace, extra: Sequence[str]) -> int:
+    from tools.log_tools import run_log_command
+
+    if extra:
+        fail(f"unrecognized arguments: {' '.join(extra)}")
+    return run_log_command(args)
+
+
+COMMANDS = {"run": command_run, "platforms": command_platforms, "modules": command_modules, "log": command_log}
 
 
 def main(argv: Sequence[str] | None = None) -> int:

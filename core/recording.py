@@ -1,0 +1,170 @@
+"""Recording representations while a program runs, switchable at run time.
+
+Which representations: per context, those the platform provides (sensor data) plus the names chosen in
+configuration (``[recording] representations``) or with ``--record-reps`` (which replaces both). Each is
+recorded in the context that owns it (the platform's or the provider module's), not where it was
+handed over to. Serialization happens in the loop (a few microseconds a message); writing happens in
+the background.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol
+
+from core.errors import UnknownModuleError
+from core.logfile import LogWriter
+from core.manager import Blackboard
+from core.naming import did_you_mean
+from core.program import ContextPlan
+from core.serialization import SerializationError, serialize
+
+
+class Sink(Protocol):
+    def write(self, topic: str, cls: type, time_ns: int, sequence: int, data: bytes,
+              metadata: Mapping[str, str] | None = None) -> bool: ...
+
+
+@dataclass(frozen=True)
+class Selection:
+    """One recorded representation of one context, with who writes it (channel metadata)."""
+
+    context: str
+    rep: type
+    source: str
+    provider: str = ""
+
+    @property
+    def topic(self) -> str:
+        return f"{self.context}/{self.rep.__name__}"
+
+    @property
+    def metadata(self) -> dict[str, str]:
+        return {"source": self.source, **({"provider": self.provider} if self.provider else {})}
+
+
+def select(plans: Mapping[str, ContextPlan], names: Iterable[str] | None, *, include_sensors: bool = True) -> list[Selection]:
+    """The representations to record; unknown names fail with the closest known ones."""
+    owners: dict[str, list[Selection]] = {}
+    for context, plan in plans.items():
+        if not plan.runs:
+            continue
+        for rep in plan.platform_provides:
+            owners.setdefault(rep.__name__, []).append(Selection(context, rep, "platform"))
+        providers = {rep: m for m in plan.active_modules() for rep in m.requirements().provides}
+        for rep, module in providers.items():
+            chosen = plan.providers.get(rep.__name__)
+            provider = chosen or module.__name__
+            owners.setdefault(rep.__name__, []).append(Selection(context, rep, "module", provider))
+    chosen_names = list(dict.fromkeys(names or []))
+    for name in chosen_names:
+        if name not in owners:
+            raise UnknownModuleError(f"cannot record {name!r}: no context has it; {did_you_mean(name, owners)}")
+    result: list[Selection] = []
+    for name, selections in owners.items():
+        for selection in selections:
+            sensor = selection.source == "platform"
+            if name in chosen_names or (include_sensors and sensor):
+                result.append(selection)
+    return list(dict.fromkeys(result))
+
+
+class Recorder:
+    """Serializes the selected representations after every frame into a sink (a ``LogWriter``)."""
+
+    def __init__(self, selections: list[Selection], metadata: Mapping[str, str] | None = None) -> None:
+        self.by_context: dict[str, list[Selection]] = {}
+        for selection in selections:
+            self.by_context.setdefault(selection.context, []).append(selection)
+        self.metadata = dict(metadata or {})
+        self.sink: Sink | None = None
+        self.writer: LogWriter | None = None
+        self.path: Path | None = None
+        self.frames_recorded: dict[str, int] = {}
+        self.errors: dict[str, str] = {}
+        #: messages dropped before they reached the writer (the concurrent runtime's forwarding)
+        self.forward_dropped = 0
+        self._last_dropped = 0
+        self.blocking = False
+
+    @property
+    def recording(self) -> bool:
+        return self.sink is not None
+
+    def start(self, path: str | Path, *, blocking: bool | None = None) -> None:
+        """Start writing to a new file (stops the current one first).
+
+        ``blocking`` makes a full queue wait instead of dropping: for runs without a beat to keep.
+        """
+        self.stop()
+        if blocking is not None:
+            self.blocking = blocking
+        self.writer = LogWriter(path, metadata=self.metadata)
+        self.writer.blocking = self.blocking
+        self.sink = self.writer
+        self.path = Path(path)
+        self.frames_recorded = {}
+
+    def attach(self, sink: Sink) -> None:
+        """Record into an existing sink (the concurrent runtime forwards to one writer)."""
+        self.sink = sink
+
+    def stop(self) -> dict[str, Any]:
+        """Stop recording and finish the file; returns the final status."""
+        status = self.status()
+        if self.writer is not None:
+            self.writer.close()
+            status = self.status()
+            self._last_dropped = self.writer.dropped
+        self.sink = None
+        self.writer = None
+        return status
+
+    def status(self) -> dict[str, Any]:
+        writer = self.writer
+        return {
+            "recording": self.recording,
+            "file": str(self.path) if self.path else "",
+            "frames": dict(self.frames_recorded),
+            "messages": writer.written if writer else 0,
+            "dropped": writer.dropped if writer else 0,
+            "bytes": writer.bytes_written if writer else 0,
+            "error": (writer.error if writer else "") or "; ".join(f"{k}: {v}" for k, v in self.errors.items()),
+        }
+
+    def dropped_total(self) -> int:
+        return (self.writer.dropped if self.writer else self._last_dropped) + self.forward_dropped
+
+    def record(self, context: str, blackboard: Blackboard, frame_number: int, time_ns: int) -> None:
+        sink = self.sink
+        if sink is None:
+            return
+        for selection in self.by_context.get(context, ()):
+            try:
+                data = serialize(blackboard[selection.rep])
+            except SerializationError as exc:  # report once per topic, keep recording the rest
+                self.errors.setdefault(selection.topic, str(exc))
+                continue
+            sink.write(selection.topic, selection.rep, time_ns, frame_number, data, selection.metadata)
+        self.frames_recorded[context] = self.frames_recorded.get(context, 0) + 1
+
+
+class QueueSink:
+    """Forwards recorded messages to another process's writer without ever blocking."""
+
+    def __init__(self, target: Any) -> None:
+        self.target = target
+        self.dropped = 0
+
+    def write(self, topic: str, cls: type, time_ns: int, sequence: int, data: bytes,
+              metadata: Mapping[str, str] | None = None) -> bool:
+        import queue
+
+        try:
+            self.target.put_nowait((topic, cls, time_ns, sequence, data, dict(metadata or {})))
+            return True
+        except queue.Full:
+            self.dropped += 1
+            return False

@@ -1,0 +1,226 @@
+"""The log platform: replays a recorded MCAP log frame by frame, so modules run again on recorded data.
+
+Recorded sensor data (what the recording platform provided) is fed to both contexts in the recorded
+order and with the recorded frame times; every processing module runs again. ``--replace`` feeds
+further recorded representations in place of the modules that computed them, so the modules
+downstream can be tested alone. Replay can be paused, stepped forward and backward, and sent to a
+frame; the debug server exposes these as ``log:*`` commands.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import threading
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from core.errors import TafelError
+from core.logfile import LogContents, read_log
+from core.manager import Blackboard
+from core.platform import EndOfData, Platform, PlatformError
+from core.representation import get_representation
+from core.serialization import SerializationError, check_compatible, deserialize
+
+log = logging.getLogger("tafel.platform.log")
+CONTEXT_ORDER = ("motion", "cognition")
+
+
+@dataclass
+class _Frame:
+    context: str
+    number: int
+    time_ns: int
+    messages: dict[str, bytes]
+
+
+class LogPlatform(Platform):
+    name = "log"
+    description = "replays a recorded MCAP log (--log FILE) frame by frame"
+    clock = "simulated"
+    drives_schedule = True
+
+    def __init__(self, options: Mapping[str, Any] | None = None) -> None:
+        super().__init__(options)
+        path = self.options.get("log")
+        if not path:
+            raise PlatformError("the log platform needs a recording: tafel run --platform log --log FILE.mcap")
+        try:
+            contents = read_log(path)
+        except TafelError as exc:
+            raise PlatformError(str(exc)) from None
+        if not contents.messages:
+            raise PlatformError(f"{path} holds no messages to replay" + (f" ({contents.problem})" if contents.problem else ""))
+        if contents.problem:
+            log.warning("replaying what could be recovered: %s", contents.problem)
+        self.contents = contents
+        self.loop = bool(self.options.get("loop", False))
+        replace = [n for n in str(self.options.get("replace") or "").split(",") if n.strip()]
+        self.classes = self._resolve_classes(contents, [n.strip() for n in replace])
+        self.provides = {  # type: ignore[misc] - depends on the file, so per instance
+            context: tuple(self.classes[topic] for topic in topics)
+            for context, topics in self._provided_topics(contents, replace).items()
+        }
+        self.consumes = {}  # type: ignore[misc]
+        self.timeline = self._timeline(contents)
+        self.position = 0  # index into the timeline of the next step
+        self.paused = False
+        self.steps_left: int | None = None  # frames to run before pausing again (stepping)
+        self._pending: dict[str, _Frame] = {}
+        self._lock = threading.Lock()
+        self._by_context = {c: [f for step in self.timeline for f in step if f.context == c] for c in self.provides}
+        self._cursors: dict[str, int] = {}
+
+    @classmethod
+    def add_arguments(cls, parser: argparse.ArgumentParser) -> None:
+        parser.add_argument("--log", help="log: the MCAP file to replay")
+        parser.add_argument("--loop", action="store_true", help="log: start again at the end")
+        parser.add_argument("--replace", default="", metavar="A,B",
+                            help="log: also feed these recorded representations, replacing their modules")
+
+    # -------------------------------------------------------------------------------- set-up
+    @staticmethod
+    def _provided_topics(contents: LogContents, replace: list[str]) -> dict[str, list[str]]:
+        recorded = {c.representation for c in contents.channels.values()}
+        unknown = [name for name in replace if name not in recorded]
+        if unknown:
+            from core.naming import did_you_mean
+
+            raise PlatformError(
+                f"--replace names {', '.join(unknown)}, which the log does not hold; "
+                + did_you_mean(unknown[0], sorted(recorded))
+            )
+        topics: dict[str, list[str]] = {}
+        for topic, channel in contents.channels.items():
+            if channel.metadata.get("source") == "platform" or channel.representation in replace:
+                topics.setdefault(channel.context, []).append(topic)
+        return topics
+
+    @staticmethod
+    def _resolve_classes(contents: LogContents, replace: list[str]) -> dict[str, type]:
+        classes = {}
+        for topic, channel in contents.channels.items():
+            try:
+                cls = get_representation(channel.representation)
+            except KeyError:
+                log.warning("%s: no representation class %s in this program; not replayed", contents.path, channel.representation)
+                continue
+            if channel.schema is not None:
+                try:
+                    check_compatible(cls, channel.schema)
+                except SerializationError as exc:
+                    raise PlatformError(f"{contents.path}, channel {topic}: {exc}") from None
+            classes[topic] = cls
+        return classes
+
+    def _timeline(self, contents: LogContents) -> list[list[_Frame]]:
+        """Steps in recorded order: the frames of all contexts that share one time."""
+        frames: dict[tuple[str, int], _Frame] = {}
+        for message in contents.messages:
+            channel = contents.channels[message.topic]
+            if message.topic not in self.classes:
+                continue
+            key = (channel.context, message.sequence)
+            frame = frames.get(key)
+            if frame is None:
+                frame = frames[key] = _Frame(channel.context, message.sequence, message.time_ns, {})
+            frame.messages[message.topic] = message.data
+        ordered = sorted(frames.values(), key=lambda f: (f.time_ns, CONTEXT_ORDER.index(f.context) if f.context in CONTEXT_ORDER else 9, f.number))
+        steps: list[list[_Frame]] = []
+        for frame in ordered:
+            if steps and steps[-1][0].time_ns == frame.time_ns and all(f.context != frame.context for f in steps[-1]):
+                steps[-1].append(frame)
+            else:
+                steps.append([frame])
+        return steps
+
+    def rates(self) -> Mapping[str, float] | None:
+        rates = {}
+        for context in ("cognition", "motion"):
+            value = self.contents.metadata.get(f"{context}_hz")
+            if value:
+                rates[context] = float(value)
+        return rates or None
+
+    # -------------------------------------------------------------------------------- replay
+    def next_step(self) -> tuple[int, frozenset[str]] | None:
+        with self._lock:
+            if self.paused:
+                return None
+            if self.position >= len(self.timeline):
+                if not self.loop:
+                    raise EndOfData(f"end of log {self.contents.path}")
+                self.position = 0
+            step = self.timeline[self.position]
+            self.position += 1
+            self._pending = {frame.context: frame for frame in step}
+            if self.steps_left is not None:
+                self.steps_left -= 1
+                if self.steps_left <= 0:
+                    self.paused, self.steps_left = True, None
+            return step[0].time_ns, frozenset(self._pending)
+
+    def sense(self, context: str, blackboard: Blackboard, frame_number: int, time_ns: int) -> None:
+        frame = self._pending.pop(context, None)
+        if frame is None:  # concurrent runtime: no schedule, serve this context's frames in order
+            frame = self._next_frame_of(context)
+        for topic, data in frame.messages.items():
+            cls = self.classes[topic]
+            try:
+                blackboard.set(deserialize(cls, data))
+            except SerializationError as exc:
+                log.error("%s frame %d of %s: %s", self.contents.path, frame.number, topic, exc)
+
+    def _next_frame_of(self, context: str) -> _Frame:
+        frames = self._by_context.get(context, [])
+        index = self._cursors.get(context, 0)
+        if index >= len(frames):
+            if not self.loop or not frames:
+                raise EndOfData(f"end of log {self.contents.path}")
+            index = 0
+        self._cursors[context] = index + 1
+        return frames[index]
+
+    # ------------------------------------------------------------------------------ stepping
+    def play(self) -> None:
+        with self._lock:
+            self.paused, self.steps_left = False, None
+
+    def pause(self) -> None:
+        with self._lock:
+            self.paused = True
+
+    def step(self, count: int = 1) -> None:
+        """Run ``count`` more steps and pause; a negative count goes back (and replays that step)."""
+        with self._lock:
+            if count < 0:
+                self.position = max(0, self.position + count - 1)
+                count = 1
+            self.paused, self.steps_left = False, count
+
+    def goto(self, frame_number: int, context: str = "") -> None:
+        """Pause at the step holding ``frame_number`` of the main context (or of ``context``)."""
+        context = context or ("motion" if any(f.context == "motion" for s in self.timeline for f in s) else "cognition")
+        for index, step in enumerate(self.timeline):
+            if any(f.context == context and f.number == frame_number for f in step):
+                with self._lock:
+                    self.position, self.paused, self.steps_left = index, True, None
+                return
+        numbers = [f.number for s in self.timeline for f in s if f.context == context]
+        raise PlatformError(
+            f"the log has no {context} frame {frame_number}; its {context} frames are {min(numbers)}..{max(numbers)}"
+            if numbers else f"the log has no {context} frames"
+        )
+
+    def status(self) -> dict[str, Any]:
+        with self._lock:
+            current = self.timeline[min(self.position, len(self.timeline)) - 1] if self.position else []
+        return {
+            "file": str(self.contents.path),
+            "paused": self.paused,
+            "step": self.position,
+            "steps": len(self.timeline),
+            "frames": {f.context: f.number for f in current},
+        }
+

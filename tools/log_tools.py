@@ -1,0 +1,225 @@
+"""``tafel log info`` and ``tafel log export``: look into recorded MCAP logs.
+
+Export decodes with the schemas stored in the log itself, so it works for logs written by older
+versions of the code too.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from google.protobuf import descriptor_pool, message_factory
+
+from core.logfile import LogContents, LogError, as_dict, read_log
+from core.naming import did_you_mean
+
+
+def add_log_commands(commands: Any) -> None:
+    log = commands.add_parser("log", help="inspect and export recorded logs")
+    actions = log.add_subparsers(dest="log_command", metavar="ACTION")
+    actions.required = True
+    info = actions.add_parser("info", help="duration, frames per context, channels with counts and sizes")
+    info.add_argument("file", type=Path)
+    info.add_argument("--json", action="store_true", help="print the information as JSON")
+    export = actions.add_parser("export", help="representations as CSV or JSON lines, images as PNG files")
+    export.add_argument("file", type=Path)
+    export.add_argument("--rep", required=True, help="representation name, e.g. BallModel")
+    export.add_argument("--context", choices=["cognition", "motion"], help="only this context's channel")
+    export.add_argument("--format", required=True, choices=["csv", "jsonl", "png"])
+    export.add_argument("--out", required=True, type=Path, help="output file (csv, jsonl) or folder (png)")
+
+
+def run_log_command(args: argparse.Namespace) -> int:
+    try:
+        contents = read_log(args.file)
+    except LogError as exc:
+        print(f"tafel log: error: {exc}", file=sys.stderr)
+        return 1
+    if args.log_command == "info":
+        return print_info(contents, args.json)
+    return export(contents, args)
+
+
+def print_info(contents: LogContents, as_json: bool) -> int:
+    info = as_dict(contents)
+    if as_json:
+        print(json.dumps(info, indent=2))
+        return 0
+    state = "complete" if info["complete"] else "recovered what was complete"
+    print(f"file: {info['file']} ({state})")
+    if info["problem"]:
+        print(f"problem: {info['problem']}")
+    print(f"duration: {info['duration_s']:.3f} s")
+    print("frames: " + (", ".join(f"{c} {n}" for c, n in info["frames"].items()) or "none"))
+    if info["metadata"]:
+        print("recorded: " + ", ".join(f"{k}={v}" for k, v in sorted(info["metadata"].items())))
+    print("channels:")
+    for topic, channel in info["channels"].items():
+        source = channel.get("source", "?") + (f" {channel['provider']}" if channel.get("provider") else "")
+        print(f"  {topic:<36} {channel['messages']:>7} messages {_size(channel['bytes']):>10}  ({source})")
+    return 0
+
+
+def _size(n: int) -> str:
+    for unit in ("B", "kB", "MB", "GB"):
+        if n < 1000 or unit == "GB":
+            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
+        n /= 1000
+    return str(n)
+
+
+# ----------------------------------------------------------------------------------------- export
+def decoded_messages(contents: LogContents, rep: str, context: str | None) -> Iterator[tuple[str, int, int, dict[str, Any]]]:
+    """(context, frame, time_ns, fields) for every message of ``rep``, decoded with the log's schema."""
+    topics = [t for t, c in contents.channels.items() if c.representation == rep and (context is None or c.context == context)]
+    if not topics:
+        names = sorted({c.representation for c in contents.channels.values()})
+        raise LogError(f"{contents.path} holds no representation {rep!r}" + (f" in {context}" if context else "") + f"; {did_you_mean(rep, names)}")
+    classes = {}
+    for topic in topics:
+        channel = contents.channels[topic]
+        if channel.schema is None:
+            raise LogError(f"{contents.path}: channel {topic} has no protobuf schema")
+        pool = descriptor_pool.DescriptorPool()
+        pool.Add(channel.schema)
+        classes[topic] = message_factory.GetMessageClass(pool.FindMessageTypeByName(channel.schema_name))
+    for message in contents.messages:
+        if message.topic in classes:
+            try:
+                decoded = classes[message.topic].FromString(message.data)
+            except Exception as exc:  # noqa: BLE001 - a damaged message is skipped, named
+                print(f"\nskipping {message.topic} frame {message.sequence}: {exc}", file=sys.stderr)
+                continue
+            yield contents.channels[message.topic].context, message.sequence, message.time_ns, to_python(decoded)
+
+
+def to_python(message: Any) -> dict[str, Any]:
+    """A protobuf message as plain Python values; ``NDArray`` messages become numpy arrays."""
+    result: dict[str, Any] = {}
+    for field in message.DESCRIPTOR.fields:
+        value = getattr(message, field.name)
+        if field.message_type is not None:
+            convert = _array if field.message_type.name == "NDArray" else to_python
+            if field.is_repeated:
+                result[field.name] = [convert(v) for v in value]
+            elif message.HasField(field.name):
+                result[field.name] = convert(value)
+            else:
+                result[field.name] = None
+        else:
+            result[field.name] = list(value) if field.is_repeated else value
+    return result
+
+
+def _array(message: Any) -> np.ndarray:
+    return np.frombuffer(message.data, dtype=np.dtype(message.dtype)).reshape(tuple(message.shape))
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, dict):
+        return {k: _jsonable(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, bytes):
+        return value.hex()
+    return value
+
+
+def _flatten(fields: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    flat: dict[str, Any] = {}
+    for key, value in fields.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            flat.update(_flatten(value, name + "."))
+        elif isinstance(value, (list, np.ndarray)):
+            flat[name] = json.dumps(_jsonable(value))
+        else:
+            flat[name] = _jsonable(value)
+    return flat
+
+
+class Progress:
+    """A progress bar on stderr for long exports (over 200 messages)."""
+
+    def __init__(self, label: str, total: int) -> None:
+        self.label, self.total, self.shown = label, total, -1
+
+    def update(self, done: int) -> None:
+        if self.total < 200:
+            return
+        percent = done * 100 // self.total
+        if percent != self.shown:
+            self.shown = percent
+            bar = "#" * (percent // 5) + "-" * (20 - percent // 5)
+            print(f"\r{self.label} [{bar}] {percent:3d}% ({done}/{self.total})", end="", file=sys.stderr, flush=True)
+
+    def close(self) -> None:
+        if self.total >= 200:
+            print(file=sys.stderr)
+
+
+def export(contents: LogContents, args: argparse.Namespace) -> int:
+    try:
+        rows = decoded_messages(contents, args.rep, args.context)
+        total = sum(c.messages for c in contents.channels.values()
+                    if c.representation == args.rep and (args.context is None or c.context == args.context))
+        progress = Progress(f"exporting {args.rep}", total)
+        written = _write(rows, args, progress)
+        progress.close()
+    except LogError as exc:
+        print(f"tafel log: error: {exc}", file=sys.stderr)
+        return 1
+    except OSError as exc:
+        print(f"tafel log: error: cannot write {args.out}: {exc.strerror}", file=sys.stderr)
+        return 1
+    print(f"exported {written} {args.rep} {'images' if args.format == 'png' else 'rows'} to {args.out}")
+    if contents.problem:
+        print(f"note: {contents.problem}", file=sys.stderr)
+    return 0
+
+
+def _write(rows: Iterator[tuple[str, int, int, dict[str, Any]]], args: argparse.Namespace, progress: Progress) -> int:
+    count = 0
+    if args.format == "png":
+        import cv2
+
+        args.out.mkdir(parents=True, exist_ok=True)
+        for done, (context, frame, _time, fields) in enumerate(rows, start=1):
+            for name, value in fields.items():
+                if isinstance(value, np.ndarray) and _is_image(value):
+                    image = cv2.cvtColor(value, cv2.COLOR_RGB2BGR) if value.ndim == 3 and value.shape[2] == 3 else value
+                    path = args.out / f"{context}_{args.rep}_{name}_{frame:06d}.png"
+                    if not cv2.imwrite(str(path), image):
+                        raise OSError(0, f"OpenCV could not write {path}")
+                    count += 1
+            progress.update(done)
+        return count
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    with open(args.out, "w", newline="") as handle:
+        writer = None
+        for done, (context, frame, time_ns, fields) in enumerate(rows, start=1):
+            row = {"context": context, "frame": frame, "time_ns": time_ns}
+            if args.format == "jsonl":
+                handle.write(json.dumps({**row, **_jsonable(fields)}) + "\n")
+            else:
+                row.update(_flatten(fields))
+                if writer is None:
+                    writer = csv.DictWriter(handle, fieldnames=list(row))
+                    writer.writeheader()
+                writer.writerow(row)
+            count += 1
+            progress.update(done)
+    return count
+
+
+def _is_image(array: np.ndarray) -> bool:
+    return array.dtype == np.uint8 and (array.ndim == 2 or (array.ndim == 3 and array.shape[2] in (1, 3, 4))) and array.size > 0
