@@ -33,6 +33,10 @@ class PlatformError(TafelError, RuntimeError):
     """A platform cannot start or cannot go on (missing device, unreadable file, lost connection)."""
 
 
+class PlatformOptionError(PlatformError):
+    """A platform option that is missing or wrong (exit status 2 on the command line)."""
+
+
 class EndOfData(TafelError):
     """The platform has no more data (end of a video or log without --loop): stop cleanly."""
 

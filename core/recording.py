@@ -86,7 +86,7 @@ class Recorder:
         self.errors: dict[str, str] = {}
         #: messages dropped before they reached the writer (the concurrent runtime's forwarding)
         self.forward_dropped = 0
-        self._last_dropped = 0
+        self._last_writer: LogWriter | None = None
         self.blocking = False
 
     @property
@@ -117,13 +117,13 @@ class Recorder:
         if self.writer is not None:
             self.writer.close()
             status = self.status()
-            self._last_dropped = self.writer.dropped
+            self._last_writer = self.writer
         self.sink = None
         self.writer = None
         return status
 
     def status(self) -> dict[str, Any]:
-        writer = self.writer
+        writer = self.writer or self._last_writer
         return {
             "recording": self.recording,
             "file": str(self.path) if self.path else "",
@@ -135,7 +135,7 @@ class Recorder:
         }
 
     def dropped_total(self) -> int:
-        return (self.writer.dropped if self.writer else self._last_dropped) + self.forward_dropped
+        return self.status()["dropped"] + self.forward_dropped
 
     def record(self, context: str, blackboard: Blackboard, frame_number: int, time_ns: int) -> None:
         sink = self.sink

@@ -148,7 +148,7 @@ def check_compatible(cls: type, written: descriptor_pb2.FileDescriptorProto) -> 
             if (before.type, before.label, before.type_name.rsplit(".", 1)[-1]) != (
                 field.type, field.label, field.type_name.rsplit(".", 1)[-1]
             ):
-                where = ".".join([cls.__name__, *path[1:], field.name])
+                where = ".".join([cls.__name__, *path[1:], field.name])  # path[0] is the top message
                 raise SerializationError(
                     f"{where} was written as {_describe_field(before)} but is {_describe_field(field)} now; "
                     "this is not a compatible change (rename the field to start afresh, or convert the log)"
@@ -168,8 +168,8 @@ def _messages_by_path(file: descriptor_pb2.FileDescriptorProto) -> dict[tuple[st
         for nested in message.nested_type:
             walk(nested, (*path, nested.name))
 
-    for message in file.message_type:
-        walk(message, (message.name,))
+    for message in file.message_type[:1]:  # the representation itself, whatever it was called then
+        walk(message, ("",))
     return result
 
 

@@ -19,9 +19,10 @@ from typing import Any
 from core.errors import TafelError
 from core.logfile import LogContents, read_log
 from core.manager import Blackboard
-from core.platform import EndOfData, Platform, PlatformError
+from core.platform import EndOfData, Platform, PlatformError, PlatformOptionError
 from core.representation import get_representation
 from core.serialization import SerializationError, check_compatible, deserialize
+from representations import load_all
 
 log = logging.getLogger("tafel.platform.log")
 CONTEXT_ORDER = ("motion", "cognition")
@@ -45,7 +46,7 @@ class LogPlatform(Platform):
         super().__init__(options)
         path = self.options.get("log")
         if not path:
-            raise PlatformError("the log platform needs a recording: tafel run --platform log --log FILE.mcap")
+            raise PlatformOptionError("the log platform needs a recording: tafel run --platform log --log FILE.mcap")
         try:
             contents = read_log(path)
         except TafelError as exc:
@@ -55,11 +56,12 @@ class LogPlatform(Platform):
         if contents.problem:
             log.warning("replaying what could be recovered: %s", contents.problem)
         self.contents = contents
+        load_all()
         self.loop = bool(self.options.get("loop", False))
         replace = [n for n in str(self.options.get("replace") or "").split(",") if n.strip()]
         self.classes = self._resolve_classes(contents, [n.strip() for n in replace])
         self.provides = {  # type: ignore[misc] - depends on the file, so per instance
-            context: tuple(self.classes[topic] for topic in topics)
+            context: tuple(self.classes[topic] for topic in topics if topic in self.classes)
             for context, topics in self._provided_topics(contents, replace).items()
         }
         self.consumes = {}  # type: ignore[misc]
@@ -87,7 +89,7 @@ class LogPlatform(Platform):
         if unknown:
             from core.naming import did_you_mean
 
-            raise PlatformError(
+            raise PlatformOptionError(
                 f"--replace names {', '.join(unknown)}, which the log does not hold; "
                 + did_you_mean(unknown[0], sorted(recorded))
             )

@@ -7,3 +7,12 @@ Coordinate convention (the only one in Tafel):
   otherwise (``time_ns``). Image coordinates in pixels (px), origin at the top-left corner, x right,
   y down.
 """
+
+
+def load_all() -> None:
+    """Import every representation file, so that all of them are registered by name (logs need that)."""
+    import importlib
+    import pkgutil
+
+    for info in pkgutil.walk_packages(__path__, prefix=__name__ + "."):
+        importlib.import_module(info.name)

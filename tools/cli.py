@@ -15,7 +15,7 @@ from typing import Any, NoReturn
 from core.config import load_config
 from core.dot import contexts_dot
 from core.errors import TafelError
-from core.platform import Platform, PlatformError, available_platforms, load_platform
+from core.platform import Platform, PlatformError, PlatformOptionError, available_platforms, load_platform
 from core.program import ContextPlan, plan_program
 from core.recording import Recorder, select
 from core.runtime import ConcurrentRuntime, ContextStats, Limits, LockstepRuntime, install_signal_handlers
@@ -32,11 +32,11 @@ class UsageError(Exception):
 def discover_modules() -> None:
     """Import every file under ``representations/`` and ``modules/`` so configuration and logs can name them."""
     import modules
-    import representations
+    from representations import load_all
 
-    for package in (representations, modules):
-        for info in pkgutil.walk_packages(package.__path__, prefix=package.__name__ + "."):
-            importlib.import_module(info.name)
+    load_all()
+    for info in pkgutil.walk_packages(modules.__path__, prefix="modules."):
+        importlib.import_module(info.name)
 
 
 def parse_speed(text: str) -> float | None:
@@ -255,6 +255,8 @@ def report_recording(recorder: Recorder | None) -> None:
 
 def report_pruned(plans: dict[str, ContextPlan]) -> None:
     for plan in plans.values():
+        for module, reps in plan.replaced.items():
+            print(f"{plan.name}: {module} replaced, the platform provides {', '.join(reps)}", file=sys.stderr)
         for module, missing in plan.pruned.items():
             print(f"{plan.name}: {module} disabled, platform provides no {', '.join(missing)}", file=sys.stderr)
 
@@ -309,6 +311,8 @@ def command_modules(args: argparse.Namespace, extra: Sequence[str]) -> int:
             print(f"  hand-over out: {rep.__name__} to {other}")
         for module, missing in plan.pruned.items():
             print(f"  pruned: {module} (missing {', '.join(missing)})")
+        for module, reps in plan.replaced.items():
+            print(f"  replaced: {module} (the platform provides {', '.join(reps)})")
         for rep in plan.unfed:
             print(f"  warning: the platform consumes {rep}, but no module provides it (defaults are sent)")
         for module in sorted(set(plan.disabled)):
@@ -338,7 +342,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.exit(2, f"tafel {args.command}: error: {exc}\n")
     except (TafelError, KeyError) as exc:
         message = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
-        status = 1 if isinstance(exc, PlatformError) else 2
+        status = 1 if isinstance(exc, PlatformError) and not isinstance(exc, PlatformOptionError) else 2
         parser.exit(status, f"tafel {args.command}: error: {message}\n")
 
 

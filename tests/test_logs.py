@@ -1,0 +1,251 @@
+"""Recording, reading, replaying and exporting MCAP logs, as a user does it."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core import array, representation
+from core.logfile import LogWriter, read_log
+from core.platform import PlatformError, PlatformOptionError
+from core.serialization import serialize
+from platforms.log import LogPlatform
+from tests.test_cli_runtime import REPO, frames, tafel
+
+
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("logs") / "run.mcap"
+    result = tafel("run", "--frames", "600", "--speed", "max", "--record", str(path))
+    assert result.returncode == 0, result.stderr
+    assert "recorded" in result.stdout and "0 messages dropped" in result.stdout
+    return path
+
+
+def test_recording_has_one_channel_per_context_and_representation(recorded: Path) -> None:
+    contents = read_log(recorded)
+    assert contents.complete and not contents.problem
+    assert set(contents.channels) >= {
+        "cognition/FrameInfo", "cognition/BallPercept", "cognition/BallModel", "cognition/HeadMotionRequest",
+        "motion/FrameInfo", "motion/JointSensorData", "motion/InertialSensorData", "motion/FsrData", "motion/JointCommand",
+    }
+    assert contents.channels["cognition/BallModel"].metadata == {"source": "module", "provider": "KalmanBallModeler"}
+    assert contents.channels["motion/JointSensorData"].metadata == {"source": "platform"}
+    assert contents.channels["motion/FrameInfo"].messages == 600
+    assert contents.channels["cognition/FrameInfo"].messages == 180
+    assert contents.metadata["motion_hz"] == "100.0"
+
+
+PLAIN_READER = textwrap.dedent('''
+    """Decodes a Tafel log with nothing but mcap and protobuf."""
+    import json, sys
+    from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
+    from mcap.reader import make_reader
+
+    decoded, checks = {}, []
+    with open(sys.argv[1], "rb") as handle:
+        reader = make_reader(handle)
+        classes = {}
+        for schema, channel, message in reader.iter_messages():
+            if schema.id not in classes:
+                pool = descriptor_pool.DescriptorPool()
+                for file in descriptor_pb2.FileDescriptorSet.FromString(schema.data).file:
+                    pool.Add(file)
+                classes[schema.id] = message_factory.GetMessageClass(pool.FindMessageTypeByName(schema.name))
+            value = classes[schema.id].FromString(message.data)
+            decoded[channel.topic] = decoded.get(channel.topic, 0) + 1
+            if schema.name == "tafel.FrameInfo":
+                checks.append((value.time_ns == message.log_time, value.frame_number == message.sequence))
+    project = [name for name in sys.modules if name.split(".")[0] in ("core", "representations", "modules", "platforms", "tools")]
+    print(json.dumps({"decoded": decoded, "checks_ok": all(a and b for a, b in checks), "project_modules": project}))
+''')
+
+
+def test_a_plain_mcap_and_protobuf_reader_decodes_everything(recorded: Path, tmp_path: Path) -> None:
+    script = tmp_path / "plain_reader.py"
+    script.write_text(PLAIN_READER)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    result = subprocess.run([sys.executable, str(script), str(recorded)], capture_output=True, text=True, cwd=tmp_path, env=env, timeout=60)
+    assert result.returncode == 0, result.stderr
+    report = json.loads(result.stdout)
+    assert report["project_modules"] == []
+    assert report["checks_ok"]  # log time = frame time, sequence = frame number
+    assert report["decoded"]["motion/JointCommand"] == 600 and report["decoded"]["cognition/BallModel"] == 180
+
+
+def test_log_info_summarises_the_recording(recorded: Path) -> None:
+    result = tafel("log", "info", str(recorded))
+    assert result.returncode == 0, result.stderr
+    assert "(complete)" in result.stdout
+    assert "frames: cognition 180, motion 600" in result.stdout
+    assert re.search(r"motion/JointCommand\s+600 messages", result.stdout)
+    info = json.loads(tafel("log", "info", str(recorded), "--json").stdout)
+    assert info["channels"]["cognition/BallModel"]["messages"] == 180 and info["duration_s"] == pytest.approx(5.99)
+
+
+def test_replay_reproduces_every_cognition_output_frame_by_frame(recorded: Path, tmp_path: Path) -> None:
+    replayed = tmp_path / "replayed.mcap"
+    result = tafel("run", "--platform", "log", "--log", str(recorded), "--speed", "max", "--record", str(replayed))
+    assert result.returncode == 0, result.stderr
+    assert frames(result.stdout) == {"cognition": 180, "motion": 600}
+    original, again = read_log(recorded), read_log(replayed)
+    for topic in ("cognition/BallModel", "cognition/HeadMotionRequest", "motion/JointCommand"):
+        first = [(m.sequence, m.time_ns, m.data) for m in original.messages if m.topic == topic]
+        second = [(m.sequence, m.time_ns, m.data) for m in again.messages if m.topic == topic]
+        assert first == second, topic
+
+
+def test_replace_feeds_a_recorded_representation_instead_of_its_module(recorded: Path, tmp_path: Path) -> None:
+    modules = tafel("modules", "--platform", "log", "--log", str(recorded), "--replace", "BallModel")
+    assert "replaced: KalmanBallModeler (the platform provides BallModel)" in modules.stdout
+    replayed = tmp_path / "replaced.mcap"
+    result = tafel("run", "--platform", "log", "--log", str(recorded), "--replace", "BallModel", "--speed", "max",
+                   "--record", str(replayed), "--record-reps", "HeadMotionRequest")
+    assert result.returncode == 0, result.stderr
+    original = [m.data for m in read_log(recorded).messages if m.topic == "cognition/HeadMotionRequest"]
+    again = [m.data for m in read_log(replayed).messages if m.topic == "cognition/HeadMotionRequest"]
+    assert original == again
+
+
+def test_log_platform_argument_errors(recorded: Path, tmp_path: Path) -> None:
+    missing = tafel("run", "--platform", "log")
+    assert missing.returncode == 2 and "needs a recording: tafel run --platform log --log FILE.mcap" in missing.stderr
+    wrong = tafel("run", "--platform", "log", "--log", str(recorded), "--replace", "BallModle")
+    assert wrong.returncode == 2 and "did you mean 'BallModel'" in wrong.stderr
+    absent = tafel("run", "--platform", "log", "--log", str(tmp_path / "nope.mcap"))
+    assert absent.returncode == 1 and "nope.mcap" in absent.stderr and "Traceback" not in absent.stderr
+
+
+def test_foreign_and_missing_files_get_clear_errors(tmp_path: Path) -> None:
+    foreign = tmp_path / "foreign.mcap"
+    foreign.write_bytes(os.urandom(1000))
+    result = tafel("log", "info", str(foreign))
+    assert result.returncode == 1 and f"{foreign} is not an MCAP log" in result.stderr
+    assert "Traceback" not in result.stderr
+    result = tafel("log", "info", str(tmp_path / "absent.mcap"))
+    assert result.returncode == 1 and "absent.mcap" in result.stderr and "Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize("keep", [0.3, 0.6, 0.9])
+def test_truncated_files_yield_what_was_complete_and_name_the_position(recorded: Path, tmp_path: Path, keep: float) -> None:
+    data = recorded.read_bytes()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(data[: int(len(data) * keep)])
+    result = tafel("log", "info", str(cut))
+    assert result.returncode == 0, result.stderr
+    assert "recovered what was complete" in result.stdout
+    assert re.search(r"(stopped reading at byte \d+|ends at byte \d+)", result.stdout)
+    assert "Traceback" not in result.stderr + result.stdout
+
+
+def test_sigkill_while_recording_loses_at_most_the_last_second(tmp_path: Path) -> None:
+    path = tmp_path / "killed.mcap"
+    process = subprocess.Popen([sys.executable, "-m", "tools.cli", "run", "--record", str(path), "--status-interval", "0.5"],
+                               cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               env={**os.environ, "PYTHONPATH": str(REPO)})
+    last_status_time = 0.0
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            line = process.stderr.readline()
+            match = re.search(r"t=([\d.]+)s", line)
+            if match:
+                last_status_time = float(match.group(1))
+                if last_status_time >= 3.0:
+                    break
+        process.send_signal(signal.SIGKILL)
+        process.wait(timeout=10)
+    finally:
+        process.kill()
+    assert last_status_time >= 3.0
+    contents = read_log(path)
+    assert not contents.complete
+    motion_frames = len(contents.frames("motion"))
+    assert motion_frames >= (last_status_time - 1.0) * 100, (motion_frames, last_status_time)
+    result = tafel("log", "info", str(path))
+    assert result.returncode == 0 and "recovered what was complete" in result.stdout
+
+
+def test_export_csv_and_jsonl(recorded: Path, tmp_path: Path) -> None:
+    out = tmp_path / "ball.csv"
+    result = tafel("log", "export", str(recorded), "--rep", "BallModel", "--format", "csv", "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    rows = list(csv.DictReader(out.open()))
+    assert len(rows) == 180 and rows[0]["context"] == "cognition" and rows[0]["frame"] == "1"
+    assert {"x", "y", "valid", "time_ns"} <= set(rows[0])
+    out = tmp_path / "joints.jsonl"
+    result = tafel("log", "export", str(recorded), "--rep", "JointSensorData", "--format", "jsonl", "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    lines = [json.loads(line) for line in out.read_text().splitlines()]
+    assert len(lines) == 600 and len(lines[10]["position"]) == 25
+    assert "exporting JointSensorData [" in result.stderr  # progress bar for long logs
+    wrong = tafel("log", "export", str(recorded), "--rep", "BallModle", "--format", "csv", "--out", str(out))
+    assert wrong.returncode == 1 and "did you mean 'BallModel'" in wrong.stderr
+
+
+@representation
+class LogTestImage:
+    image: np.ndarray = array((6, 8, 3), np.uint8)
+
+
+def test_export_png_writes_images(tmp_path: Path) -> None:
+    import cv2
+
+    path = tmp_path / "images.mcap"
+    writer = LogWriter(path)
+    images = []
+    for frame in range(1, 4):
+        rep = LogTestImage()
+        rep.image[:, :, 0] = frame * 40  # red channel (images are RGB)
+        images.append(rep.image.copy())
+        writer.write("cognition/LogTestImage", LogTestImage, frame * 33_000_000, frame, serialize(rep), {"source": "platform"})
+    writer.close()
+    out = tmp_path / "png"
+    result = tafel("log", "export", str(path), "--rep", "LogTestImage", "--format", "png", "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    written = sorted(out.glob("*.png"))
+    assert [p.name for p in written] == [f"cognition_LogTestImage_image_{i:06d}.png" for i in (1, 2, 3)]
+    assert np.array_equal(cv2.cvtColor(cv2.imread(str(written[1])), cv2.COLOR_BGR2RGB), images[1])
+
+
+def test_stepping_the_replay(recorded: Path) -> None:
+    platform = LogPlatform({"log": str(recorded)})
+    first = platform.next_step()
+    assert first is not None and first[1] == frozenset({"motion", "cognition"})
+    platform.pause()
+    assert platform.next_step() is None
+    platform.step(2)
+    second, third = platform.next_step(), platform.next_step()
+    assert second is not None and third is not None and platform.next_step() is None
+    platform.step(-1)
+    again = platform.next_step()
+    assert again == second and platform.next_step() is None  # back to the frame before the current one
+    platform.goto(100)
+    assert platform.paused
+    platform.play()
+    platform.next_step()
+    assert platform.status()["frames"]["motion"] == 100
+    with pytest.raises(PlatformError, match="no motion frame 5000; its motion frames are 1..600"):
+        platform.goto(5000)
+    with pytest.raises(PlatformOptionError):
+        LogPlatform({})
+
+
+def test_concurrent_runs_record_into_one_file(tmp_path: Path) -> None:
+    path = tmp_path / "concurrent.mcap"
+    result = tafel("run", "--concurrent", "--frames", "150", "--record", str(path))
+    assert result.returncode == 0, result.stderr
+    contents = read_log(path)
+    assert contents.complete
+    assert len(contents.frames("motion")) == 150 and len(contents.frames("cognition")) >= 30
