@@ -204,6 +204,11 @@ class ModuleManager:
         return [m.__name__ for m in self._modules]
 
     @property
+    def module_classes(self) -> list[type]:
+        """All module classes known to this manager, active or not."""
+        return list(self._modules)
+
+    @property
     def external(self) -> list[type]:
         return list(self._external)
 
@@ -254,6 +259,17 @@ class ModuleManager:
                 errors=slot.errors,
             )
         return result
+
+    def p95_us(self, name: str) -> float:
+        """95th percentile of a running module's execution time over the timing window (us)."""
+        for slot in self._slots:
+            if slot.name == name:
+                n = min(self.frame - slot.first_frame, TIMING_WINDOW)
+                if n <= 0:
+                    return 0.0
+                recent = sorted(slot.times[(self.frame - i) % TIMING_WINDOW] for i in range(n))
+                return recent[int(0.95 * (n - 1))] / 1e3
+        raise KeyError(f"module {name} is not running in {self.name}")
 
     def errors(self) -> dict[str, tuple[int, str]]:
         """Module name -> (error count, last error) for modules that failed at least once."""

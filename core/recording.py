@@ -45,12 +45,18 @@ class Selection:
         return {"source": self.source, **({"provider": self.provider} if self.provider else {})}
 
 
-def select(plans: Mapping[str, ContextPlan], names: Iterable[str] | None, *, include_sensors: bool = True) -> list[Selection]:
-    """The representations to record; unknown names fail with the closest known ones."""
+def select(plans: Mapping[str, ContextPlan], names: Iterable[str] | None, *, include_sensors: bool = True,
+           extra: Iterable[type] = ()) -> list[Selection]:
+    """The representations to record; unknown names fail with the closest known ones.
+
+    ``extra`` are representations every running context can fill besides its modules (debug data).
+    """
     owners: dict[str, list[Selection]] = {}
     for context, plan in plans.items():
         if not plan.runs:
             continue
+        for rep in extra:
+            owners.setdefault(rep.__name__, []).append(Selection(context, rep, "debug"))
         for rep in plan.platform_provides:
             owners.setdefault(rep.__name__, []).append(Selection(context, rep, "platform"))
         providers = {rep: m for m in plan.active_modules() for rep in m.requirements().provides}
@@ -88,6 +94,10 @@ class Recorder:
         self.forward_dropped = 0
         self._last_writer: LogWriter | None = None
         self.blocking = False
+        #: records only while this returns True (set in context processes of the concurrent runtime)
+        self.gate: Any = None
+        #: called with True on start and False on stop
+        self.listeners: list[Any] = []
 
     @property
     def recording(self) -> bool:
@@ -103,6 +113,8 @@ class Recorder:
             self.blocking = blocking
         self.writer = LogWriter(path, metadata=self.metadata)
         self.writer.blocking = self.blocking
+        for listener in self.listeners:
+            listener(True)
         self.sink = self.writer
         self.path = Path(path)
         self.frames_recorded = {}
@@ -118,6 +130,9 @@ class Recorder:
             self.writer.close()
             status = self.status()
             self._last_writer = self.writer
+        if self.sink is not None:
+            for listener in self.listeners:
+                listener(False)
         self.sink = None
         self.writer = None
         return status
@@ -139,7 +154,7 @@ class Recorder:
 
     def record(self, context: str, blackboard: Blackboard, frame_number: int, time_ns: int) -> None:
         sink = self.sink
-        if sink is None:
+        if sink is None or (self.gate is not None and not self.gate()):
             return
         for selection in self.by_context.get(context, ()):
             try:

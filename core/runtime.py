@@ -335,6 +335,9 @@ class WorkerSpec:
     realtime_priority: int = 50
     record: list[Any] = field(default_factory=list)
     record_queue: Any = None
+    record_switch: Any = None
+    #: (function, arguments) run in the context process once its runner exists (debug server wiring)
+    setup: tuple[Callable[[ContextRunner, Any], None], Any] | None = None
 
 
 def try_realtime(priority: int) -> str:
@@ -444,7 +447,11 @@ def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
             recorder = Recorder(spec.record)
             sink = QueueSink(spec.record_queue)
             recorder.attach(sink)
+            recorder.gate = spec.record_switch.is_set
             runner.after_step.append(recorder_hook(recorder))
+        if spec.setup is not None:
+            function, arguments = spec.setup
+            function(runner, arguments)
         watch = cognition_watcher(inbox, spec.stall_timeout_s) if spec.plan.name == "motion" and inbox else None
         if spec.plan.name == "motion" and watch is None:
             watch = lambda: (False, 0, 0.0)  # noqa: E731 - no cognition context at all
@@ -486,8 +493,10 @@ class ConcurrentRuntime:
 
     def __init__(self, plans: Mapping[str, ContextPlan], platform_class: type[Platform],
                  platform_options: Mapping[str, Any], *, strict: bool = False, stall_timeout_s: float = 1.0,
-                 recorder: Recorder | None = None) -> None:
+                 recorder: Recorder | None = None,
+                 worker_setup: tuple[Callable[[ContextRunner, Any], None], Any] | None = None) -> None:
         self.recorder = recorder
+        self.worker_setup = worker_setup
         self.plans = {name: plan for name, plan in plans.items() if plan.runs}
         if not self.plans:
             raise PlatformError("nothing to run: no context has modules or platform data")
@@ -502,6 +511,11 @@ class ConcurrentRuntime:
         self.on_report: list[Callable[[ConcurrentRuntime], None]] = []
         self._mp = multiprocessing.get_context("spawn")
         self.stop = self._mp.Event()
+        self.record_switch = self._mp.Event()
+        if recorder is not None:
+            recorder.listeners.append(lambda on: self.record_switch.set() if on else self.record_switch.clear())
+            if recorder.recording:
+                self.record_switch.set()
         self.processes: dict[str, Any] = {}
 
     def run(self, limits: Limits) -> dict[str, ContextStats]:
@@ -521,6 +535,7 @@ class ConcurrentRuntime:
                     inbox_name=channels[other].name if (plan.handover_in or watch_cognition) and other in channels else None,
                     outbox_name=channels[name].name, stall_timeout_s=self.stall_timeout_s,
                     record=self.recorder.by_context.get(name, []) if self.recorder else [], record_queue=record_queue,
+                    record_switch=self.record_switch, setup=self.worker_setup,
                 )
                 receiver, sender = self._mp.Pipe(duplex=False)
                 process = self._mp.Process(target=_worker_main, args=(spec, self.stop, sender), name=f"tafel-{name}", daemon=True)

@@ -7,6 +7,7 @@ import importlib
 import logging
 import pkgutil
 import sys
+import threading
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -18,11 +19,23 @@ from core.errors import TafelError
 from core.platform import Platform, PlatformError, PlatformOptionError, available_platforms, load_platform
 from core.program import ContextPlan, plan_program
 from core.recording import Recorder, select
+from representations.modeling import BallModel
+from tools.debugging import (
+    DEBUG_REPRESENTATIONS,
+    LocalExecutor,
+    ProgramDebug,
+    RemoteExecutor,
+    concurrent_pipes,
+    context_debug,
+    handovers_of,
+    worker_debug_setup,
+)
 from core.runtime import ConcurrentRuntime, ContextStats, Limits, LockstepRuntime, install_signal_handlers
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_CONFIG = REPO_ROOT / "config"
 FALLBACK_PLATFORM = "dummy"
+DEFAULT_DEBUG_PORT = 5401
 
 
 class UsageError(Exception):
@@ -93,10 +106,17 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("-v", "--verbose", action="store_true", help="log informational messages")
     run.add_argument("--record", type=Path, metavar="FILE.mcap", help="record representations into an MCAP log")
     run.add_argument("--record-reps", metavar="A,B", help="what to record (default: sensor data and [recording] representations)")
+    run.add_argument("--debug-port", type=int, default=None, metavar="P", help=f"debug server port (default {DEFAULT_DEBUG_PORT}; 0 takes a free one)")
+    run.add_argument("--debug-host", default="127.0.0.1", metavar="H", help="debug server address (default: %(default)s)")
+    run.add_argument("--debug-token", metavar="T", help="clients must send 'auth T' first")
+    run.add_argument("--no-debug", action="store_true", help="run without the debug server")
 
     from tools.log_tools import add_log_commands
 
     add_log_commands(commands)
+    from tools.console import add_console_command
+
+    add_console_command(commands)
 
     platforms = commands.add_parser("platforms", help="list the platforms and what they provide and consume")
     platforms.add_argument("--verbose", "-v", action="store_true")
@@ -177,39 +197,49 @@ def print_summary(platform: str, mode: str, stats: dict[str, ContextStats], wall
 def command_run(args: argparse.Namespace, extra: Sequence[str]) -> int:
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(name)s %(levelname)s: %(message)s")
     platform, options, plans, config = prepare(args, extra)
-    platform_class = type(platform)
     report_pruned(plans)
-    recorder = make_recorder(args, plans, config, platform_class.name)
+    recorder = make_recorder(args, plans, config, type(platform).name)
     limits = Limits(frames=args.frames, seconds=args.seconds, speed=args.speed)
-    concurrent = args.concurrent or platform_class.clock == "own"
-    stall = float(config.get("runtime", {}).get("stall_timeout_s", 1.0))
-    started = time.monotonic()
-    if concurrent:
-        platform.stop()  # each context process makes its own
-        runtime = ConcurrentRuntime(plans, platform_class, options, strict=args.strict, stall_timeout_s=stall, recorder=recorder)
-        last = [started]
+    if args.concurrent or type(platform).clock == "own":
+        return run_concurrent(args, platform, options, plans, config, recorder, limits)
+    return run_lockstep(args, platform, plans, recorder, limits)
 
-        def on_report(rt: ConcurrentRuntime) -> None:
-            now = time.monotonic()
-            if now - last[0] >= args.status_interval:
-                last[0] = now
-                print(format_status(platform_class.name, now - started, rt.stats, rt.notices), file=sys.stderr, flush=True)
 
-        runtime.on_report.append(on_report)
-        install_signal_handlers(runtime.stop, on_force=lambda: [p.kill() for p in runtime.processes.values()])
-        stats = runtime.run(limits)
-        realtime = stats.get("motion", ContextStats("motion")).realtime
-        if realtime:
-            print(f"motion: {realtime}", file=sys.stderr)
-        for notice in runtime.notices:
-            print(f"notice: {notice}", file=sys.stderr)
-        print_summary(platform_class.name, "concurrent", stats, time.monotonic() - started, None, "")
-        report_recording(recorder)
-        failed = [s.failure for s in stats.values() if s.failure]
-        return 1 if failed else 0
+def start_debug(args: argparse.Namespace, recorder: Recorder | None, plans: dict[str, ContextPlan]) -> ProgramDebug | None:
+    """The debug server of this run, not yet listening; None with --no-debug."""
+    if args.no_debug:
+        return None
+    port = DEFAULT_DEBUG_PORT if args.debug_port is None else args.debug_port
+    debug = ProgramDebug(host=args.debug_host, port=port, token=args.debug_token, config_dir=args.config, recorder=recorder)
+    debug.handovers = handovers_of(plans)
+    return debug
 
+
+def listen(args: argparse.Namespace, debug: ProgramDebug | None) -> None:
+    if debug is None:
+        return
+    try:
+        host, port = debug.server.start()
+    except OSError as exc:
+        if args.debug_port is not None:
+            raise PlatformError(f"{exc}; choose another --debug-port (0 takes a free one)") from None
+        print(f"warning: {exc}; running without the debug server (use --debug-port 0 for a free port)", file=sys.stderr)
+        return
+    print(f"debug server listening on {host}:{port}", flush=True)
+
+
+def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, ContextPlan], recorder: Recorder | None, limits: Limits) -> int:
     runtime = LockstepRuntime(plans, platform, strict=args.strict, recorder=recorder)
+    debug = start_debug(args, recorder, plans)
+    if debug is not None:
+        recorded = debug_recorded(recorder)
+        for name, runner in runtime.runners.items():
+            debug.add_context(name, LocalExecutor(context_debug(name, runner.manager, recorded.get(name, ()))))
+        debug.add_platform_commands(platform)
+        runtime.after_tick.append(lambda _runtime: debug.server.process_pending())
+        listen(args, debug)
     install_signal_handlers(runtime.stop)
+    started = time.monotonic()
     last = [started]
 
     def status(rt: LockstepRuntime) -> None:
@@ -217,35 +247,103 @@ def command_run(args: argparse.Namespace, extra: Sequence[str]) -> int:
         if now - last[0] >= args.status_interval:
             last[0] = now
             stats = {name: r.stats(now - started) for name, r in rt.runners.items()}
-            print(format_status(platform_class.name, rt.time_ns * 1e-9, stats), file=sys.stderr, flush=True)
+            print(format_status(type(platform).name, rt.time_ns * 1e-9, stats, ball_status(rt.runners)), file=sys.stderr, flush=True)
 
     runtime.after_tick.append(status)
-    stats = runtime.run(limits)
-    print_summary(platform_class.name, "lockstep", stats, runtime.wall_s, runtime.time_ns * 1e-9, runtime.end_reason)
+    try:
+        stats = runtime.run(limits)
+    finally:
+        if debug is not None:
+            debug.server.stop()
+    print_summary(type(platform).name, "lockstep", stats, runtime.wall_s, runtime.time_ns * 1e-9, runtime.end_reason)
     report_recording(recorder)
     return 0
 
 
+def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[str, Any], plans: dict[str, ContextPlan],
+                   config: dict[str, Any], recorder: Recorder | None, limits: Limits) -> int:
+    platform.stop()  # each context process makes its own
+    platform_class = type(platform)
+    debug = start_debug(args, recorder, plans)
+    setup = None
+    if debug is not None:
+        running = [name for name, plan in plans.items() if plan.runs]
+        ours, theirs = concurrent_pipes(running)
+        setup = (worker_debug_setup, {"connections": theirs, "recorded": debug_recorded(recorder)})
+        for name in running:
+            debug.add_context(name, RemoteExecutor(name, ours[name]))
+    stall = float(config.get("runtime", {}).get("stall_timeout_s", 1.0))
+    runtime = ConcurrentRuntime(plans, platform_class, options, strict=args.strict, stall_timeout_s=stall,
+                                recorder=recorder, worker_setup=setup)
+    started = time.monotonic()
+    last = [started]
+
+    def on_report(rt: ConcurrentRuntime) -> None:
+        now = time.monotonic()
+        if now - last[0] >= args.status_interval:
+            last[0] = now
+            print(format_status(platform_class.name, now - started, rt.stats, rt.notices), file=sys.stderr, flush=True)
+
+    runtime.on_report.append(on_report)
+    install_signal_handlers(runtime.stop, on_force=lambda: [p.kill() for p in runtime.processes.values()])
+    if debug is not None:
+        listen(args, debug)
+        threading.Thread(target=debug.server.dispatch_forever, args=(runtime.stop,), name="tafel-debug-dispatch", daemon=True).start()
+    try:
+        stats = runtime.run(limits)
+    finally:
+        if debug is not None:
+            debug.server.stop()
+    realtime = stats.get("motion", ContextStats("motion")).realtime
+    if realtime:
+        print(f"motion: {realtime}", file=sys.stderr)
+    for notice in runtime.notices:
+        print(f"notice: {notice}", file=sys.stderr)
+    print_summary(platform_class.name, "concurrent", stats, time.monotonic() - started, None, "")
+    report_recording(recorder)
+    return 1 if any(s.failure for s in stats.values()) else 0
+
+
+def debug_recorded(recorder: Recorder | None) -> dict[str, list[type]]:
+    """Per context, the debug representations the recorder takes (they must be filled every frame)."""
+    if recorder is None:
+        return {}
+    return {context: [s.rep for s in selections if s.source == "debug"] for context, selections in recorder.by_context.items()}
+
+
+def ball_status(runners: dict[str, Any]) -> list[str]:
+    """The ball as cognition believes it, for the status line."""
+    cognition = runners.get("cognition")
+    if cognition is None or BallModel not in cognition.manager.blackboard:
+        return []
+    ball = cognition.manager.blackboard[BallModel]
+    if not ball.valid:
+        return ["ball not seen"]
+    return [f"ball {'seen' if ball.seen else 'remembered'} at x={ball.x:.0f} y={ball.y:.0f} mm"]
+
+
 def make_recorder(args: argparse.Namespace, plans: dict[str, ContextPlan], config: dict[str, Any], platform: str) -> Recorder | None:
-    """A recorder for --record, started; None without it."""
-    if args.record is None and not args.record_reps:
+    """The recorder of this run, started with --record; ready for log:start when the debug server runs."""
+    if args.record is None and args.no_debug:
+        if args.record_reps:
+            fail("--record-reps needs --record FILE.mcap (or the debug server's log:start)")
         return None
-    if args.record is None:
-        fail("--record-reps needs --record FILE.mcap")
     names = (
         [n.strip() for n in args.record_reps.split(",") if n.strip()] if args.record_reps
         else list(config.get("recording", {}).get("representations", []))
     )
-    selections = select(plans, names, include_sensors=not args.record_reps)
+    selections = select(plans, names, include_sensors=not args.record_reps, extra=DEBUG_REPRESENTATIONS)
     metadata = {"platform": platform, **{f"{c}_hz": str(p.rate_hz) for c, p in plans.items()}}
     recorder = Recorder(selections, metadata)
     # Without a beat to keep (lockstep at --speed max) recording waits for the writer rather than drop.
-    recorder.start(args.record, blocking=args.speed is None and not args.concurrent)
+    recorder.blocking = args.speed is None and not args.concurrent
+    if args.record is not None:
+        recorder.start(args.record)
     return recorder
 
 
 def report_recording(recorder: Recorder | None) -> None:
-    if recorder is None:
+    if recorder is None or recorder.path is None:
         return
     status = recorder.status()
     frames = ", ".join(f"{c} {n}" for c, n in sorted(status["frames"].items()))
@@ -328,7 +426,16 @@ def command_log(args: argparse.Namespace, extra: Sequence[str]) -> int:
     return run_log_command(args)
 
 
-COMMANDS = {"run": command_run, "platforms": command_platforms, "modules": command_modules, "log": command_log}
+def command_console(args: argparse.Namespace, extra: Sequence[str]) -> int:
+    from tools.console import run_console
+
+    if extra:
+        fail(f"unrecognized arguments: {' '.join(extra)}")
+    return run_console(args)
+
+
+COMMANDS = {"run": command_run, "platforms": command_platforms, "modules": command_modules, "log": command_log,
+            "console": command_console}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -338,6 +445,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.error(f"unrecognized arguments: {' '.join(extra)}")
     try:
         return COMMANDS[args.command](args, extra)
+    except BrokenPipeError:  # output piped into head and the like
+        sys.stderr.close()
+        return 0
     except UsageError as exc:
         parser.exit(2, f"tafel {args.command}: error: {exc}\n")
     except (TafelError, KeyError) as exc:

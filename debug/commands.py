@@ -1,0 +1,418 @@
+"""Debug commands: what each context answers, and how answers of both contexts are combined.
+
+Every context command takes an optional ``-context cognition|motion`` to ask only that context.
+
+A ``ContextDebug`` answers the commands about one context (its modules, blackboard, parameters and
+the debug data its modules produced). It runs in the thread or process of that context, between
+frames. A ``DebugRouter`` asks every context and combines the answers: lists are merged with a
+heading per context; a command about one name takes the answer of the context that has it, so names
+(modules, representations, requests) can be used without saying which context they are in.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import json
+import statistics
+import time
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from core.errors import TafelError
+from core.manager import ModuleManager
+from core.naming import did_you_mean
+from core.parameters import ParameterError, parameter_values, set_parameter
+from core.representation import fields_of
+from core.serialization import SerializationError, deserialize, serialize
+from debug.concepts import STATE, DebugState
+from debug.protocol import Command
+
+
+class CommandError(TafelError):
+    """A command that cannot be carried out; the message becomes ``error: ...``."""
+
+
+class NotHere(TafelError):
+    """The name a command refers to does not exist in this context (another context may have it)."""
+
+    def __init__(self, kind: str, name: str, known: Iterable[str]) -> None:
+        super().__init__(kind, name)
+        self.kind, self.name, self.known = kind, name, sorted(set(known))
+
+
+@dataclass(frozen=True)
+class CommandSpec:
+    name: str
+    summary: str
+    usage: str
+    #: "merge": every context answers, combined under headings; "first": the context that has the name;
+    #: "lines": the lines of every context that has something, without headings (for tools)
+    routing: str = "merge"
+
+
+SPECS: dict[str, CommandSpec] = {}
+
+
+def _spec(name: str, summary: str, usage: str = "", routing: str = "merge") -> None:
+    SPECS[name] = CommandSpec(name, summary, usage or name, routing)
+
+
+_spec("modules:list", "per context: execution order, enabled, providers and alternatives, mean and max time")
+_spec("modules:set", "enable or disable a module", "modules:set -module NAME -enabled true|false", "first")
+_spec("modules:provider", "choose the module that provides a representation", "modules:provider -representation NAME -module NAME", "first")
+_spec("representation:list", "the representations of both contexts and who provides them")
+_spec("representation:print", "a representation's current value as readable text", "representation:print -name NAME", "first")
+_spec("representation:get", "a representation's current value as protobuf bytes (use +representation:get for base64)", "+representation:get -name NAME", "first")
+_spec("representation:set", "set a representation from protobuf bytes or one field", "representation:set -name NAME +data BASE64 | -field FIELD -value VALUE", "first")
+_spec("debug_request:list", "debug requests, on or off")
+_spec("debug_request:set", "switch a debug request on or off", "debug_request:set -name NAME -value on|off", "first")
+_spec("modify:list", "published modify values, and which are pinned")
+_spec("modify:set", "pin a modify value", "modify:set -name NAME -value VALUE", "first")
+_spec("modify:release", "unpin a modify value", "modify:release -name NAME", "first")
+_spec("stopwatch:list", "per module and named stopwatch: last, mean, max, p95 (us), per context, and loop frequency")
+_spec("plot:get", "a plot's recent values (frame value per line); without -name the plot names", "plot:get [-name NAME] [-count N]", "lines")
+_spec("drawings:get", "the last frame's drawings of both contexts as JSON lines", "drawings:get [-canvas field|image:top|image:bottom]", "lines")
+_spec("parameter:list", "modules with parameters and their values")
+_spec("parameter:get", "a module's parameters", "parameter:get -module NAME", "first")
+_spec("parameter:set", "change a parameter; the module sees it next frame", "parameter:set -module NAME -name PARAMETER -value VALUE", "first")
+
+
+def argument(command: Command, *names: str, positional: bool = True, required: bool = True) -> str:
+    """A string argument by name (``-name value``), or the first empty argument (``print BallModel``)."""
+    for name in names:
+        value = command.args.get(name)
+        if isinstance(value, str) and value != "":
+            return value
+    if positional:
+        for key, value in command.args.items():
+            if value == "" and key not in names:
+                return key
+    if required:
+        raise CommandError(f"{command.name} needs -{names[0]}; usage: {SPECS[command.name].usage if command.name in SPECS else command.name}")
+    return ""
+
+
+def parse_bool(text: str, what: str) -> bool:
+    lowered = text.lower()
+    if lowered in ("on", "true", "1", "yes"):
+        return True
+    if lowered in ("off", "false", "0", "no"):
+        return False
+    raise CommandError(f"{what} takes on/off or true/false, got {text!r}")
+
+
+def pretty(value: Any, indent: str = "") -> str:
+    """A representation (or any value in one) as readable, indented text."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        lines = []
+        for info in fields_of(type(value)):
+            field_value = getattr(value, info.name)
+            if dataclasses.is_dataclass(field_value) or (isinstance(field_value, list) and field_value and dataclasses.is_dataclass(field_value[0])):
+                lines.append(f"{indent}{info.name}:")
+                lines.append(pretty(field_value, indent + "  "))
+            else:
+                lines.append(f"{indent}{info.name}: {_short(field_value)}")
+        return "\n".join(lines)
+    if isinstance(value, list):
+        return "\n".join(f"{indent}[{i}]\n{pretty(v, indent + '  ')}" for i, v in enumerate(value))
+    return f"{indent}{_short(value)}"
+
+
+def _short(value: Any) -> str:
+    if isinstance(value, np.ndarray):
+        if value.size > 32:
+            return f"array(shape={value.shape}, dtype={value.dtype}, min={value.min():.4g}, max={value.max():.4g})"
+        return np.array2string(value, precision=4, separator=", ", max_line_width=200)
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if isinstance(value, enum.Enum):
+        return value.name
+    if isinstance(value, bytes):
+        return f"{len(value)} bytes" if len(value) > 32 else value.hex()
+    return str(value)
+
+
+def _coerce_like(current: Any, text: str, what: str) -> Any:
+    """``text`` converted to the type of ``current`` (for modify values and single fields)."""
+    try:
+        if isinstance(current, bool):
+            return parse_bool(text, what)
+        if isinstance(current, int):
+            return int(text)
+        if isinstance(current, float):
+            return float(text)
+        if isinstance(current, enum.Enum):
+            return type(current)[text]
+        if isinstance(current, str) or current is None:
+            return text
+        if isinstance(current, (list, np.ndarray)):
+            values = json.loads(text)
+            return np.asarray(values, dtype=current.dtype) if isinstance(current, np.ndarray) else list(values)
+    except (ValueError, KeyError, json.JSONDecodeError):
+        pass
+    raise CommandError(f"{what} holds {type(current).__name__}; {text!r} is not one")
+
+
+class ContextDebug:
+    """Answers debug commands about one context; call ``execute`` between that context's frames."""
+
+    def __init__(self, context: str, manager: ModuleManager, *, state: DebugState = STATE,
+                 rate: Callable[[], float] | None = None) -> None:
+        self.context = context
+        self.manager = manager
+        self.state = state
+        self.rate = rate or (lambda: 0.0)
+        self.handlers: dict[str, Callable[[Command], str | bytes]] = {
+            name: getattr(self, "cmd_" + name.replace(":", "_")) for name in SPECS
+        }
+
+    def execute(self, command: Command) -> tuple[str, str | bytes]:
+        """("ok", text), ("error", message) or ("missing", json of kind, name, known)."""
+        handler = self.handlers.get(command.name)
+        if handler is None:
+            return "error", f"{command.name} is not a context command"
+        wanted = command.args.get("context")
+        if isinstance(wanted, str) and wanted not in ("", self.context):
+            return "missing", json.dumps(["context", wanted, [self.context]])
+        try:
+            return "ok", handler(command)
+        except NotHere as missing:
+            return "missing", json.dumps([missing.kind, missing.name, missing.known])
+        except (CommandError, ParameterError, SerializationError, TafelError) as exc:
+            return "error", str(exc)
+        except Exception as exc:  # noqa: BLE001 - a handler bug must not take the loop down
+            return "error", f"{command.name} failed: {type(exc).__name__}: {exc}"
+
+    def execute_batch(self, commands: Sequence[Command], budget_s: float | None = None) -> list[tuple[str, str | bytes]]:
+        """Answers for the commands in order; with a budget, for as many as fit (at least one)."""
+        if budget_s is None:
+            return [self.execute(c) for c in commands]
+        deadline = time.perf_counter() + budget_s
+        answers = []
+        for command in commands:
+            answers.append(self.execute(command))
+            if time.perf_counter() > deadline:
+                break
+        return answers
+
+    # ------------------------------------------------------------------------------ modules
+    def _module_name(self, command: Command) -> str:
+        name = argument(command, "module", "name")
+        if name not in self.manager.modules:
+            raise NotHere("module", name, self.manager.modules)
+        return name
+
+    def cmd_modules_list(self, command: Command) -> str:
+        timings = self.manager.timings()
+        lines = [f"order: {' -> '.join(self.manager.order) or '(none)'}"]
+        for name in self.manager.modules:
+            state = "on" if self.manager.is_enabled(name) else "off"
+            timing = timings.get(name)
+            if timing:
+                lines.append(f"  {name:<28} {state:<3} running  mean {timing.mean_us:8.1f} us  max {timing.max_us:8.1f} us  errors {timing.errors}")
+            else:
+                lines.append(f"  {name:<28} {state:<3} {'idle (not chosen as provider)' if state == 'on' else 'disabled'}")
+        for rep, info in sorted(self.manager.graph()["representations"].items()):
+            if len(info["alternatives"]) > 1:
+                lines.append(f"  provider {rep}: {info['provider']} (alternatives: {', '.join(info['alternatives'])})")
+        return "\n".join(lines)
+
+    def cmd_modules_set(self, command: Command) -> str:
+        name = self._module_name(command)
+        enabled = parse_bool(argument(command, "enabled", "value", positional=False), "-enabled")
+        self.manager.set_enabled(name, enabled)
+        return f"{name} {'enabled' if enabled else 'disabled'} in {self.context}; order: {' -> '.join(self.manager.order)}"
+
+    def cmd_modules_provider(self, command: Command) -> str:
+        rep = argument(command, "representation", "name")
+        module = argument(command, "module", positional=False)
+        if not self.manager.alternatives(rep):
+            raise NotHere("representation", rep, self.manager.blackboard.names())
+        self.manager.set_provider(rep, module)
+        return f"{rep} is provided by {module} in {self.context}"
+
+    def graph(self) -> dict[str, Any]:
+        return self.manager.graph()
+
+    # ------------------------------------------------------------------------ representations
+    def _representation(self, command: Command) -> Any:
+        name = argument(command, "name", "representation")
+        if name not in self.manager.blackboard.names():
+            raise NotHere("representation", name, self.manager.blackboard.names())
+        return self.manager.blackboard.get(name)
+
+    def cmd_representation_list(self, command: Command) -> str:
+        lines = []
+        for name in self.manager.blackboard.names():
+            try:
+                provider = self.manager.provider_of(name) or "from outside (platform or other context)"
+            except TafelError:
+                provider = "read only here"
+            lines.append(f"  {name:<28} {provider}")
+        return "\n".join(lines)
+
+    def cmd_representation_print(self, command: Command) -> str:
+        rep = self._representation(command)
+        return f"{type(rep).__name__} ({self.context}, frame {self.manager.frame}):\n{pretty(rep, '  ')}"
+
+    def cmd_representation_get(self, command: Command) -> bytes:
+        return serialize(self._representation(command))
+
+    def cmd_representation_set(self, command: Command) -> str:
+        rep = self._representation(command)
+        data = command.args.get("data")
+        if isinstance(data, bytes):
+            self.manager.blackboard.set(deserialize(type(rep), data))
+            return f"{type(rep).__name__} set from {len(data)} bytes"
+        field_name = argument(command, "field", positional=False)
+        if field_name not in {f.name for f in fields_of(type(rep))}:
+            raise CommandError(f"{type(rep).__name__} has no field {field_name!r}; {did_you_mean(field_name, [f.name for f in fields_of(type(rep))])}")
+        value = _coerce_like(getattr(rep, field_name), argument(command, "value", positional=False), f"{type(rep).__name__}.{field_name}")
+        setattr(rep, field_name, value)
+        return f"{type(rep).__name__}.{field_name} = {_short(value)}"
+
+    # --------------------------------------------------------------------- debug concepts
+    def _mine(self, items: Mapping[str, Any]) -> dict[str, Any]:
+        """The entries used in this context, or declared (at import) in a file of one of its modules."""
+        files = {cls.__module__ for cls in self.manager.module_classes}
+        return {
+            name: item for name, item in items.items()
+            if item.context == self.context or (not item.context and getattr(item, "origin", "") in files)
+        }
+
+    def _named(self, command: Command, items: Mapping[str, Any], kind: str) -> Any:
+        name = argument(command, "name")
+        mine = self._mine(items)
+        if name not in mine:
+            raise NotHere(kind, name, mine)
+        return mine[name]
+
+    def cmd_debug_request_list(self, command: Command) -> str:
+        requests = self._mine(self.state.requests)
+        return "\n".join(f"  {'on ' if r.on else 'off'} {name}  {r.description}" for name, r in sorted(requests.items())) or "  (none yet)"
+
+    def cmd_debug_request_set(self, command: Command) -> str:
+        found = self._named(command, self.state.requests, "debug request")
+        found.on = parse_bool(argument(command, "value", "on", positional=False), "-value")
+        return f"{found.name} {'on' if found.on else 'off'}"
+
+    def cmd_modify_list(self, command: Command) -> str:
+        modifies = self._mine(self.state.modifies)
+        return "\n".join(
+            f"  {name} = {_short(m.value)}" + (f"  (pinned to {_short(m.pinned_value)})" if m.pinned else "")
+            for name, m in sorted(modifies.items())
+        ) or "  (none yet)"
+
+    def cmd_modify_set(self, command: Command) -> str:
+        found = self._named(command, self.state.modifies, "modify")
+        found.pinned_value = _coerce_like(found.value, argument(command, "value", positional=False), found.name)
+        found.pinned = True
+        return f"{found.name} pinned to {_short(found.pinned_value)}"
+
+    def cmd_modify_release(self, command: Command) -> str:
+        found = self._named(command, self.state.modifies, "modify")
+        found.pinned = False
+        return f"{found.name} released"
+
+    def cmd_stopwatch_list(self, command: Command) -> str:
+        lines = [f"loop: {self.rate():.1f} Hz, frame {self.manager.frame}"]
+        lines.append(f"  {'module':<32} {'last':>9} {'mean':>9} {'max':>9} {'p95':>9}  (us)")
+        for name, timing in self.manager.timings().items():
+            lines.append(f"  {name:<32} {timing.last_us:9.1f} {timing.mean_us:9.1f} {timing.max_us:9.1f} {self.manager.p95_us(name):9.1f}")
+        for name, watch in sorted(self._mine(self.state.stopwatches).items()):
+            times = [t / 1000 for t in watch.times_ns]
+            if times:
+                p95 = sorted(times)[int(0.95 * (len(times) - 1))]
+                lines.append(f"  {name:<32} {times[-1]:9.1f} {statistics.fmean(times):9.1f} {max(times):9.1f} {p95:9.1f}")
+        return "\n".join(lines)
+
+    def cmd_plot_get(self, command: Command) -> str:
+        plots = self._mine(self.state.plots)
+        if not argument(command, "name", required=False):
+            return "\n".join(f"{name} ({len(p.values)} values, {self.context})" for name, p in sorted(plots.items()))
+        found = self._named(command, self.state.plots, "plot")
+        count = int(argument(command, "count", positional=False, required=False) or len(found.values))
+        return "\n".join(f"{frame} {value:.6g}" for frame, value in list(found.values)[-count:])
+
+    def cmd_drawings_get(self, command: Command) -> str:
+        canvas = argument(command, "canvas", required=False)
+        drawings = [d for d in self.state.drawings_last.get(self.context, []) if not canvas or d["canvas"] == canvas]
+        return "\n".join(json.dumps({"context": self.context, **d}) for d in drawings)
+
+    # ------------------------------------------------------------------------- parameters
+    def _parameters(self, command: Command) -> tuple[str, Any]:
+        name = argument(command, "module")
+        try:
+            instance = self.manager.module(name)
+        except (KeyError, TafelError):
+            raise NotHere("module", name, self._parameter_modules()) from None
+        if instance.parameters is None:
+            raise CommandError(f"{name} has no parameters")
+        return name, instance.parameters
+
+    def _parameter_modules(self) -> list[str]:
+        return [n for n in self.manager.order if getattr(self.manager.module(n), "parameters", None) is not None]
+
+    def cmd_parameter_list(self, command: Command) -> str:
+        lines = []
+        for name in self._parameter_modules():
+            values = parameter_values(self.manager.module(name).parameters)
+            lines.append(f"  {name}: " + ", ".join(f"{k}={_short(v)}" for k, v in values.items()))
+        return "\n".join(lines) or "  (no running module has parameters)"
+
+    def cmd_parameter_get(self, command: Command) -> str:
+        name, parameters = self._parameters(command)
+        return "\n".join(f"{k} = {_short(v)}" for k, v in parameter_values(parameters).items())
+
+    def cmd_parameter_set(self, command: Command) -> str:
+        module, parameters = self._parameters(command)
+        parameter = argument(command, "name", "parameter", positional=False)
+        value = set_parameter(module, parameters, parameter, argument(command, "value", positional=False))
+        return f"{module}.{parameter} = {_short(value)}"
+
+    def parameter_values(self, module: str) -> dict[str, Any] | None:
+        try:
+            instance = self.manager.module(module)
+        except (KeyError, TafelError):
+            return None
+        return parameter_values(instance.parameters) if instance.parameters is not None else None
+
+    def choices(self) -> dict[str, Any]:
+        """Provider choices and disabled modules, for ``modules:store``."""
+        return {"providers": self.manager.providers, "disabled": sorted(self.manager.disabled)}
+
+
+def merge_answers(command: Command, answers: Mapping[str, tuple[str, str | bytes]]) -> tuple[bool, str | bytes]:
+    """Combine the contexts' answers to one: (is_error, text or bytes)."""
+    spec = SPECS[command.name]
+    errors = [(ctx, text) for ctx, (status, text) in answers.items() if status == "error"]
+    oks = [(ctx, text) for ctx, (status, text) in answers.items() if status == "ok"]
+    if spec.routing == "lines":
+        if oks:
+            return False, "\n".join(str(text) for _, text in oks if text)
+        if errors:
+            return True, str(errors[0][1])
+    if spec.routing in ("first", "lines"):
+        if oks and all(text == oks[0][1] for _, text in oks):
+            return False, oks[0][1]
+        if oks:  # the name exists in several contexts (a representation on both blackboards): show each
+            if any(isinstance(text, bytes) for _, text in oks):
+                return True, f"{command.name}: the name exists in {' and '.join(c for c, _ in oks)}; add -context NAME"
+            return False, "\n".join(f"[{ctx}]\n{text}" for ctx, text in oks)
+        if errors:
+            return True, str(errors[0][1])
+        known: set[str] = set()
+        kind, name = "name", ""
+        for status, text in answers.values():
+            if status == "missing":
+                kind, name, names = json.loads(text)
+                known.update(names)
+        return True, f"unknown {kind} {name!r}: {did_you_mean(name, known)}"
+    if errors and not oks:
+        return True, "; ".join(f"{ctx}: {text}" for ctx, text in errors)
+    parts = [f"[{ctx}]\n{text}" for ctx, text in oks] + [f"[{ctx}] error: {text}" for ctx, text in errors]
+    return False, "\n".join(parts)

@@ -1,0 +1,211 @@
+"""The NaoTH text command protocol: parsing, formatting, and telnet input.
+
+    Command   = ["+"], CMDName, {Space, Argument}, "\\n";
+    Argument  = StringArg | Base64Arg | EmptyArg;
+    StringArg = "-", ArgName, Space, ArgValue;
+    Base64Arg = "+", ArgName, Space, ArgValue;
+    EmptyArg  = ArgName;
+    ArgValue  = '"', {CharNoQuote}, '"' | {CharNoSpace};
+
+Example: ``mycommand -arg1 "value1 with space" -arg2 value2 argwithemptyvalue +argwithbase64 aGVsbG8=``.
+String arguments arrive as ``str``, base64 arguments decoded as ``bytes``, empty arguments as ``""``.
+A ``+`` before the command name asks for the answer in base64. Every answer is UTF-8 text ending with a
+newline, followed by a NUL byte.
+"""
+
+from __future__ import annotations
+
+import base64
+import binascii
+import re
+from dataclasses import dataclass, field
+
+from core.errors import TafelError
+
+MAX_LINE = 64 * 1024
+EMPTY_VALUE = '""'  # an empty ArgValue must be quoted
+IDENTIFIER = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_:./\-]*")
+
+
+class ParseError(TafelError, ValueError):
+    """A line that is not a well-formed command; the message says what was expected."""
+
+
+@dataclass(frozen=True)
+class Command:
+    name: str
+    args: dict[str, str | bytes] = field(default_factory=dict)
+    base64_answer: bool = False
+
+
+def parse(line: str) -> Command:
+    """Parse one command line (without its newline)."""
+    position = 0
+    length = len(line)
+    base64_answer = line.startswith("+")
+    if base64_answer:
+        position = 1
+    match = IDENTIFIER.match(line, position)
+    if not match:
+        raise ParseError("expected a command name (letters, digits, _ : . / -) at the start of the line")
+    name = match.group()
+    position = match.end()
+    args: dict[str, str | bytes] = {}
+    while position < length:
+        if line[position] != " ":
+            raise ParseError(f"expected a space before the next argument at column {position + 1}")
+        while position < length and line[position] == " ":
+            position += 1
+        if position >= length:
+            break
+        kind = line[position]
+        if kind in "-+":
+            position += 1
+        arg = IDENTIFIER.match(line, position)
+        if not arg:
+            raise ParseError(f"expected an argument name at column {position + 1}")
+        arg_name = arg.group()
+        position = arg.end()
+        if arg_name in args:
+            raise ParseError(f"argument {arg_name!r} is given twice")
+        if kind not in "-+":
+            args[arg_name] = ""
+            continue
+        if position >= length or line[position] != " ":
+            raise ParseError(f"argument {kind}{arg_name} needs a value after a space")
+        while position < length and line[position] == " ":
+            position += 1
+        if position >= length:
+            raise ParseError(f"argument {kind}{arg_name} needs a value after a space")
+        if line[position] == '"':
+            end = line.find('"', position + 1)
+            if end < 0:
+                raise ParseError(f'the value of {kind}{arg_name} opens a quote (") that is never closed')
+            value = line[position + 1 : end]
+            position = end + 1
+        else:
+            end = line.find(" ", position)
+            end = length if end < 0 else end
+            value = line[position:end]
+            position = end
+        if kind == "+":
+            try:
+                args[arg_name] = base64.b64decode(value.encode("ascii"), validate=True)
+            except (binascii.Error, UnicodeEncodeError):
+                raise ParseError(f"argument +{arg_name} is not valid base64: {value[:40]!r}") from None
+        else:
+            args[arg_name] = value
+    return Command(name, args, base64_answer)
+
+
+def format_command(command: Command) -> str:
+    """The protocol line of a command (without newline); ``parse(format_command(c)) == c``."""
+    parts = [("+" if command.base64_answer else "") + command.name]
+    for name, value in command.args.items():
+        if isinstance(value, bytes):
+            parts.append(f"+{name} {base64.b64encode(value).decode('ascii') or EMPTY_VALUE}")
+        elif value == "":
+            parts.append(name)  # an EmptyArg; parses back as ""
+        else:
+            parts.append(f"-{name} {quote(value)}")
+    return " ".join(parts)
+
+
+def quote(value: str) -> str:
+    """A string value as ArgValue: bare when possible, quoted when it has spaces."""
+    if "\n" in value or "\r" in value:
+        raise ParseError("string values cannot contain line breaks; send them as base64 (+name)")
+    if value and " " not in value and not value.startswith('"'):
+        return value
+    if '"' in value:
+        raise ParseError('a value with spaces cannot contain a quote ("); send it as base64 (+name)')
+    return f'"{value}"'
+
+
+def answer_bytes(text: str | bytes, *, base64_answer: bool = False) -> bytes:
+    """The bytes sent for an answer: UTF-8 text ending with a newline, then NUL."""
+    if base64_answer:
+        payload = text.encode("utf-8") if isinstance(text, str) else text
+        body = base64.b64encode(payload).decode("ascii")
+    elif isinstance(text, bytes):
+        body = base64.b64encode(text).decode("ascii")
+    else:
+        body = text
+    if not body.endswith("\n"):
+        body += "\n"
+    return body.encode("utf-8") + b"\0"
+
+
+IAC, SB, SE = 255, 250, 240
+_NEGOTIATION = {251, 252, 253, 254}  # WILL, WONT, DO, DONT
+
+
+class TelnetDecoder:
+    """Strips telnet option negotiation from a byte stream and splits it into lines.
+
+    Accepts ``\\n``, ``\\r\\n`` and ``\\r\\0`` line ends; ``IAC IAC`` is a literal 0xFF. State survives
+    chunk boundaries. Lines longer than ``MAX_LINE`` are reported (``None`` in the output) and skipped.
+    """
+
+    def __init__(self, max_line: int = MAX_LINE) -> None:
+        self.max_line = max_line
+        self.buffer = bytearray()
+        self.state = "data"
+        self.overlong = False
+        self.pending_cr = False
+
+    def feed(self, data: bytes) -> list[bytes | None]:
+        lines: list[bytes | None] = []
+        for byte in data:
+            state = self.state
+            if state == "data":
+                if byte == IAC:
+                    self.state = "iac"
+                    continue
+                self._data(byte, lines)
+            elif state == "iac":
+                if byte == IAC:
+                    self.state = "data"
+                    self._data(IAC, lines)
+                elif byte in _NEGOTIATION:
+                    self.state = "option"
+                elif byte == SB:
+                    self.state = "sub"
+                else:
+                    self.state = "data"  # two-byte command (NOP, GA, ...)
+            elif state == "option":
+                self.state = "data"
+            elif state == "sub":
+                if byte == IAC:
+                    self.state = "sub-iac"
+            elif state == "sub-iac":
+                self.state = "data" if byte == SE else "sub"
+        return lines
+
+    def _data(self, byte: int, lines: list[bytes | None]) -> None:
+        if self.pending_cr:
+            self.pending_cr = False
+            if byte == 0:  # \r\0 is a bare carriage return: end of line
+                self._end_line(lines)
+                return
+            if byte == 10:
+                self._end_line(lines)
+                return
+            self._end_line(lines)
+        if byte == 13:
+            self.pending_cr = True
+            return
+        if byte == 10:
+            self._end_line(lines)
+            return
+        if self.overlong:
+            return
+        self.buffer.append(byte)
+        if len(self.buffer) > self.max_line:
+            self.overlong = True
+            self.buffer.clear()
+
+    def _end_line(self, lines: list[bytes | None]) -> None:
+        lines.append(None if self.overlong else bytes(self.buffer))
+        self.buffer.clear()
+        self.overlong = False

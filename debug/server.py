@@ -1,0 +1,370 @@
+"""The debug server: the command protocol over TCP, answered between frames.
+
+A network thread runs an asyncio server. Each connection's lines are parsed there and queued, with
+their sequence number, for the thread that owns the data; ``process_pending`` (called between frames,
+or by a dispatcher thread for contexts in other processes) executes everything queued in one go and
+hands the answers back. A connection writes its answers strictly in the order its commands arrived.
+
+Nothing a client sends can stop a loop or another client: malformed lines get ``error:`` answers,
+overlong lines are cut off and reported, a client that floods commands is slowed down (it is not read
+while too many of its commands are open), and a client that does not read its answers is dropped once
+its output buffer is full.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import hmac
+import logging
+import queue
+import threading
+import time
+from collections import deque
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from core.naming import did_you_mean
+from debug.commands import SPECS, CommandError, merge_answers
+from debug.protocol import Command, ParseError, TelnetDecoder, answer_bytes, parse
+
+log = logging.getLogger("tafel.debug")
+
+MAX_OUTSTANDING = 2000  # open commands per connection before it is read no more
+MAX_OUTPUT = 8 << 20  # unsent answer bytes per connection before it is dropped
+
+
+class Executor:
+    """Something that answers context commands in batches: a ``ContextDebug`` or a remote process."""
+
+    def execute_batch(self, commands: Sequence[Command]) -> list[tuple[str, str | bytes]]:
+        raise NotImplementedError
+
+
+@dataclass
+class GlobalCommand:
+    summary: str
+    usage: str
+    handler: Callable[[Command], str | bytes]
+
+
+class DebugRouter:
+    """Runs commands: globals itself, context commands on every context, answers combined."""
+
+    def __init__(self) -> None:
+        self.contexts: dict[str, Executor] = {}
+        self.globals: dict[str, GlobalCommand] = {}
+        self.register("help", "the commands, or one command's arguments", "help [NAME]", self._help)
+        self.register("ping", "answers pong", "ping", lambda command: "pong")
+        self.register("auth", "authenticate with the server's token (--debug-token)", "auth TOKEN", lambda command: "authenticated")
+
+    def add_context(self, name: str, executor: Executor) -> None:
+        self.contexts[name] = executor
+
+    def register(self, name: str, summary: str, usage: str, handler: Callable[[Command], str | bytes]) -> None:
+        self.globals[name] = GlobalCommand(summary, usage, handler)
+
+    def names(self) -> list[str]:
+        return sorted({*self.globals, *SPECS})
+
+    def _help(self, command: Command) -> str:
+        name = next((k for k, v in command.args.items() if v == ""), "") or str(command.args.get("name", ""))
+        if name:
+            if name in self.globals:
+                return f"{name}: {self.globals[name].summary}\nusage: {self.globals[name].usage}"
+            if name in SPECS:
+                return f"{name}: {SPECS[name].summary}\nusage: {SPECS[name].usage}"
+            raise CommandError(f"unknown command {name!r}: {did_you_mean(name, self.names())}")
+        lines = [f"{n:<24} {self.globals[n].summary if n in self.globals else SPECS[n].summary}" for n in self.names()]
+        return "\n".join(lines)
+
+    def handle_batch(self, commands: Sequence[Command]) -> list[tuple[bool, str | bytes]]:
+        """(is_error, answer) per command, in order. Runs of context commands go out as one batch."""
+        results: list[tuple[bool, str | bytes] | None] = [None] * len(commands)
+        run: list[int] = []
+
+        def flush() -> None:
+            if not run:
+                return
+            batch = [commands[i] for i in run]
+            per_context = {name: executor.execute_batch(batch) for name, executor in self.contexts.items()}
+            for position, index in enumerate(run):
+                answers = {name: per_context[name][position] for name in self.contexts}
+                results[index] = merge_answers(commands[index], answers) if answers else (True, "no context is running")
+            run.clear()
+
+        for index, command in enumerate(commands):
+            if command.name in SPECS:
+                run.append(index)
+                continue
+            flush()
+            handler = self.globals.get(command.name)
+            if handler is None:
+                results[index] = (True, f"unknown command {command.name!r}: {did_you_mean(command.name, self.names())}")
+                continue
+            try:
+                results[index] = (False, handler.handler(command))
+            except CommandError as exc:
+                results[index] = (True, str(exc))
+            except Exception as exc:  # noqa: BLE001 - a handler bug answers, never crashes the loop
+                results[index] = (True, f"{command.name} failed: {type(exc).__name__}: {exc}")
+        flush()
+        return [r if r is not None else (True, "no answer") for r in results]
+
+
+@dataclass
+class _Request:
+    connection: _Connection
+    sequence: int
+    command: Command
+
+
+class _Connection:
+    def __init__(self, server: DebugServer, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        self.server = server
+        self.reader, self.writer = reader, writer
+        self.authenticated = server.token is None
+        self.next_sequence = 0
+        self.next_answer = 0
+        self.answers: dict[int, bytes] = {}
+        self.outstanding = 0
+        self.room = asyncio.Event()
+        self.closed = False
+        self.reading_done = False
+        self.peer = writer.get_extra_info("peername")
+
+    async def serve(self) -> None:
+        decoder = TelnetDecoder(self.server.max_line)
+        try:
+            while not self.closed:
+                data = await self.reader.read(65536)
+                if not data:
+                    break
+                for line in decoder.feed(data):
+                    self._line(line)
+                while self.outstanding > MAX_OUTSTANDING and not self.closed:
+                    self.room.clear()
+                    await self.room.wait()
+        except (ConnectionError, asyncio.IncompleteReadError):
+            self.drop()
+            return
+        # The client sent everything (it may have half-closed): answer what is open, then close.
+        self.reading_done = True
+        self._finish_if_done()
+
+    def _line(self, raw: bytes | None) -> None:
+        if raw is not None and not raw.strip():
+            return  # an empty line is no command: telnet users press enter
+        sequence = self.next_sequence
+        self.next_sequence += 1
+        if raw is None:
+            self.deliver(sequence, answer_bytes(f"error: line too long (at most {self.server.max_line} bytes)"))
+            return
+        try:
+            command = parse(raw.decode("utf-8").strip())
+        except UnicodeDecodeError as exc:
+            self.deliver(sequence, answer_bytes(f"error: the line is not valid UTF-8 (byte {exc.start})"))
+            return
+        except ParseError as exc:
+            self.deliver(sequence, answer_bytes(f"error: {exc}"))
+            return
+        if command.name == "auth":
+            token = next((k for k, v in command.args.items() if v == ""), "") or command.args.get("token", "")
+            if self.server.token is None or hmac.compare_digest(str(token).encode(), self.server.token.encode()):
+                self.authenticated = True
+                self.deliver(sequence, answer_bytes("authenticated"))
+            else:
+                self.deliver(sequence, answer_bytes("error: wrong token"))
+            return
+        if not self.authenticated:
+            self.deliver(sequence, answer_bytes("error: not authenticated (send: auth TOKEN)"))
+            return
+        self.outstanding += 1
+        self.server.pending.put(_Request(self, sequence, command))
+
+    def deliver(self, sequence: int, data: bytes) -> None:
+        """Network thread: keep the answer and send every answer that is next in order."""
+        if self.closed:
+            return
+        if self.writer.transport.is_closing():  # the client is gone (reset): stop answering it
+            self.drop()
+            return
+        self.answers[sequence] = data
+        while self.next_answer in self.answers:
+            self.writer.write(self.answers.pop(self.next_answer))
+            self.next_answer += 1
+        if self.writer.transport.get_write_buffer_size() > self.server.max_output:
+            log.warning("dropping debug client %s: it does not read its answers", self.peer)
+            self.drop()
+            return
+        self._finish_if_done()
+
+    def answered(self) -> None:
+        self.outstanding -= 1
+        if self.outstanding <= MAX_OUTSTANDING // 2:
+            self.room.set()
+
+    def _finish_if_done(self) -> None:
+        if self.reading_done and self.outstanding <= 0 and not self.answers and not self.closed:
+            self.closed = True
+            self.writer.close()  # graceful: what is buffered still goes out
+            self.server.connections.discard(self)
+
+    def drop(self) -> None:
+        """Close at once, discarding unsent answers (a client that does not read, or is gone)."""
+        if not self.closed:
+            self.closed = True
+            self.room.set()
+            self.writer.transport.abort()
+            self.server.connections.discard(self)
+
+
+class DebugServer:
+    """The debug server; ``start`` binds and prints nothing, ``address`` says where it listens."""
+
+    def __init__(self, router: DebugRouter, host: str = "127.0.0.1", port: int = 5401, *, token: str | None = None,
+                 max_line: int = 64 * 1024, max_output: int = MAX_OUTPUT) -> None:
+        self.router = router
+        self.host, self.port = host, port
+        self.token = token
+        self.max_line = max_line
+        self.max_output = max_output
+        self.pending: queue.SimpleQueue[_Request] = queue.SimpleQueue()
+        self._queues: dict[_Connection, deque[_Request]] = {}
+        self.connections: set[_Connection] = set()
+        self.answered = 0
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._server: asyncio.base_events.Server | None = None
+        self._thread: threading.Thread | None = None
+        self._ready = threading.Event()
+        self._error: BaseException | None = None
+
+    @property
+    def address(self) -> tuple[str, int]:
+        return self.host, self.port
+
+    def start(self) -> tuple[str, int]:
+        self._thread = threading.Thread(target=self._run, name="tafel-debug-server", daemon=True)
+        self._thread.start()
+        self._ready.wait(timeout=10)
+        if self._error is not None:
+            raise OSError(f"debug server cannot listen on {self.host}:{self.port}: {self._error}")
+        return self.address
+
+    def _run(self) -> None:
+        loop = asyncio.new_event_loop()
+        self._loop = loop
+        asyncio.set_event_loop(loop)
+
+        async def accept(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+            connection = _Connection(self, reader, writer)
+            self.connections.add(connection)
+            await connection.serve()
+
+        try:
+            self._server = loop.run_until_complete(asyncio.start_server(accept, self.host, self.port, limit=self.max_line * 2))
+            self.port = self._server.sockets[0].getsockname()[1]
+        except OSError as exc:
+            self._error = exc
+            self._ready.set()
+            return
+        self._ready.set()
+        try:
+            loop.run_forever()
+        finally:
+            loop.run_until_complete(loop.shutdown_asyncgens())
+            loop.close()
+
+    def stop(self) -> None:
+        loop = self._loop
+        if loop is None or not loop.is_running():
+            return
+
+        def shutdown() -> None:
+            for connection in list(self.connections):
+                connection.drop()
+            if self._server is not None:
+                self._server.close()
+            loop.stop()
+
+        loop.call_soon_threadsafe(shutdown)
+        if self._thread is not None:
+            self._thread.join(timeout=5)
+
+    def _collect(self, wait: float = 0.0) -> None:
+        """Move what the network thread queued into per-connection queues (processing thread only)."""
+        try:
+            if wait > 0 and not any(self._queues.values()):
+                request = self.pending.get(timeout=wait)
+                self._queues.setdefault(request.connection, deque()).append(request)
+            while True:
+                request = self.pending.get_nowait()
+                self._queues.setdefault(request.connection, deque()).append(request)
+        except queue.Empty:
+            pass
+
+    def _next_batch(self, limit: int) -> list[_Request]:
+        """Up to ``limit`` requests, taken round-robin from the connections (in order within each)."""
+        batch: list[_Request] = []
+        while len(batch) < limit:
+            took = False
+            for connection, waiting in list(self._queues.items()):
+                if connection.closed or not waiting:
+                    del self._queues[connection]  # a closed client's commands are not worth running
+                    continue
+                batch.append(waiting.popleft())
+                took = True
+                if len(batch) >= limit:
+                    break
+            if not took:
+                break
+        return batch
+
+    def process_pending(self, budget_s: float = 0.004, chunk: int = 32) -> int:
+        """Between frames: answer queued commands for at most about ``budget_s``; the rest next frame."""
+        start = time.perf_counter()
+        self._collect()
+        answered = 0
+        while time.perf_counter() - start < budget_s:
+            batch = self._next_batch(chunk)
+            if not batch:
+                break
+            self._answer(batch)
+            answered += len(batch)
+        return answered
+
+    def _answer(self, requests: list[_Request]) -> None:
+        try:
+            results = self.router.handle_batch([r.command for r in requests])
+        except Exception as exc:  # noqa: BLE001 - a bug in a handler answers errors, the program goes on
+            log.exception("debug commands failed")
+            results = [(True, f"internal error in the debug server: {type(exc).__name__}: {exc}")] * len(requests)
+        loop = self._loop
+        for request, (is_error, payload) in zip(requests, results):
+            if is_error:
+                data = answer_bytes(f"error: {payload}")
+            elif isinstance(payload, bytes) and not request.command.base64_answer:
+                data = answer_bytes(f"error: {request.command.name} answers with bytes; send +{request.command.name} for base64")
+            else:
+                data = answer_bytes(payload, base64_answer=request.command.base64_answer)
+            if loop is not None and not request.connection.closed:
+                loop.call_soon_threadsafe(self._deliver, request.connection, request.sequence, data)
+        self.answered += len(requests)
+
+    @staticmethod
+    def _deliver(connection: _Connection, sequence: int, data: bytes) -> None:
+        connection.answered()
+        connection.deliver(sequence, data)
+
+    def dispatch_forever(self, stop: Any, timeout: float = 0.1, chunk: int = 256) -> None:
+        """For contexts in other processes: answer batches as they come until ``stop`` is set."""
+        while not stop.is_set():
+            self._collect(wait=timeout)
+            batch = self._next_batch(chunk)
+            if batch:
+                self._answer(batch)
+
+    def wait_until_idle(self, timeout: float = 5.0) -> None:
+        deadline = time.monotonic() + timeout
+        while not self.pending.empty() and time.monotonic() < deadline:
+            time.sleep(0.01)

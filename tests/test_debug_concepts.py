@@ -1,0 +1,121 @@
+"""The debug concepts module authors use, through the mocked blackboard and the runtime's frame hooks."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from core import ModuleManager
+from core.testing import ModuleHarness
+from debug.commands import ContextDebug, pretty
+from debug.concepts import STATE, frame_debug_data
+from debug.protocol import parse
+from representations.infrastructure import FrameInfo
+from tests.support.debug_user import DRAW, DebugUser, DebugUserOutput
+from tests.test_debug_server import Program
+from tools.console import Completer
+from tools.debugging import RateMeter, instrument
+
+
+@pytest.fixture
+def instrumented() -> ModuleManager:
+    manager = ModuleManager([DebugUser], name="cognition", external=[FrameInfo], strict=True)
+    instrument("cognition", manager, RateMeter())
+    return manager
+
+
+def run_frames(manager: ModuleManager, frames: int) -> None:
+    for i in range(1, frames + 1):
+        manager.blackboard.set(FrameInfo(frame_number=i, time_ns=i * 33_000_000))
+        manager.execute()
+
+
+def test_requests_are_off_until_switched_on(instrumented: ModuleManager) -> None:
+    DRAW.on = False
+    run_frames(instrumented, 2)
+    assert STATE.drawings_last["cognition"] == []
+    DRAW.on = True
+    try:
+        run_frames(instrumented, 1)
+        kinds = [(d["canvas"], d["kind"]) for d in STATE.drawings_last["cognition"]]
+        assert kinds == [("field", "circle"), ("image:top", "text")]
+        drawings, _ = frame_debug_data("cognition")
+        assert drawings.primitives[0].points == [100.0, 200.0, 50.0]
+    finally:
+        DRAW.on = False
+
+
+def test_modify_publishes_and_can_be_pinned(instrumented: ModuleManager) -> None:
+    run_frames(instrumented, 3)
+    assert instrumented.blackboard[DebugUserOutput].value == 3.0
+    debug = ContextDebug("cognition", instrumented)
+    assert debug.execute(parse("modify:set -name DebugUser:gain -value 2.5")) == ("ok", "DebugUser:gain pinned to 2.5")
+    run_frames(instrumented, 2)
+    assert instrumented.blackboard[DebugUserOutput].value == 5.0  # 2.5 * frame 2
+    debug.execute(parse("modify:release -name DebugUser:gain"))
+    run_frames(instrumented, 2)
+    assert instrumented.blackboard[DebugUserOutput].value == 2.0
+
+
+def test_plots_and_stopwatches_collect_per_frame(instrumented: ModuleManager) -> None:
+    run_frames(instrumented, 4)
+    assert list(STATE.plots["DebugUser:frame"].values)[-4:] == [(1, 1.0), (2, 2.0), (3, 3.0), (4, 4.0)]
+    assert len(STATE.stopwatches["DebugUser:work"].times_ns) >= 4
+    _, plots = frame_debug_data("cognition")
+    assert "DebugUser:frame" in plots.names and plots.values[plots.names.index("DebugUser:frame")] == 4.0
+
+
+def test_the_module_works_on_the_mocked_blackboard_without_a_debug_server() -> None:
+    bb = ModuleHarness(DebugUser, FrameInfo(frame_number=7)).execute()
+    assert bb[DebugUserOutput].value == 7.0
+
+
+def test_unknown_names_are_reported_for_the_router(instrumented: ModuleManager) -> None:
+    debug = ContextDebug("cognition", instrumented)
+    status, payload = debug.execute(parse("modify:set -name DebugUser:gian -value 1"))
+    assert status == "missing" and "DebugUser:gain" in payload
+    status, payload = debug.execute(parse("debug_request:set -name DebugUser:draw -value sometimes"))
+    assert status == "error" and "takes on/off" in payload
+
+
+def test_pretty_prints_nested_values() -> None:
+    text = pretty(DebugUserOutput(value=1.5))
+    assert text == "value: 1.5"
+
+
+def test_console_completion_and_an_interactive_session() -> None:
+    program = Program()
+    try:
+        from debug.client import DebugClient
+
+        with DebugClient(program.host, program.port) as client:
+            completer = Completer(client)
+            assert completer.candidates("modules:l", "modules:l") == ["modules:list"]
+            assert "KalmanBallModeler" in completer.candidates("Kal", "modules:set -module Kal")
+            assert "BallModel" in completer.candidates("BallM", "representation:print BallM")
+        session = subprocess.run([sys.executable, "-m", "tools.cli", "console", "--port", str(program.port)],
+                                 input="ping\nrepresentation:print BallModel\nquit\n", capture_output=True, text=True, timeout=30)
+        assert session.returncode == 0, session.stderr
+        assert "connected to" in session.stdout and "pong" in session.stdout and "BallModel (cognition" in session.stdout
+    finally:
+        program.stop()
+
+
+def test_debug_data_is_recorded_like_representations(tmp_path) -> None:
+    from core.logfile import read_log
+    from core.serialization import deserialize
+    from debug.concepts import DebugPlots
+    from tests.test_cli_runtime import tafel
+
+    path = tmp_path / "debug.mcap"
+    result = tafel("run", "--frames", "30", "--speed", "max", "--debug-port", "0", "--record", str(path),
+                   "--record-reps", "DebugPlots,DebugDrawings",
+                   "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "tests.support.debug_user:DebugUser"]')
+    assert result.returncode == 0, result.stderr
+    contents = read_log(path)
+    plots = [deserialize(DebugPlots, m.data) for m in contents.messages if m.topic == "cognition/DebugPlots"]
+    assert len(plots) == 9
+    assert [p.values[p.names.index("DebugUser:frame")] for p in plots] == [float(i) for i in range(1, 10)]
+    assert contents.channels["cognition/DebugPlots"].metadata == {"source": "debug"}

@@ -1,0 +1,114 @@
+"""``tafel console``: an interactive debug console with history and tab completion, or one command."""
+
+from __future__ import annotations
+
+import argparse
+import re
+import sys
+from pathlib import Path
+from typing import Any
+
+from debug.client import DebugClient
+
+HISTORY = Path.home() / ".tafel_history"
+
+
+def add_console_command(commands: Any) -> None:
+    console = commands.add_parser("console", help="talk to a running program's debug server")
+    console.add_argument("--host", default="127.0.0.1")
+    console.add_argument("--port", type=int, default=5401)
+    console.add_argument("--token", help="send 'auth TOKEN' first")
+    console.add_argument("-c", dest="one_command", metavar="COMMAND", help="run one command, print its answer and exit (status 1 on error:)")
+
+
+def run_console(args: argparse.Namespace) -> int:
+    try:
+        client = DebugClient(args.host, args.port)
+    except OSError as exc:
+        print(f"tafel console: error: cannot connect to {args.host}:{args.port}: {exc.strerror or exc}; "
+              "is 'tafel run' running, and on which --debug-port?", file=sys.stderr)
+        return 2
+    with client:
+        if args.token:
+            answer = client.ask(f"auth {args.token}")
+            if answer.startswith("error:"):
+                print(answer, file=sys.stderr)
+                return 1
+        if args.one_command is not None:
+            answer = client.ask(args.one_command)
+            print(answer)
+            return 1 if answer.startswith("error:") else 0
+        return interactive(client, f"{args.host}:{args.port}")
+
+
+class Completer:
+    """Completes command names, then module, representation and debug request names."""
+
+    def __init__(self, client: DebugClient) -> None:
+        self.client = client
+        self.commands = [line.split()[0] for line in client.ask("help").splitlines() if line.strip()]
+        self.names: list[str] = []
+        self.refresh()
+
+    def refresh(self) -> None:
+        names: set[str] = set()
+        for command, pattern in (("modules:list", r"^\s+(\w+)\s+(?:on|off)\b"), ("representation:list", r"^\s+(\w+)\s"),
+                                 ("debug_request:list", r"^\s+(?:on|off)\s+(\S+)"), ("modify:list", r"^\s+(\S+) =")):
+            answer = self.client.ask(command)
+            if not answer.startswith("error:"):
+                names.update(m.group(1) for line in answer.splitlines() for m in [re.match(pattern, line)] if m)
+        self.names = sorted(names)
+
+    def candidates(self, text: str, line: str) -> list[str]:
+        pool = self.commands if not line.strip() or (" " not in line.lstrip() and not line.endswith(" ")) else self.names
+        return [c for c in pool if c.startswith(text)]
+
+    def complete(self, text: str, state: int) -> str | None:
+        import readline
+
+        matches = self.candidates(text, readline.get_line_buffer())
+        return matches[state] if state < len(matches) else None
+
+
+def interactive(client: DebugClient, where: str) -> int:
+    try:
+        import readline
+    except ImportError:  # pragma: no cover - not on Linux
+        readline = None
+    completer = Completer(client)
+    if readline is not None:
+        readline.set_completer(completer.complete)
+        readline.set_completer_delims(" ")
+        readline.parse_and_bind("tab: complete")
+        if HISTORY.exists():
+            readline.read_history_file(HISTORY)
+    print(f"connected to {where}; 'help' lists the commands, Ctrl-D leaves")
+    try:
+        while True:
+            try:
+                line = input("tafel> ").strip()
+            except EOFError:
+                print()
+                return 0
+            if not line:
+                continue
+            if line in ("quit", "exit"):
+                return 0
+            try:
+                answer = client.ask(line)
+            except ConnectionError as exc:
+                print(f"connection lost: {exc}", file=sys.stderr)
+                return 1
+            print(answer)
+            if line.split()[0] in ("modules:set", "modules:provider", "debug_request:set"):
+                completer.refresh()
+    finally:
+        if readline is not None:
+            readline.set_history_length(1000)
+            try:
+                readline.write_history_file(HISTORY)
+            except OSError:
+                pass
+    return 0
+
+

@@ -1,0 +1,275 @@
+"""Wiring the debug server to a running program (lockstep or concurrent).
+
+Lockstep: both contexts live in the main thread, so queued commands run in the runtime's after-tick
+hook, between frames. Concurrent: each context process answers batches of commands through a pipe
+between its frames, and a dispatcher thread in the supervising process routes and combines them.
+"""
+
+from __future__ import annotations
+
+import json
+import multiprocessing
+import threading
+import time
+from collections import deque
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from core.config import store_private
+from core.dot import contexts_dot
+from core.errors import TafelError
+from core.manager import ModuleManager
+from core.program import ContextPlan
+from core.recording import Recorder
+from core.runtime import ContextRunner
+from debug.commands import CommandError, ContextDebug, argument
+from debug.concepts import STATE, DebugDrawings, DebugPlots, frame_debug_data
+from debug.protocol import Command
+from debug.server import DebugRouter, DebugServer, Executor
+
+DEBUG_REPRESENTATIONS = (DebugDrawings, DebugPlots)
+
+
+class RateMeter:
+    """Frames per second over the last two seconds of wall time."""
+
+    def __init__(self) -> None:
+        self.stamps: deque[float] = deque(maxlen=2000)
+
+    def tick(self) -> None:
+        self.stamps.append(time.monotonic())
+
+    def rate(self) -> float:
+        now = time.monotonic()
+        recent = [t for t in self.stamps if now - t <= 2.0]
+        if len(recent) < 2:
+            return 0.0
+        return (len(recent) - 1) / (recent[-1] - recent[0]) if recent[-1] > recent[0] else 0.0
+
+
+def instrument(context: str, manager: ModuleManager, meter: RateMeter) -> None:
+    """Frame hooks: tell the debug concepts which context runs, keep its drawings and plots per frame."""
+    manager.before_frame.append(lambda: STATE.begin_frame(context, manager.frame + 1))
+
+    def after() -> None:
+        STATE.end_frame(context)
+        meter.tick()
+        if DebugDrawings in manager.blackboard or DebugPlots in manager.blackboard:
+            drawings, plots = frame_debug_data(context)
+            if DebugDrawings in manager.blackboard:
+                manager.blackboard.set(drawings)
+            if DebugPlots in manager.blackboard:
+                manager.blackboard.set(plots)
+
+    manager.after_frame.append(after)
+
+
+def context_debug(context: str, manager: ModuleManager, recorded: Sequence[type] = ()) -> ContextDebug:
+    meter = RateMeter()
+    for rep in recorded:
+        manager.blackboard.ensure(rep)
+    instrument(context, manager, meter)
+    return ContextDebug(context, manager, rate=meter.rate)
+
+
+class LocalExecutor(Executor):
+    def __init__(self, debug: ContextDebug) -> None:
+        self.debug = debug
+
+    def execute_batch(self, commands: Sequence[Command]) -> list[tuple[str, str | bytes]]:
+        return self.debug.execute_batch(commands)
+
+    def internal(self, what: str, argument_: str = "") -> Any:
+        return internal_answer(self.debug, what, argument_)
+
+
+def internal_answer(debug: ContextDebug, what: str, argument_: str) -> Any:
+    """Plain data the router needs from a context (graph, choices, parameter values)."""
+    if what == "graph":
+        return debug.graph()
+    if what == "choices":
+        return debug.choices()
+    if what == "parameters":
+        return debug.parameter_values(argument_)
+    raise ValueError(what)
+
+
+class RemoteExecutor(Executor):
+    """A context in another process, asked through a pipe; answers arrive between its frames."""
+
+    def __init__(self, context: str, connection: Any, timeout: float = 3.0) -> None:
+        self.context = context
+        self.connection = connection
+        self.timeout = timeout
+        self.batch = 0
+        self.lock = threading.Lock()
+
+    def _ask(self, payload: Any, count: int) -> list[Any] | None:
+        with self.lock:
+            self.batch += 1
+            try:
+                self.connection.send((self.batch, payload))
+                deadline = time.monotonic() + self.timeout
+                while time.monotonic() < deadline:
+                    if self.connection.poll(max(0.0, deadline - time.monotonic())):
+                        batch, answers = self.connection.recv()
+                        if batch == self.batch:
+                            return answers
+            except (OSError, EOFError):
+                return None
+        return None
+
+    def execute_batch(self, commands: Sequence[Command]) -> list[tuple[str, str | bytes]]:
+        """The process answers as many as fit in its frame budget; the rest go in the next rounds."""
+        answers: list[tuple[str, str | bytes]] = []
+        while len(answers) < len(commands):
+            part = self._ask(("commands", list(commands[len(answers):])), len(commands) - len(answers))
+            if not part:
+                missing = len(commands) - len(answers)
+                return answers + [("error", f"{self.context} does not answer (stalled or gone)")] * missing
+            answers.extend(part)
+        return answers
+
+    def internal(self, what: str, argument_: str = "") -> Any:
+        answers = self._ask(("internal", (what, argument_)), 1)
+        if answers is None:
+            raise CommandError(f"{self.context} does not answer (stalled or gone)")
+        return answers
+
+
+def worker_debug_setup(runner: ContextRunner, args: Mapping[str, Any]) -> None:
+    """Runs in a context process: answer the supervisor's commands between frames."""
+    connection = args["connections"].get(runner.name)
+    budget = 0.1 / runner.plan.rate_hz  # at most a tenth of a frame period per frame for commands
+    debug = context_debug(runner.name, runner.manager, args.get("recorded", {}).get(runner.name, ()))
+    if connection is None:
+        return
+
+    def serve(_runner: ContextRunner) -> None:
+        while connection.poll():
+            batch, (kind, payload) = connection.recv()
+            if kind == "commands":
+                connection.send((batch, debug.execute_batch(payload, budget_s=budget)))
+            else:
+                connection.send((batch, internal_answer(debug, *payload)))
+
+    runner.after_step.append(serve)
+
+
+class ProgramDebug:
+    """The debug server of one program run, with the program-wide commands."""
+
+    def __init__(self, *, host: str, port: int, token: str | None, config_dir: Path, recorder: Recorder | None,
+                 record_path_default: Path | None = None) -> None:
+        self.router = DebugRouter()
+        self.server = DebugServer(self.router, host, port, token=token)
+        self.config_dir = config_dir
+        self.recorder = recorder
+        self.executors: dict[str, Any] = {}
+        self.record_default = record_path_default or Path("tafel.mcap")
+        router = self.router
+        router.register("modules:graph", "Graphviz DOT of both contexts and their hand-overs", "modules:graph", self._graph)
+        router.register("modules:store", "write provider choices and disabled modules to config/private/private.toml", "modules:store", self._store_modules)
+        router.register("parameter:store", "write a module's parameters to config/private/private.toml", "parameter:store -module NAME", self._store_parameters)
+        router.register("log:start", "start recording", "log:start [-file FILE.mcap]", self._log_start)
+        router.register("log:stop", "stop recording and finish the file", "log:stop", self._log_stop)
+        router.register("log:status", "whether and where recording goes, with counts", "log:status", self._log_status)
+        self.handovers: list[tuple[str, str, str]] = []
+
+    def add_context(self, name: str, executor: Any) -> None:
+        self.executors[name] = executor
+        self.router.add_context(name, executor)
+
+    def add_platform_commands(self, platform: Any) -> None:
+        """Replay stepping for the log platform, and whatever commands a platform offers."""
+        if all(hasattr(platform, m) for m in ("play", "pause", "step", "goto")):
+            self.router.register("log:play", "replay: run", "log:play", lambda c: (platform.play(), "playing")[1])
+            self.router.register("log:pause", "replay: pause", "log:pause", lambda c: (platform.pause(), "paused")[1])
+            self.router.register("log:step", "replay: step N frames (negative: back) and pause", "log:step [-count N]",
+                                 lambda c: self._replay_step(platform, c))
+            self.router.register("log:goto", "replay: pause at a frame of the main context", "log:goto -frame N",
+                                 lambda c: self._replay_goto(platform, c))
+        for name, (summary, handler) in platform.commands().items():
+            self.router.register(name, summary, name, lambda c, h=handler: h(dict(c.args)))
+
+    @staticmethod
+    def _replay_step(platform: Any, command: Command) -> str:
+        text = argument(command, "count", required=False) or "1"
+        try:
+            count = int(text)
+        except ValueError:
+            raise CommandError(f"-count takes a whole number, got {text!r}") from None
+        platform.step(count)
+        return f"stepping {count}"
+
+    @staticmethod
+    def _replay_goto(platform: Any, command: Command) -> str:
+        text = argument(command, "frame")
+        try:
+            frame = int(text)
+        except ValueError:
+            raise CommandError(f"-frame takes a whole number, got {text!r}") from None
+        try:
+            platform.goto(frame)
+        except TafelError as exc:
+            raise CommandError(str(exc)) from None
+        return f"paused at frame {frame}"
+
+    def _graph(self, command: Command) -> str:
+        graphs = [executor.internal("graph") for executor in self.executors.values()]
+        return contexts_dot(graphs, self.handovers)
+
+    def _store_modules(self, command: Command) -> str:
+        stored = []
+        for context, executor in self.executors.items():
+            choices = executor.internal("choices")
+            for rep, module in choices["providers"].items():
+                store_private(self.config_dir, [context, "providers", rep], module)
+                stored.append(f"{context}.providers.{rep}={module}")
+            path = store_private(self.config_dir, [context, "disabled"], choices["disabled"])
+            stored.append(f"{context}.disabled={choices['disabled']}")
+        return f"stored in {path}: " + ", ".join(stored)
+
+    def _store_parameters(self, command: Command) -> str:
+        module = argument(command, "module")
+        for executor in self.executors.values():
+            values = executor.internal("parameters", module)
+            if values is not None:
+                path = None
+                for name, value in values.items():
+                    path = store_private(self.config_dir, ["parameters", module, name], value)
+                return f"stored {len(values)} parameters of {module} in {path}"
+        raise CommandError(f"no running module {module!r} with parameters")
+
+    def _log_start(self, command: Command) -> str:
+        if self.recorder is None:
+            raise CommandError("this run cannot record (no representations selected)")
+        path = Path(argument(command, "file", required=False) or self.record_default)
+        self.recorder.start(path)
+        return f"recording to {path}"
+
+    def _log_stop(self, command: Command) -> str:
+        if self.recorder is None or not self.recorder.recording:
+            raise CommandError("not recording")
+        status = self.recorder.stop()
+        return f"stopped recording {status['file']}: {status['messages']} messages, {status['dropped']} dropped"
+
+    def _log_status(self, command: Command) -> str:
+        if self.recorder is None:
+            return "recording: not available"
+        return json.dumps(self.recorder.status())
+
+
+def concurrent_pipes(contexts: Sequence[str]) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(supervisor ends, worker ends) of one command pipe per context process."""
+    mp = multiprocessing.get_context("spawn")
+    ours, theirs = {}, {}
+    for context in contexts:
+        ours[context], theirs[context] = mp.Pipe(duplex=True)
+    return ours, theirs
+
+
+def handovers_of(plans: Mapping[str, ContextPlan]) -> list[tuple[str, str, str]]:
+    return [(rep.__name__, other, name) for name, plan in plans.items() for other in plans if other != name
+            for rep in plan.handover_in]
