@@ -205,6 +205,8 @@ class LockstepRuntime:
         self.end_reason = ""
         #: called after every tick with the runtime (status lines, debug commands between frames)
         self.after_tick: list[Callable[[LockstepRuntime], None]] = []
+        #: waits between ticks when pacing to the wall clock; replaced to do work meanwhile (debug commands)
+        self.idle: Callable[[float], None] = time.sleep
 
     @property
     def managers(self) -> dict[str, ModuleManager]:
@@ -249,7 +251,7 @@ class LockstepRuntime:
                 if limits.speed:
                     delay = start + time_ns * 1e-9 / limits.speed - time.monotonic()
                     if delay > 0:
-                        time.sleep(delay)
+                        self.idle(delay)
                 self.time_ns = time_ns
                 self.platform.advance(time_ns)
                 if motion_status is not None and cognition is not None:
@@ -278,7 +280,7 @@ class LockstepRuntime:
             step = self.platform.next_step()
             if step is None:  # paused
                 origin = None
-                time.sleep(0.01)
+                self.idle(0.01)
                 for hook in self.after_tick:
                     hook(self)
                 continue
@@ -292,7 +294,7 @@ class LockstepRuntime:
                     origin = (time.monotonic(), time_ns)
                 delay = origin[0] + (time_ns - origin[1]) * 1e-9 / limits.speed - time.monotonic()
                 if delay > 0:
-                    time.sleep(delay)
+                    self.idle(delay)
             self.time_ns = time_ns
             for name in MAIN_CONTEXT_ORDER:
                 if name in contexts and name in self.runners:

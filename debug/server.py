@@ -35,7 +35,17 @@ MAX_OUTPUT = 8 << 20  # unsent answer bytes per connection before it is dropped
 
 
 class Executor:
-    """Something that answers context commands in batches: a ``ContextDebug`` or a remote process."""
+    """Something that answers context commands in batches: a ``ContextDebug`` or a remote process.
+
+    ``start`` hands a batch over and ``finish`` collects its answers, so that contexts in other
+    processes work on their batches at the same time.
+    """
+
+    def start(self, commands: Sequence[Command]) -> Any:
+        return self.execute_batch(commands)
+
+    def finish(self, started: Any) -> list[tuple[str, str | bytes]]:
+        return started
 
     def execute_batch(self, commands: Sequence[Command]) -> list[tuple[str, str | bytes]]:
         raise NotImplementedError
@@ -54,12 +64,32 @@ class DebugRouter:
     def __init__(self) -> None:
         self.contexts: dict[str, Executor] = {}
         self.globals: dict[str, GlobalCommand] = {}
+        #: context -> names of its modules and representations, to ask only the context that has a name
+        self.index: dict[str, set[str]] = {}
         self.register("help", "the commands, or one command's arguments", "help [NAME]", self._help)
         self.register("ping", "answers pong", "ping", lambda command: "pong")
         self.register("auth", "authenticate with the server's token (--debug-token)", "auth TOKEN", lambda command: "authenticated")
 
-    def add_context(self, name: str, executor: Executor) -> None:
+    def add_context(self, name: str, executor: Executor, names: set[str] | None = None) -> None:
         self.contexts[name] = executor
+        if names is not None:
+            self.index[name] = set(names)
+
+    #: commands that need no context and change nothing: answered by the network thread on arrival
+    IMMEDIATE = frozenset({"ping", "help"})
+
+    def targets(self, command: Command) -> list[str]:
+        """The contexts to ask: the one that has the named module or representation, else all."""
+        wanted = command.args.get("context")
+        if isinstance(wanted, str) and wanted in self.contexts:
+            return [wanted]
+        if SPECS[command.name].routing != "merge" and self.index:
+            names = {v for k, v in command.args.items() if k in ("module", "name", "representation") and isinstance(v, str)}
+            names |= {k for k, v in command.args.items() if v == ""}
+            having = [c for c in self.contexts if names & self.index.get(c, set())]
+            if having:
+                return having
+        return list(self.contexts)
 
     def register(self, name: str, summary: str, usage: str, handler: Callable[[Command], str | bytes]) -> None:
         self.globals[name] = GlobalCommand(summary, usage, handler)
@@ -86,10 +116,13 @@ class DebugRouter:
         def flush() -> None:
             if not run:
                 return
-            batch = [commands[i] for i in run]
-            per_context = {name: executor.execute_batch(batch) for name, executor in self.contexts.items()}
-            for position, index in enumerate(run):
-                answers = {name: per_context[name][position] for name in self.contexts}
+            wanted = {index: self.targets(commands[index]) for index in run}
+            batches = {name: [i for i in run if name in wanted[i]] for name in self.contexts}
+            started = {name: executor.start([commands[i] for i in batches[name]])
+                       for name, executor in self.contexts.items() if batches[name]}
+            per_context = {name: dict(zip(batches[name], self.contexts[name].finish(handle))) for name, handle in started.items()}
+            for index in run:
+                answers = {name: per_context[name][index] for name in wanted[index] if name in per_context}
                 results[index] = merge_answers(commands[index], answers) if answers else (True, "no context is running")
             run.clear()
 
@@ -179,20 +212,31 @@ class _Connection:
         if not self.authenticated:
             self.deliver(sequence, answer_bytes("error: not authenticated (send: auth TOKEN)"))
             return
+        if command.name in DebugRouter.IMMEDIATE:  # stateless: answer here, in order, without waiting a frame
+            ((is_error, payload),) = self.server.router.handle_batch([command])
+            self.deliver(sequence, self.server.encode(command, is_error, payload))
+            return
         self.outstanding += 1
         self.server.pending.put(_Request(self, sequence, command))
 
     def deliver(self, sequence: int, data: bytes) -> None:
         """Network thread: keep the answer and send every answer that is next in order."""
+        self.deliver_many([(sequence, data)])
+
+    def deliver_many(self, answers: list[tuple[int, bytes]]) -> None:
+        """Network thread: keep the answers; send, in one write, all that are next in order."""
         if self.closed:
             return
         if self.writer.transport.is_closing():  # the client is gone (reset): stop answering it
             self.drop()
             return
-        self.answers[sequence] = data
+        self.answers.update(answers)
+        ready = []
         while self.next_answer in self.answers:
-            self.writer.write(self.answers.pop(self.next_answer))
+            ready.append(self.answers.pop(self.next_answer))
             self.next_answer += 1
+        if ready:
+            self.writer.write(b"".join(ready))
         if self.writer.transport.get_write_buffer_size() > self.server.max_output:
             log.warning("dropping debug client %s: it does not read its answers", self.peer)
             self.drop()
@@ -231,6 +275,7 @@ class DebugServer:
         self.max_output = max_output
         self.pending: queue.SimpleQueue[_Request] = queue.SimpleQueue()
         self._queues: dict[_Connection, deque[_Request]] = {}
+        self._turns: deque[_Connection] = deque()  # connections with queued commands, in rotation
         self.connections: set[_Connection] = set()
         self.answered = 0
         self._loop: asyncio.AbstractEventLoop | None = None
@@ -294,33 +339,41 @@ class DebugServer:
     def _collect(self, wait: float = 0.0) -> None:
         """Move what the network thread queued into per-connection queues (processing thread only)."""
         try:
-            if wait > 0 and not any(self._queues.values()):
-                request = self.pending.get(timeout=wait)
-                self._queues.setdefault(request.connection, deque()).append(request)
+            if wait > 0 and not self._queues:
+                self._take(self.pending.get(timeout=wait))
             while True:
-                request = self.pending.get_nowait()
-                self._queues.setdefault(request.connection, deque()).append(request)
+                self._take(self.pending.get_nowait())
         except queue.Empty:
             pass
 
+    def _take(self, request: _Request) -> None:
+        waiting = self._queues.get(request.connection)
+        if waiting is None:
+            waiting = self._queues[request.connection] = deque()
+            self._turns.append(request.connection)
+        waiting.append(request)
+
     def _next_batch(self, limit: int) -> list[_Request]:
-        """Up to ``limit`` requests, taken round-robin from the connections (in order within each)."""
+        """Up to ``limit`` requests, one connection after the other in rotation (in order within each).
+
+        A client with one command waits for at most one command of each other client, however many
+        those have queued.
+        """
         batch: list[_Request] = []
-        while len(batch) < limit:
-            took = False
-            for connection, waiting in list(self._queues.items()):
-                if connection.closed or not waiting:
-                    del self._queues[connection]  # a closed client's commands are not worth running
-                    continue
-                batch.append(waiting.popleft())
-                took = True
-                if len(batch) >= limit:
-                    break
-            if not took:
-                break
+        while len(batch) < limit and self._turns:
+            connection = self._turns.popleft()
+            waiting = self._queues.get(connection)
+            if connection.closed or not waiting:
+                self._queues.pop(connection, None)  # a closed client's commands are not worth running
+                continue
+            batch.append(waiting.popleft())
+            if waiting:
+                self._turns.append(connection)
+            else:
+                del self._queues[connection]
         return batch
 
-    def process_pending(self, budget_s: float = 0.004, chunk: int = 32) -> int:
+    def process_pending(self, budget_s: float = 0.001, chunk: int = 8) -> int:
         """Between frames: answer queued commands for at most about ``budget_s``; the rest next frame."""
         start = time.perf_counter()
         self._collect()
@@ -340,23 +393,32 @@ class DebugServer:
             log.exception("debug commands failed")
             results = [(True, f"internal error in the debug server: {type(exc).__name__}: {exc}")] * len(requests)
         loop = self._loop
+        per_connection: dict[_Connection, list[tuple[int, bytes]]] = {}
         for request, (is_error, payload) in zip(requests, results):
-            if is_error:
-                data = answer_bytes(f"error: {payload}")
-            elif isinstance(payload, bytes) and not request.command.base64_answer:
-                data = answer_bytes(f"error: {request.command.name} answers with bytes; send +{request.command.name} for base64")
-            else:
-                data = answer_bytes(payload, base64_answer=request.command.base64_answer)
-            if loop is not None and not request.connection.closed:
-                loop.call_soon_threadsafe(self._deliver, request.connection, request.sequence, data)
+            data = self.encode(request.command, is_error, payload)
+            if not request.connection.closed:
+                per_connection.setdefault(request.connection, []).append((request.sequence, data))
+        if loop is not None and per_connection:
+            loop.call_soon_threadsafe(self._deliver, per_connection)  # one wake-up of the network thread per batch
         self.answered += len(requests)
 
     @staticmethod
-    def _deliver(connection: _Connection, sequence: int, data: bytes) -> None:
-        connection.answered()
-        connection.deliver(sequence, data)
+    def encode(command: Command, is_error: bool, payload: str | bytes) -> bytes:
+        """The bytes of one answer."""
+        if is_error:
+            return answer_bytes(f"error: {payload}")
+        if isinstance(payload, bytes) and not command.base64_answer:
+            return answer_bytes(f"error: {command.name} answers with bytes; send +{command.name} for base64")
+        return answer_bytes(payload, base64_answer=command.base64_answer)
 
-    def dispatch_forever(self, stop: Any, timeout: float = 0.1, chunk: int = 256) -> None:
+    @staticmethod
+    def _deliver(per_connection: dict[_Connection, list[tuple[int, bytes]]]) -> None:
+        for connection, answers in per_connection.items():
+            for _ in answers:
+                connection.answered()
+            connection.deliver_many(answers)
+
+    def dispatch_forever(self, stop: Any, timeout: float = 0.1, chunk: int = 32) -> None:
         """For contexts in other processes: answer batches as they come until ``stop`` is set."""
         while not stop.is_set():
             self._collect(wait=timeout)
@@ -364,7 +426,26 @@ class DebugServer:
             if batch:
                 self._answer(batch)
 
-    def wait_until_idle(self, timeout: float = 5.0) -> None:
-        deadline = time.monotonic() + timeout
-        while not self.pending.empty() and time.monotonic() < deadline:
-            time.sleep(0.01)
+    def serve_while_idle(self, seconds: float, reserve: float = 0.002, share: float = 0.3) -> None:
+        """Between frames, while the loop would sleep anyway: answer commands as they arrive.
+
+        Works in small batches for at most ``share`` of the idle time and stops ``reserve`` seconds
+        before the next frame, so frames keep their rate however hard clients push: a flooding client
+        gets its answers more slowly instead.
+        """
+        start = time.perf_counter()
+        deadline = start + seconds
+        work_until = min(deadline - reserve, start + seconds * share)
+        while True:
+            now = time.perf_counter()
+            if now >= deadline:
+                return
+            if now >= work_until or not self._queues:
+                self._collect(wait=max(0.0, min(deadline - now, 0.05)))
+                if time.perf_counter() >= work_until:
+                    time.sleep(max(0.0, deadline - time.perf_counter()))
+                    return
+            batch = self._next_batch(8)
+            if batch:
+                self._answer(batch)
+            self._collect()

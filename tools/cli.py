@@ -234,9 +234,10 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
     if debug is not None:
         recorded = debug_recorded(recorder)
         for name, runner in runtime.runners.items():
-            debug.add_context(name, LocalExecutor(context_debug(name, runner.manager, recorded.get(name, ()))))
+            debug.add_context(name, LocalExecutor(context_debug(name, runner.manager, recorded.get(name, ()))), plans[name])
         debug.add_platform_commands(platform)
         runtime.after_tick.append(lambda _runtime: debug.server.process_pending())
+        runtime.idle = debug.server.serve_while_idle
         listen(args, debug)
     install_signal_handlers(runtime.stop)
     started = time.monotonic()
@@ -271,7 +272,7 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
         ours, theirs = concurrent_pipes(running)
         setup = (worker_debug_setup, {"connections": theirs, "recorded": debug_recorded(recorder)})
         for name in running:
-            debug.add_context(name, RemoteExecutor(name, ours[name]))
+            debug.add_context(name, RemoteExecutor(name, ours[name]), plans[name])
     stall = float(config.get("runtime", {}).get("stall_timeout_s", 1.0))
     runtime = ConcurrentRuntime(plans, platform_class, options, strict=args.strict, stall_timeout_s=stall,
                                 recorder=recorder, worker_setup=setup)

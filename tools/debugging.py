@@ -105,34 +105,59 @@ class RemoteExecutor(Executor):
         self.batch = 0
         self.lock = threading.Lock()
 
-    def _ask(self, payload: Any, count: int) -> list[Any] | None:
+    def _ask(self, payload: Any) -> Any:
         with self.lock:
             self.batch += 1
             try:
                 self.connection.send((self.batch, payload))
-                deadline = time.monotonic() + self.timeout
-                while time.monotonic() < deadline:
-                    if self.connection.poll(max(0.0, deadline - time.monotonic())):
-                        batch, answers = self.connection.recv()
-                        if batch == self.batch:
-                            return answers
+                return self._receive()
             except (OSError, EOFError):
                 return None
-        return None
 
     def execute_batch(self, commands: Sequence[Command]) -> list[tuple[str, str | bytes]]:
-        """The process answers as many as fit in its frame budget; the rest go in the next rounds."""
+        return self.finish(self.start(commands))
+
+    def start(self, commands: Sequence[Command]) -> Any:
+        """Send the batch; the process answers as many as fit in its frame budget."""
+        self.lock.acquire()
+        self.batch += 1
+        try:
+            self.connection.send((self.batch, ("commands", list(commands))))
+        except (OSError, EOFError):
+            return (list(commands), False)
+        return (list(commands), True)
+
+    def finish(self, started: Any) -> list[tuple[str, str | bytes]]:
+        """Collect the answers, sending what did not fit again until all are answered."""
+        commands, sent = started
         answers: list[tuple[str, str | bytes]] = []
-        while len(answers) < len(commands):
-            part = self._ask(("commands", list(commands[len(answers):])), len(commands) - len(answers))
-            if not part:
-                missing = len(commands) - len(answers)
-                return answers + [("error", f"{self.context} does not answer (stalled or gone)")] * missing
-            answers.extend(part)
-        return answers
+        try:
+            while sent:
+                part = self._receive()
+                if not part:
+                    break
+                answers.extend(part)
+                if len(answers) >= len(commands):
+                    return answers
+                self.batch += 1
+                self.connection.send((self.batch, ("commands", commands[len(answers):])))
+        except (OSError, EOFError):
+            pass
+        finally:
+            self.lock.release()
+        return answers + [("error", f"{self.context} does not answer (stalled or gone)")] * (len(commands) - len(answers))
+
+    def _receive(self) -> list[Any] | None:
+        deadline = time.monotonic() + self.timeout
+        while time.monotonic() < deadline:
+            if self.connection.poll(max(0.0, deadline - time.monotonic())):
+                batch, answers = self.connection.recv()
+                if batch == self.batch:
+                    return answers
+        return None
 
     def internal(self, what: str, argument_: str = "") -> Any:
-        answers = self._ask(("internal", (what, argument_)), 1)
+        answers = self._ask(("internal", (what, argument_)))
         if answers is None:
             raise CommandError(f"{self.context} does not answer (stalled or gone)")
         return answers
@@ -177,9 +202,14 @@ class ProgramDebug:
         router.register("log:status", "whether and where recording goes, with counts", "log:status", self._log_status)
         self.handovers: list[tuple[str, str, str]] = []
 
-    def add_context(self, name: str, executor: Any) -> None:
+    def add_context(self, name: str, executor: Any, plan: ContextPlan | None = None) -> None:
         self.executors[name] = executor
-        self.router.add_context(name, executor)
+        names = None
+        if plan is not None:
+            reps = {r.__name__ for r in plan.external}
+            reps |= {r.__name__ for m in plan.modules for r in (*m.requirements().reads(), *m.requirements().provides)}
+            names = {m.__name__ for m in plan.modules} | reps
+        self.router.add_context(name, executor, names)
 
     def add_platform_commands(self, platform: Any) -> None:
         """Replay stepping for the log platform, and whatever commands a platform offers."""
