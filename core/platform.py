@@ -56,6 +56,8 @@ class Platform:
     consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {}
     #: True when ``next_step`` decides which contexts run when (log replay); else rates decide
     drives_schedule: ClassVar[bool] = False
+    #: False when the contexts cannot run in separate processes (one simulated world feeds both)
+    concurrent: ClassVar[bool] = True
 
     def __init__(self, options: Mapping[str, Any] | None = None) -> None:
         self.options = dict(options or {})

@@ -70,7 +70,7 @@ class ContextPlan:
             providers=providers,
             strict=strict,
             parameters=parameters,
-            disabled=[*self.disabled, *self.pruned, *self.replaced],
+            disabled=[name for name in (*self.disabled, *self.pruned, *self.replaced) if name in {m.__name__ for m in self.modules}],
         )
 
 

@@ -502,6 +502,11 @@ class ConcurrentRuntime:
         self.plans = {name: plan for name, plan in plans.items() if plan.runs}
         if not self.plans:
             raise PlatformError("nothing to run: no context has modules or platform data")
+        if not platform_class.concurrent and len(self.plans) > 1:
+            raise PlatformError(
+                f"platform {platform_class.name!r} feeds both contexts from one simulated world and runs them in "
+                "lockstep; run it without --concurrent (the concurrent runtime is for robots and cameras)"
+            )
         self.platform_class = platform_class
         self.platform_options = dict(platform_options)
         self.strict = strict

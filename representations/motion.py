@@ -5,6 +5,8 @@ Every 25-element joint array is in ``JOINT_NAMES`` order (the order of the NAO's
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 
 from core import array, representation
@@ -78,3 +80,44 @@ class JointCommand:
 
     position: np.ndarray = array((JOINT_COUNT,))
     stiffness: np.ndarray = array((JOINT_COUNT,))
+
+
+@representation
+class InertialModel:
+    """The filtered torso orientation: ``roll`` and ``pitch`` (rad) of the torso relative to the
+    ground, ``gyroscope`` (rad/s) and ``accelerometer`` (m/s^2) low-pass filtered."""
+
+    roll: float = 0.0
+    pitch: float = 0.0
+    gyroscope: np.ndarray = array((3,))
+    accelerometer: np.ndarray = array((3,))
+
+
+@dataclass
+class CameraMatrix:
+    """Where a camera is in the robot frame: ``rotation`` (3x3) and ``translation`` (mm) of the camera
+    frame, whose x axis is the optical axis, y points left and z up in the image. ``valid`` once
+    computed from measured joints."""
+
+    rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    translation: np.ndarray = array((3,))
+    valid: bool = False
+
+
+@representation
+class CameraMatrixTop(CameraMatrix):
+    """The top camera's pose in the robot frame."""
+
+
+@representation
+class CameraMatrixBottom(CameraMatrix):
+    """The bottom camera's pose in the robot frame."""
+
+
+@representation
+class TorsoPose:
+    """The torso's pose in the robot frame: ``rotation`` (3x3) and ``translation`` (mm); the
+    translation's z is the torso's height above the ground."""
+
+    rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    translation: np.ndarray = array((3,))

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
-from core import representation
+from dataclasses import dataclass
+
+import numpy as np
+
+from core import array, representation
 
 
 @representation
@@ -20,3 +24,23 @@ class BallPercept:
     image_y: float = 0.0
     radius: float = 0.0
     camera: str = ""
+
+
+@dataclass
+class CameraImage:
+    """An RGB image (height x width x 3, uint8; top-left origin) of one camera, with its field of
+    view (rad). Both cameras have their own representation, so modules declare which they read."""
+
+    image: np.ndarray = array((240, 320, 3), np.uint8)
+    horizontal_fov: float = 0.0
+    vertical_fov: float = 0.0
+
+
+@representation
+class CameraImageTop(CameraImage):
+    """The top camera's image (upright: the NAO platform already rotated it)."""
+
+
+@representation
+class CameraImageBottom(CameraImage):
+    """The bottom camera's image."""

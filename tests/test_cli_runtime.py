@@ -21,21 +21,26 @@ def tafel(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
     return subprocess.run([*TAFEL, *args], capture_output=True, text=True, timeout=timeout, cwd=REPO, env=env)
 
 
+def dummy(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:
+    """``tafel run`` on the dummy platform, without the debug server: the runtime alone."""
+    return tafel("run", "--platform", "dummy", "--no-debug", *args, timeout=timeout)
+
+
 def frames(output: str) -> dict[str, int]:
     return {name: int(n) for name, n in re.findall(r"^  (\w+): (\d+) frames", output, re.MULTILINE)}
 
 
 def test_dummy_run_gives_frame_counts_matching_the_rates() -> None:
-    result = tafel("run", "--platform", "dummy", "--frames", "1000", "--speed", "max")
+    result = dummy("--frames", "1000", "--speed", "max")
     assert result.returncode == 0, result.stderr
     assert frames(result.stdout) == {"cognition": 300, "motion": 1000}
     assert "platform dummy (lockstep): ran 10.000 s of platform time" in result.stdout
 
 
 def test_dummy_runs_are_deterministic() -> None:
-    first = tafel("run", "--platform", "dummy", "--frames", "500", "--speed", "max", "--seed", "3")
-    second = tafel("run", "--platform", "dummy", "--frames", "500", "--speed", "max", "--seed", "3")
-    other_seed = tafel("run", "--platform", "dummy", "--frames", "500", "--speed", "max", "--seed", "4")
+    first = dummy("--frames", "500", "--speed", "max", "--seed", "3")
+    second = dummy("--frames", "500", "--speed", "max", "--seed", "3")
+    other_seed = dummy("--frames", "500", "--speed", "max", "--seed", "4")
     assert first.returncode == second.returncode == 0
     assert first.stdout == second.stdout
     assert "state " in first.stdout
@@ -43,13 +48,13 @@ def test_dummy_runs_are_deterministic() -> None:
 
 
 def test_rates_come_from_configuration() -> None:
-    result = tafel("run", "--frames", "200", "--speed", "max", "--set", "runtime.cognition_hz=10", "--set", "runtime.motion_hz=50")
+    result = dummy("--frames", "200", "--speed", "max", "--set", "runtime.cognition_hz=10", "--set", "runtime.motion_hz=50")
     assert result.returncode == 0, result.stderr
     assert frames(result.stdout) == {"cognition": 40, "motion": 200}
 
 
 def test_seconds_limit_uses_platform_time() -> None:
-    result = tafel("run", "--seconds", "2", "--speed", "max")
+    result = dummy("--seconds", "2", "--speed", "max")
     assert result.returncode == 0, result.stderr
     assert frames(result.stdout) == {"cognition": 60, "motion": 200}
 
@@ -62,7 +67,7 @@ def test_seconds_limit_uses_platform_time() -> None:
         (["run", "--speed", "fast"], "--speed takes a positive number or 'max'"),
         (["run", "--frames", "0"], "expected a number greater than zero"),
         (["run", "--frames", "3", "--seconds", "2"], "not allowed with argument"),
-        (["run", "--bogus"], "unrecognized arguments: --bogus; options of platform dummy: --seed"),
+        (["run", "--platform", "dummy", "--bogus"], "unrecognized arguments: --bogus; options of platform dummy: --seed"),
         (["run", "--set", "nonsense"], "--set takes KEY=VALUE"),
         (["run", "--config", "/nonexistent"], "configuration folder /nonexistent does not exist"),
         (["modules", "--set", 'cognition.providers.BallModel="Nope"'], "unknown module 'Nope'"),
@@ -87,21 +92,21 @@ def test_modules_shows_order_providers_and_hand_overs() -> None:
     result = tafel("modules", "--platform", "dummy")
     assert result.returncode == 0, result.stderr
     out = result.stdout
-    assert "order: StandMotion -> HeadMotion -> MotionCombinator" in out
+    assert "order: InertialFilter -> CameraMatrixProvider -> StandMotion -> HeadMotion -> MotionCombinator" in out
     assert "provider BallModel: KalmanBallModeler (alternatives: SimpleBallModeler)" in out
     assert "hand-over in: HeadMotionRequest from cognition" in out
     assert "hand-over out: HeadMotionRequest to motion" in out
 
 
 def test_modules_dot_has_both_contexts_and_the_hand_over() -> None:
-    result = tafel("modules", "--dot")
+    result = tafel("modules", "--platform", "dummy", "--dot")
     assert result.returncode == 0, result.stderr
     assert 'subgraph "cluster_cognition"' in result.stdout and 'subgraph "cluster_motion"' in result.stdout
     assert '"cognition:HeadMotionRequest" -> "motion:HeadMotionRequest"' in result.stdout
 
 
 def test_module_exceptions_are_counted_and_the_loop_goes_on() -> None:
-    result = tafel("run", "--frames", "100", "--speed", "max", "--set",
+    result = dummy("--frames", "100", "--speed", "max", "--set",
                    'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "tests.support.runtime_faults:RaiseEveryFrame"]')
     assert result.returncode == 0, result.stderr
     assert frames(result.stdout) == {"cognition": 30, "motion": 100}
@@ -111,7 +116,7 @@ def test_module_exceptions_are_counted_and_the_loop_goes_on() -> None:
 
 @pytest.mark.parametrize("concurrent", [False, True])
 def test_sigint_and_sigterm_shut_down_cleanly(concurrent: bool) -> None:
-    args = [*TAFEL, "run", "--status-interval", "0.3"] + (["--concurrent"] if concurrent else [])
+    args = [*TAFEL, "run", "--platform", "dummy", "--no-debug", "--status-interval", "0.3"] + (["--concurrent"] if concurrent else [])
     for sig in (signal.SIGINT, signal.SIGTERM):
         process = subprocess.Popen(args, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                    env={**os.environ, "PYTHONPATH": str(REPO)})
@@ -132,8 +137,8 @@ def test_sigint_and_sigterm_shut_down_cleanly(concurrent: bool) -> None:
 
 
 def run_concurrent_fault(module: str, seconds: str, motion_frames: int) -> subprocess.CompletedProcess:
-    return tafel(
-        "run", "--concurrent", "--frames", str(motion_frames),
+    return dummy(
+        "--concurrent", "--frames", str(motion_frames),
         "--set", f'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "tests.support.runtime_faults:{module}"]',
         "--set", f"parameters.{module}.after_frames=20",
         *(["--set", f"parameters.{module}.stall={seconds}"] if module == "StallCognition" else []),

@@ -110,7 +110,7 @@ def test_debug_data_is_recorded_like_representations(tmp_path) -> None:
     from tests.test_cli_runtime import tafel
 
     path = tmp_path / "debug.mcap"
-    result = tafel("run", "--frames", "30", "--speed", "max", "--debug-port", "0", "--record", str(path),
+    result = tafel("run", "--platform", "dummy", "--frames", "30", "--speed", "max", "--debug-port", "0", "--record", str(path),
                    "--record-reps", "DebugPlots,DebugDrawings",
                    "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "tests.support.debug_user:DebugUser"]')
     assert result.returncode == 0, result.stderr

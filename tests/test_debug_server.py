@@ -31,7 +31,7 @@ class Program:
 
     def __init__(self, *args: str, cwd: Path = REPO) -> None:
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "tools.cli", "run", "--debug-port", "0", *args],
+            [sys.executable, "-m", "tools.cli", "run", "--debug-port", "0", *args] + ([] if "--platform" in args else ["--platform", "dummy"]),
             cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
             env={**os.environ, "PYTHONPATH": str(REPO)},
         )
@@ -309,7 +309,7 @@ def test_token_authentication() -> None:
 
 def test_replay_commands(tmp_path: Path) -> None:
     log = tmp_path / "replay.mcap"
-    assert tafel("run", "--frames", "300", "--speed", "max", "--record", str(log), "--no-debug").returncode == 0
+    assert tafel("run", "--platform", "dummy", "--frames", "300", "--speed", "max", "--record", str(log), "--no-debug").returncode == 0
     replay = Program("--platform", "log", "--log", str(log), "--loop", "--speed", "0.2")
     try:
         assert replay.ask("log:pause") == "paused"
@@ -357,5 +357,5 @@ def test_console_runs_one_command_for_scripts(program: Program) -> None:
 
 
 def test_the_listening_line_and_port_conflicts(program: Program) -> None:
-    taken = tafel("run", "--frames", "10", "--speed", "max", "--debug-port", str(program.port))
+    taken = tafel("run", "--platform", "dummy", "--frames", "10", "--speed", "max", "--debug-port", str(program.port))
     assert taken.returncode == 1 and f"cannot listen on 127.0.0.1:{program.port}" in taken.stderr

@@ -21,13 +21,13 @@ from core.logfile import LogWriter, read_log
 from core.platform import PlatformError, PlatformOptionError
 from core.serialization import serialize
 from platforms.log import LogPlatform
-from tests.test_cli_runtime import REPO, frames, tafel
+from tests.test_cli_runtime import REPO, dummy, frames, tafel
 
 
 @pytest.fixture(scope="module")
 def recorded(tmp_path_factory) -> Path:
     path = tmp_path_factory.mktemp("logs") / "run.mcap"
-    result = tafel("run", "--frames", "600", "--speed", "max", "--record", str(path))
+    result = dummy("--frames", "600", "--speed", "max", "--record", str(path))
     assert result.returncode == 0, result.stderr
     assert "recorded" in result.stdout and "0 messages dropped" in result.stdout
     return path
@@ -96,7 +96,7 @@ def test_log_info_summarises_the_recording(recorded: Path) -> None:
 
 def test_replay_reproduces_every_cognition_output_frame_by_frame(recorded: Path, tmp_path: Path) -> None:
     replayed = tmp_path / "replayed.mcap"
-    result = tafel("run", "--platform", "log", "--log", str(recorded), "--speed", "max", "--record", str(replayed))
+    result = tafel("run", "--platform", "log", "--no-debug", "--log", str(recorded), "--speed", "max", "--record", str(replayed))
     assert result.returncode == 0, result.stderr
     assert frames(result.stdout) == {"cognition": 180, "motion": 600}
     original, again = read_log(recorded), read_log(replayed)
@@ -110,7 +110,7 @@ def test_replace_feeds_a_recorded_representation_instead_of_its_module(recorded:
     modules = tafel("modules", "--platform", "log", "--log", str(recorded), "--replace", "BallModel")
     assert "replaced: KalmanBallModeler (the platform provides BallModel)" in modules.stdout
     replayed = tmp_path / "replaced.mcap"
-    result = tafel("run", "--platform", "log", "--log", str(recorded), "--replace", "BallModel", "--speed", "max",
+    result = tafel("run", "--platform", "log", "--no-debug", "--log", str(recorded), "--replace", "BallModel", "--speed", "max",
                    "--record", str(replayed), "--record-reps", "HeadMotionRequest")
     assert result.returncode == 0, result.stderr
     original = [m.data for m in read_log(recorded).messages if m.topic == "cognition/HeadMotionRequest"]
@@ -151,7 +151,7 @@ def test_truncated_files_yield_what_was_complete_and_name_the_position(recorded:
 
 def test_sigkill_while_recording_loses_at_most_the_last_second(tmp_path: Path) -> None:
     path = tmp_path / "killed.mcap"
-    process = subprocess.Popen([sys.executable, "-m", "tools.cli", "run", "--record", str(path), "--status-interval", "0.5"],
+    process = subprocess.Popen([sys.executable, "-m", "tools.cli", "run", "--platform", "dummy", "--no-debug", "--record", str(path), "--status-interval", "0.5"],
                                cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                env={**os.environ, "PYTHONPATH": str(REPO)})
     last_status_time = 0.0
@@ -244,7 +244,7 @@ def test_stepping_the_replay(recorded: Path) -> None:
 
 def test_concurrent_runs_record_into_one_file(tmp_path: Path) -> None:
     path = tmp_path / "concurrent.mcap"
-    result = tafel("run", "--concurrent", "--frames", "150", "--record", str(path))
+    result = dummy("--concurrent", "--frames", "150", "--record", str(path))
     assert result.returncode == 0, result.stderr
     contents = read_log(path)
     assert contents.complete

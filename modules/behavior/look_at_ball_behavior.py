@@ -1,4 +1,4 @@
-"""LookAtBallBehavior: look at the ball while it is known; sweep the head to find it when it is not."""
+"""LookAtBallBehavior: look at the ball while it is seen; sweep the head to find it when it is not."""
 
 from __future__ import annotations
 
@@ -11,10 +11,22 @@ from representations.infrastructure import FrameInfo
 from representations.modeling import BallModel
 
 
+def sweep(start: float, direction: float, distance: float, amplitude: float) -> float:
+    """Where a point moving ``distance`` from ``start`` in ``direction`` (+1/-1) is, bouncing at ±amplitude."""
+    if amplitude <= 0:
+        return 0.0
+    position = start + direction * distance + amplitude  # unfold into [0, 4A) and fold back
+    period = 4 * amplitude
+    phase = position % period
+    return (phase if phase <= 2 * amplitude else period - phase) - amplitude
+
+
 @requires(BallModel, FrameInfo)
 @provides(HeadMotionRequest)
 class LookAtBallBehavior(Module):
-    """Points the head at the ball model's position; searches left and right when the model is invalid."""
+    """Points the head at the ball model's position while the ball is being seen. Once it has not been
+    seen for ``lost_after`` (it rolled away, or was moved), the head sweeps left and right, starting
+    towards the other side, where the ball most likely went out of view."""
 
     @dataclass
     class Parameters:
@@ -22,10 +34,10 @@ class LookAtBallBehavior(Module):
         """mm, height of the top camera above the ground when standing"""
         camera_tilt: float = math.radians(1.2)
         """rad, downward tilt of the top camera relative to the head"""
+        lost_after: float = 0.5
+        """s without seeing the ball before searching"""
         search_amplitude: float = 1.2
         """rad, largest head yaw while searching"""
-        search_period: float = 6.0
-        """s for one full left-right sweep"""
         search_pitch: float = 0.3
         """rad, head pitch while searching"""
         track_speed: float = 3.0
@@ -33,15 +45,23 @@ class LookAtBallBehavior(Module):
         search_speed: float = 1.5
         """rad/s, head speed while searching"""
 
+    def __init__(self) -> None:
+        self.search_start: tuple[float, float, float] | None = None  # (time s, yaw rad, direction)
+
     def execute(self) -> None:
         p, ball, request = self.parameters, self.ball_model, self.head_motion_request
-        if ball.valid:
+        now = self.frame_info.time_s
+        if ball.valid and ball.time_since_seen <= p.lost_after:
+            self.search_start = None
             distance = max(math.hypot(ball.x, ball.y), 1.0)
             request.yaw = math.atan2(ball.y, ball.x)
             request.pitch = math.atan2(p.camera_height, distance) - p.camera_tilt
             request.max_speed = p.track_speed
             return
-        phase = 2.0 * math.pi * self.frame_info.time_s / p.search_period
-        request.yaw = p.search_amplitude * math.sin(phase)
+        if self.search_start is None:
+            yaw = max(-p.search_amplitude, min(p.search_amplitude, request.yaw))
+            self.search_start = (now, yaw, -1.0 if yaw > 0 else 1.0)
+        started, yaw, direction = self.search_start
+        request.yaw = sweep(yaw, direction, (now - started) * p.search_speed, p.search_amplitude)
         request.pitch = p.search_pitch
-        request.max_speed = p.search_speed
+        request.max_speed = p.search_speed * 1.5  # the request itself moves at search speed; keep up with it

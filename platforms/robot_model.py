@@ -1,0 +1,302 @@
+"""The simulated world, generated from the shared robot and field descriptions.
+
+``mjcf()`` gives MuJoCo XML of the NAO (bodies, joints with limits, masses and inertias, collision
+shapes, IMU and foot pressure sites, both cameras, position servos) on an SPL field with a ball.
+``urdf()`` gives the same robot as URDF for simulators that read it. Both come from
+``representations.nao`` and ``representations.field``; nothing here is a hand-made copy of figures.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from representations import field
+from representations.nao import (
+    CAMERAS,
+    COUPLED_JOINTS,
+    ELBOW_OFFSET_Y,
+    FOOT_HEIGHT,
+    HAND_OFFSET_X,
+    HAND_OFFSET_Z,
+    HIP_OFFSET_Z,
+    IMU_POSITION,
+    JOINTS,
+    LOWER_ARM_LENGTH,
+    SOLE_BACK,
+    SOLE_FRONT,
+    SOLE_INSIDE,
+    SOLE_OUTSIDE,
+    THIGH_LENGTH,
+    TIBIA_LENGTH,
+    TORSO_MASS,
+    UPPER_ARM_LENGTH,
+    VERTICAL_FOV,
+)
+
+M = 0.001  # mm -> m
+#: servo strength at stiffness 1 (N m / rad) and the torque a joint can give (N m)
+SERVO_GAIN = 120.0
+SERVO_TORQUE = 25.0
+JOINT_DAMPING = 0.6
+JOINT_ARMATURE = 0.01
+#: torso height above the ground with straight legs (m): where the robot is placed
+STANDING_HEIGHT = (HIP_OFFSET_Z + THIGH_LENGTH + TIBIA_LENGTH + FOOT_HEIGHT) * M
+ROBOT_GROUP, WORLD_GROUP = 2, 1  # collision bits: the robot touches the world, not itself
+
+
+@dataclass(frozen=True)
+class Shape:
+    """A collision and visual shape of a link, in the link frame (m)."""
+
+    kind: str  # "box" (size = half extents), "capsule" (from, to, radius), "sphere" (center, radius)
+    size: tuple[float, ...]
+    center: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    end: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rgba: str = "0.85 0.85 0.88 1"
+
+
+def _foot(side: str) -> Shape:
+    outward = SOLE_OUTSIDE if side == "L" else -SOLE_OUTSIDE
+    inward = -SOLE_INSIDE if side == "L" else SOLE_INSIDE
+    half = ((SOLE_FRONT + SOLE_BACK) / 2 * M, abs(outward - inward) / 2 * M, 0.012)
+    center = ((SOLE_FRONT - SOLE_BACK) / 2 * M, (outward + inward) / 2 * M, -FOOT_HEIGHT * M + half[2])
+    return Shape("box", half, center, rgba="0.75 0.75 0.8 1")
+
+
+def shapes(link: str) -> list[Shape]:
+    """The simple shapes of each link; limbs are capsules, feet boxes with the sole's size."""
+    side = link[0] if link[0] in "LR" and link != "torso" else ""
+    s = 1.0 if side == "L" else -1.0
+    name = link[1:] if side else link
+    table: dict[str, list[Shape]] = {
+        "torso": [Shape("box", (0.045, 0.065, 0.095), (-0.008, 0.0, 0.035))],
+        "Neck": [],
+        "Head": [Shape("sphere", (0.062,), (0.0, 0.0, 0.055), rgba="0.9 0.9 0.92 1")],
+        "Shoulder": [],
+        "Biceps": [Shape("capsule", (0.024,), (0.0, 0.0, 0.0), (UPPER_ARM_LENGTH * M, s * ELBOW_OFFSET_Y * M, 0.0))],
+        "Elbow": [],
+        "ForeArm": [Shape("capsule", (0.021,), (0.0, 0.0, 0.0), (LOWER_ARM_LENGTH * M, 0.0, 0.0))],
+        "Wrist": [Shape("capsule", (0.02,), (0.0, 0.0, 0.0), (HAND_OFFSET_X * M, 0.0, -HAND_OFFSET_Z * M))],
+        "Fingers": [],
+        "Pelvis": [],
+        "Hip": [],
+        "Thigh": [Shape("capsule", (0.033,), (0.0, 0.0, -0.015), (0.0, 0.0, -(THIGH_LENGTH - 15) * M))],
+        "Tibia": [Shape("capsule", (0.03,), (0.0, 0.0, -0.015), (0.0, 0.0, -(TIBIA_LENGTH - 15) * M))],
+        "Ankle": [],
+        "Foot": [_foot(side)] if side else [],
+    }
+    return table[name]
+
+
+def inertia(mass: float, link_shapes: list[Shape]) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """Centre of mass and diagonal inertia (kg m^2) of a link, from its main shape (a small sphere if none)."""
+    if not link_shapes:
+        r = 0.015
+        return (0.0, 0.0, 0.0), (0.4 * mass * r * r,) * 3
+    shape = link_shapes[0]
+    if shape.kind == "box":
+        x, y, z = (2 * h for h in shape.size)
+        return shape.center, (mass / 12 * (y * y + z * z), mass / 12 * (x * x + z * z), mass / 12 * (x * x + y * y))
+    if shape.kind == "sphere":
+        r = shape.size[0]
+        return shape.center, (0.4 * mass * r * r,) * 3
+    start, end = np.array(shape.center), np.array(shape.end)
+    length = float(np.linalg.norm(end - start))
+    r = shape.size[0]
+    axial = 0.5 * mass * r * r
+    transverse = mass * (3 * r * r + length * length) / 12
+    axis = int(np.argmax(np.abs(end - start)))
+    diagonal = [transverse] * 3
+    diagonal[axis] = axial
+    center = tuple((start + end) / 2)
+    return center, tuple(diagonal)  # type: ignore[return-value]
+
+
+def fsr_sites(side: str) -> list[tuple[str, tuple[float, float, float]]]:
+    """Four pressure sensors per sole: front-left, front-right, rear-left, rear-right (m, foot frame)."""
+    left = (SOLE_OUTSIDE if side == "L" else SOLE_INSIDE) * M - 0.012
+    right = -(SOLE_INSIDE if side == "L" else SOLE_OUTSIDE) * M + 0.012
+    front, rear = SOLE_FRONT * M - 0.015, -SOLE_BACK * M + 0.015
+    z = -FOOT_HEIGHT * M
+    return [(f"{side}FsrFrontLeft", (front, left, z)), (f"{side}FsrFrontRight", (front, right, z)),
+            (f"{side}FsrRearLeft", (rear, left, z)), (f"{side}FsrRearRight", (rear, right, z))]
+
+
+def _vec(values: tuple[float, ...] | np.ndarray) -> str:
+    return " ".join(f"{v:.6g}" for v in values)
+
+
+def _geom_xml(shape: Shape, name: str) -> str:
+    common = f'name="{name}" contype="{ROBOT_GROUP}" conaffinity="{WORLD_GROUP}" rgba="{shape.rgba}" group="1"'
+    if shape.kind == "box":
+        return f'<geom {common} type="box" size="{_vec(shape.size)}" pos="{_vec(shape.center)}" friction="1.0 0.02 0.001"/>'
+    if shape.kind == "sphere":
+        return f'<geom {common} type="sphere" size="{shape.size[0]:.6g}" pos="{_vec(shape.center)}"/>'
+    return f'<geom {common} type="capsule" size="{shape.size[0]:.6g}" fromto="{_vec(shape.center)} {_vec(shape.end)}"/>'
+
+
+def _camera_xml(link: str) -> list[str]:
+    if link != "Head":
+        return []
+    lines = []
+    for camera in CAMERAS:
+        # MuJoCo cameras look along -z with y up: x_cam = right (-y), y_cam = up tilted forward by the tilt.
+        up = (math.sin(camera.tilt), 0.0, math.cos(camera.tilt))
+        lines.append(f'<camera name="{camera.name}_camera" pos="{_vec(np.array(camera.position) * M)}" '
+                     f'xyaxes="0 -1 0 {_vec(up)}" fovy="{math.degrees(VERTICAL_FOV):.4f}"/>')
+    return lines
+
+
+def _body_xml(link: str, children: dict[str, list], indent: str) -> list[str]:
+    lines = []
+    for joint in children.get(link, []):
+        link_shapes = shapes(joint.link)
+        center, diagonal = inertia(joint.mass, link_shapes)
+        lines.append(f'{indent}<body name="{joint.link}" pos="{_vec(np.array(joint.offset) * M)}">')
+        inner = indent + "  "
+        lines.append(f'{inner}<inertial pos="{_vec(center)}" mass="{joint.mass:.6g}" diaginertia="{_vec(diagonal)}"/>')
+        low, high = joint.limits
+        lines.append(f'{inner}<joint name="{joint.name}" type="hinge" axis="{_vec(joint.axis)}" range="{low:.6g} {high:.6g}" '
+                     f'limited="true" damping="{JOINT_DAMPING}" armature="{JOINT_ARMATURE}"/>')
+        for i, shape in enumerate(link_shapes):
+            lines.append(inner + _geom_xml(shape, f"{joint.link}_geom{i}"))
+        if joint.link.endswith("Foot"):
+            for name, position in fsr_sites(joint.link[0]):
+                lines.append(f'{inner}<site name="{name}" type="box" size="0.014 0.014 0.006" pos="{_vec(position)}" rgba="1 0 0 0"/>')
+        lines += [inner + c for c in _camera_xml(joint.link)]
+        lines += _body_xml(joint.link, children, inner)
+        lines.append(f"{indent}</body>")
+    return lines
+
+
+def _field_xml() -> list[str]:
+    """Carpet, lines (visual only), goals and ball."""
+    half_x, half_y = field.LENGTH / 2 * M, field.WIDTH / 2 * M
+    carpet_x, carpet_y = half_x + field.BORDER_STRIP * M, half_y + field.BORDER_STRIP * M
+    w = field.LINE_WIDTH / 2 * M
+    lines = [f'<geom name="carpet" type="plane" size="{carpet_x:.4g} {carpet_y:.4g} 0.1" material="carpet" '
+             f'contype="{WORLD_GROUP}" conaffinity="{ROBOT_GROUP | WORLD_GROUP}" friction="1.0 0.02 0.002"/>']
+    segments: list[tuple[float, float, float, float]] = [
+        (-half_x, -half_y, half_x, -half_y), (-half_x, half_y, half_x, half_y),
+        (-half_x, -half_y, -half_x, half_y), (half_x, -half_y, half_x, half_y), (0.0, -half_y, 0.0, half_y),
+    ]
+    for sign in (-1.0, 1.0):
+        for depth, width in ((field.PENALTY_AREA_LENGTH, field.PENALTY_AREA_WIDTH), (field.GOAL_AREA_LENGTH, field.GOAL_AREA_WIDTH)):
+            x_inner, y = sign * (half_x - depth * M), width / 2 * M
+            segments += [(sign * half_x, -y, x_inner, -y), (sign * half_x, y, x_inner, y), (x_inner, -y, x_inner, y)]
+    radius = field.CENTER_CIRCLE_DIAMETER / 2 * M
+    steps = 32
+    for i in range(steps):
+        a, b = 2 * math.pi * i / steps, 2 * math.pi * (i + 1) / steps
+        segments.append((radius * math.cos(a), radius * math.sin(a), radius * math.cos(b), radius * math.sin(b)))
+    for i, (x1, y1, x2, y2) in enumerate(segments):
+        length = math.hypot(x2 - x1, y2 - y1)
+        angle = math.atan2(y2 - y1, x2 - x1)
+        lines.append(f'<geom name="line{i}" type="box" size="{length / 2 + w:.4g} {w:.4g} 0.0005" pos="{(x1 + x2) / 2:.4g} {(y1 + y2) / 2:.4g} 0.0005" '
+                     f'euler="0 0 {angle:.6g}" rgba="1 1 1 1" contype="0" conaffinity="0"/>')
+    for sign in (-1.0, 1.0):
+        x = sign * (half_x + field.GOAL_POST_DIAMETER / 2 * M)
+        y = (field.GOAL_INNER_WIDTH + field.GOAL_POST_DIAMETER) / 2 * M
+        r, h = field.GOAL_POST_DIAMETER / 2 * M, field.GOAL_HEIGHT * M
+        for post, py in (("left", y), ("right", -y)):
+            lines.append(f'<geom name="goal_{"opponent" if sign > 0 else "own"}_{post}" type="cylinder" size="{r:.4g} {h / 2:.4g}" '
+                         f'pos="{x:.4g} {py:.4g} {h / 2:.4g}" rgba="1 1 1 1" contype="{WORLD_GROUP}" conaffinity="{WORLD_GROUP | ROBOT_GROUP}"/>')
+        lines.append(f'<geom name="goal_{"opponent" if sign > 0 else "own"}_bar" type="capsule" size="{r:.4g}" '
+                     f'fromto="{x:.4g} {-y:.4g} {h:.4g} {x:.4g} {y:.4g} {h:.4g}" rgba="1 1 1 1" contype="0" conaffinity="0"/>')
+    ball_r = field.BALL_RADIUS * M
+    lines += [
+        f'<body name="ball" pos="1 0 {ball_r:.4g}">',
+        '  <freejoint name="ball"/>',
+        f'  <geom name="ball" type="sphere" size="{ball_r:.4g}" mass="{field.BALL_MASS}" rgba="1 0.42 0 1" '
+        f'contype="{WORLD_GROUP}" conaffinity="{WORLD_GROUP | ROBOT_GROUP}" condim="6" friction="0.6 0.01 0.002"/>',
+        "</body>",
+    ]
+    return lines
+
+
+def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002) -> str:
+    """MuJoCo XML of the robot on the field with the ball."""
+    children: dict[str, list] = {}
+    for joint in JOINTS:
+        children.setdefault(joint.parent, []).append(joint)
+    torso_shapes = shapes("torso")
+    center, diagonal = inertia(TORSO_MASS, torso_shapes)
+    robot = [
+        f'<body name="torso" pos="0 0 {STANDING_HEIGHT + 0.002:.4f}">',
+        '  <freejoint name="root"/>',
+        f'  <inertial pos="{_vec(center)}" mass="{TORSO_MASS}" diaginertia="{_vec(diagonal)}"/>',
+        "  " + _geom_xml(torso_shapes[0], "torso_geom0"),
+        f'  <site name="imu" pos="{_vec(np.array(IMU_POSITION) * M)}" size="0.005"/>',
+        *_body_xml("torso", children, "  "),
+        "</body>",
+    ]
+    actuated = [j for j in JOINTS if j.name not in COUPLED_JOINTS]
+    actuators = [f'<position name="{j.name}" joint="{j.name}" kp="{SERVO_GAIN}" kv="0" ctrlrange="{j.limits[0]:.6g} {j.limits[1]:.6g}" '
+                 f'forcerange="{-SERVO_TORQUE} {SERVO_TORQUE}"/>' for j in actuated]
+    equalities = [f'<joint joint1="{follower}" joint2="{leader}" polycoef="0 1 0 0 0"/>' for follower, leader in COUPLED_JOINTS.items()]
+    sensors = ['<accelerometer name="accelerometer" site="imu"/>', '<gyro name="gyroscope" site="imu"/>']
+    sensors += [f'<touch name="{name}" site="{name}"/>' for side in "LR" for name, _ in fsr_sites(side)]
+    width, height = offscreen
+    return "\n".join([
+        '<mujoco model="tafel-nao-spl">',
+        f'  <option timestep="{timestep}" integrator="implicitfast" cone="elliptic"/>',
+        '  <compiler angle="radian" autolimits="true"/>',
+        f'  <visual><global offwidth="{width}" offheight="{height}"/><quality shadowsize="0"/>'
+        '<headlight ambient="0.45 0.45 0.45" diffuse="0.5 0.5 0.5" specular="0 0 0"/></visual>',
+        '  <asset><material name="carpet" rgba="0.18 0.55 0.2 1" reflectance="0"/></asset>',
+        "  <worldbody>",
+        '    <light name="sun" pos="0 0 6" dir="0 0 -1" directional="true" diffuse="0.6 0.6 0.6" castshadow="false"/>',
+        *("    " + line for line in _field_xml()),
+        *("    " + line for line in robot),
+        "  </worldbody>",
+        "  <equality>", *("    " + e for e in equalities), "  </equality>",
+        "  <actuator>", *("    " + a for a in actuators), "  </actuator>",
+        "  <sensor>", *("    " + s for s in sensors), "  </sensor>",
+        "</mujoco>",
+    ]) + "\n"
+
+
+def urdf() -> str:
+    """The robot alone as URDF (links, joints, limits, masses, inertias, collision shapes), in metres."""
+    out = ['<?xml version="1.0"?>', '<robot name="tafel-nao">']
+
+    def link_xml(name: str, mass: float, link_shapes: list[Shape]) -> None:
+        center, diagonal = inertia(mass, link_shapes)
+        out.append(f'  <link name={quoteattr(name)}>')
+        out.append(f'    <inertial><origin xyz="{_vec(center)}"/><mass value="{mass:.6g}"/>'
+                   f'<inertia ixx="{diagonal[0]:.6g}" iyy="{diagonal[1]:.6g}" izz="{diagonal[2]:.6g}" ixy="0" ixz="0" iyz="0"/></inertial>')
+        for shape in link_shapes:
+            geometry, origin = _urdf_geometry(shape)
+            for tag in ("collision", "visual"):
+                out.append(f"    <{tag}>{origin}<geometry>{geometry}</geometry></{tag}>")
+        out.append("  </link>")
+
+    link_xml("torso", TORSO_MASS, shapes("torso"))
+    for joint in JOINTS:
+        link_xml(joint.link, joint.mass, shapes(joint.link))
+        low, high = joint.limits
+        out.append(f'  <joint name={quoteattr(joint.name)} type="revolute"><parent link="{joint.parent}"/><child link="{joint.link}"/>'
+                   f'<origin xyz="{_vec(np.array(joint.offset) * M)}"/><axis xyz="{_vec(joint.axis)}"/>'
+                   f'<limit lower="{low:.6g}" upper="{high:.6g}" effort="{SERVO_TORQUE}" velocity="8"/>'
+                   f'<dynamics damping="{JOINT_DAMPING}"/></joint>')
+    out.append("</robot>")
+    return "\n".join(out) + "\n"
+
+
+def _urdf_geometry(shape: Shape) -> tuple[str, str]:
+    if shape.kind == "box":
+        return f'<box size="{_vec(tuple(2 * h for h in shape.size))}"/>', f'<origin xyz="{_vec(shape.center)}"/>'
+    if shape.kind == "sphere":
+        return f'<sphere radius="{shape.size[0]:.6g}"/>', f'<origin xyz="{_vec(shape.center)}"/>'
+    start, end = np.array(shape.center), np.array(shape.end)
+    direction = end - start
+    length = float(np.linalg.norm(direction))
+    # URDF cylinders lie along z: tilt z onto the capsule's direction
+    pitch = math.atan2(math.hypot(direction[0], direction[1]), direction[2])
+    yaw = math.atan2(direction[1], direction[0])
+    origin = f'<origin xyz="{_vec((start + end) / 2)}" rpy="0 {pitch:.6g} {yaw:.6g}"/>'
+    return f'<capsule radius="{shape.size[0]:.6g}" length="{length:.6g}"/>', origin
