@@ -199,6 +199,11 @@ class LockstepRuntime:
         if recorder is not None:
             for runner in self.runners.values():
                 runner.after_step.append(recorder_hook(recorder))
+        self.ticks = 0
+        self._opened = False
+        self._main_rate = Fraction(str(self.plans[self.main].rate_hz))
+        self._cognition_rate = Fraction(str(self.plans["cognition"].rate_hz)) if "cognition" in self.plans else Fraction(0)
+        self._motion_status = self._cognition_status()
         self.time_ns = 0
         self.wall_s = 0.0
         self.stop = StopFlag()
@@ -212,8 +217,50 @@ class LockstepRuntime:
     def managers(self) -> dict[str, ModuleManager]:
         return {name: runner.manager for name, runner in self.runners.items()}
 
+    def open(self) -> None:
+        """Start the platform (once); ``run`` does this itself, tests and tools stepping by hand call it."""
+        if not self._opened:
+            self.platform.start(frozenset(self.runners))
+            self._opened = True
+
+    def close(self) -> None:
+        """Stop the platform and finish the recording (once)."""
+        if self._opened:
+            self._opened = False
+            self.platform.stop()
+            if self.recorder is not None:
+                self.recorder.stop()
+
+    def next_time_ns(self) -> int:
+        """Platform time of the next tick of the rate schedule."""
+        return int(Fraction(self.ticks * 10**9) / self._main_rate)
+
+    def tick(self) -> int:
+        """One tick of the rate schedule: the main context's frame, and cognition's if it is due.
+
+        Motion runs first, so cognition sees this tick's motion results (camera matrices).
+        Returns the tick's platform time (ns).
+        """
+        self.open()
+        time_ns = self.next_time_ns()
+        self.time_ns = time_ns
+        self.platform.advance(time_ns)
+        cognition = self.runners.get("cognition") if self.main == "motion" else None
+        if self._motion_status is not None and cognition is not None:
+            self._motion_status.alive = True
+            self._motion_status.frame_number = cognition.frames
+            self._motion_status.age = (time_ns - cognition.time_ns) * 1e-9 if cognition.frames else 0.0
+        self.runners[self.main].step(time_ns)
+        # cognition tick k is due at k / cognition_rate seconds: compare exactly
+        if cognition is not None and self.ticks * self._cognition_rate >= cognition.frames * self._main_rate:
+            cognition.step(time_ns)
+        self.ticks += 1
+        for hook in self.after_tick:
+            hook(self)
+        return time_ns
+
     def run(self, limits: Limits) -> dict[str, ContextStats]:
-        self.platform.start(frozenset(self.runners))
+        self.open()
         start = time.monotonic()
         try:
             if self.platform.drives_schedule:
@@ -224,27 +271,21 @@ class LockstepRuntime:
             self.end_reason = str(exc) or "end of data"
         finally:
             self.wall_s = time.monotonic() - start
-            self.platform.stop()
-            if self.recorder is not None:
-                self.recorder.stop()
+            self.close()
         if self.stop.is_set() and not self.end_reason:
             self.end_reason = "stopped"
         return self.stats()
 
     def _run_rate_schedule(self, limits: Limits) -> None:
-        """Motion on every tick, cognition whenever simulated time has passed its next tick."""
-        main_rate = Fraction(str(self.plans[self.main].rate_hz))
-        cognition = self.runners.get("cognition") if self.main == "motion" else None
-        cognition_rate = Fraction(str(self.plans["cognition"].rate_hz)) if cognition else None
-        motion_status = self._cognition_status()
+        """Ticks paced to the wall clock (or as fast as possible) until a limit or a stop."""
         start = time.monotonic()
-        tick = 0
+        first = self.ticks
         try:
             while not self.stop.is_set():
-                if limits.frames is not None and tick >= limits.frames:
+                if limits.frames is not None and self.ticks - first >= limits.frames:
                     self.end_reason = f"{limits.frames} {self.main} frames"
                     break
-                time_ns = int(Fraction(tick * 10**9) / main_rate)
+                time_ns = self.next_time_ns()
                 if limits.seconds is not None and time_ns >= limits.seconds * 1e9:
                     self.end_reason = f"{limits.seconds:g} s"
                     break
@@ -252,21 +293,9 @@ class LockstepRuntime:
                     delay = start + time_ns * 1e-9 / limits.speed - time.monotonic()
                     if delay > 0:
                         self.idle(delay)
-                self.time_ns = time_ns
-                self.platform.advance(time_ns)
-                if motion_status is not None and cognition is not None:
-                    motion_status.alive = True
-                    motion_status.frame_number = cognition.frames
-                    motion_status.age = (time_ns - cognition.time_ns) * 1e-9 if cognition.frames else 0.0
-                self.runners[self.main].step(time_ns)
-                # cognition tick k is due at k / cognition_rate seconds: compare exactly
-                if cognition is not None and tick * cognition_rate >= cognition.frames * main_rate:
-                    cognition.step(time_ns)
-                tick += 1
-                for hook in self.after_tick:
-                    hook(self)
+                self.tick()
         finally:
-            self.time_ns = int(Fraction(tick * 10**9) / main_rate)  # platform time covered by the ticks run
+            self.time_ns = self.next_time_ns()  # platform time covered by the ticks run
 
     def _run_platform_schedule(self, limits: Limits) -> None:
         """The platform says which contexts run next and at what time (log replay)."""

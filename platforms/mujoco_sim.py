@@ -86,6 +86,7 @@ class MujocoPlatform(Platform):
         self.viewer: Any = None
         self.paused = False
         self.time_ns = 0
+        self.last_steps = 0  # physics steps of the last advance (benchmarks read it)
         self.rng = np.random.default_rng(self.seed)
 
     @classmethod
@@ -166,6 +167,7 @@ class MujocoPlatform(Platform):
     def advance(self, time_ns: int) -> None:
         steps = int(round((time_ns - self.time_ns) * 1e-9 / TIMESTEP))
         self.time_ns = time_ns
+        self.last_steps = 0 if self.paused else max(steps, 0)
         if self.paused or steps <= 0:
             return
         for _ in range(steps):

@@ -117,10 +117,13 @@ def inertia(mass: float, link_shapes: list[Shape]) -> tuple[tuple[float, float, 
 
 
 def fsr_sites(side: str) -> list[tuple[str, tuple[float, float, float]]]:
-    """Four pressure sensors per sole: front-left, front-right, rear-left, rear-right (m, foot frame)."""
-    left = (SOLE_OUTSIDE if side == "L" else SOLE_INSIDE) * M - 0.012
-    right = -(SOLE_INSIDE if side == "L" else SOLE_OUTSIDE) * M + 0.012
-    front, rear = SOLE_FRONT * M - 0.015, -SOLE_BACK * M + 0.015
+    """Four pressure sensors per sole: front-left, front-right, rear-left, rear-right (m, foot frame).
+
+    Centred on the sole's corners, where a flat sole's contacts with the ground are.
+    """
+    left = (SOLE_OUTSIDE if side == "L" else SOLE_INSIDE) * M
+    right = -(SOLE_INSIDE if side == "L" else SOLE_OUTSIDE) * M
+    front, rear = SOLE_FRONT * M, -SOLE_BACK * M
     z = -FOOT_HEIGHT * M
     return [(f"{side}FsrFrontLeft", (front, left, z)), (f"{side}FsrFrontRight", (front, right, z)),
             (f"{side}FsrRearLeft", (rear, left, z)), (f"{side}FsrRearRight", (rear, right, z))]
@@ -166,7 +169,7 @@ def _body_xml(link: str, children: dict[str, list], indent: str) -> list[str]:
             lines.append(inner + _geom_xml(shape, f"{joint.link}_geom{i}"))
         if joint.link.endswith("Foot"):
             for name, position in fsr_sites(joint.link[0]):
-                lines.append(f'{inner}<site name="{name}" type="box" size="0.014 0.014 0.006" pos="{_vec(position)}" rgba="1 0 0 0"/>')
+                lines.append(f'{inner}<site name="{name}" type="box" size="0.02 0.02 0.008" pos="{_vec(position)}" rgba="1 0 0 0"/>')
         lines += [inner + c for c in _camera_xml(joint.link)]
         lines += _body_xml(joint.link, children, inner)
         lines.append(f"{indent}</body>")

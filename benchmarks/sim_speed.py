@@ -1,0 +1,97 @@
+"""Simulation speed: real-time factor of the whole program at --speed max, with and without cameras.
+
+For each engine, runs the default configuration (every module of both contexts) in lockstep as fast as
+possible for ``--seconds`` of simulated time, with both cameras rendered at 320x240 at 30 Hz and with
+the cameras off; and times each physics step and each camera render inside those runs.
+Prints one JSON line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from tests.support.simulation import Simulation  # noqa: E402
+
+ENGINES = ("mujoco",)
+
+
+def instrument(sim: Simulation) -> dict[str, list[float]]:
+    """Wrap the platform's stepping and rendering with timers (seconds per call)."""
+    timings: dict[str, list[float]] = {"advance": [], "steps": [], "render": []}
+    platform = sim.platform
+    original_advance = platform.advance
+
+    def timed_advance(time_ns: int) -> None:
+        start = time.perf_counter()
+        original_advance(time_ns)
+        timings["advance"].append(time.perf_counter() - start)
+        timings["steps"].append(platform.last_steps)
+
+    platform.advance = timed_advance
+    for name, renderer in list(getattr(platform, "renderers", {}).items()):
+        platform.renderers[name] = TimedRenderer(renderer, timings["render"])
+    return timings
+
+
+class TimedRenderer:
+    def __init__(self, renderer, sink: list[float]) -> None:
+        self.renderer, self.sink = renderer, sink
+
+    def update_scene(self, *args, **kwargs):
+        self._start = time.perf_counter()
+        return self.renderer.update_scene(*args, **kwargs)
+
+    def render(self, *args, **kwargs):
+        result = self.renderer.render(*args, **kwargs)
+        self.sink.append(time.perf_counter() - self._start)
+        return result
+
+    def close(self) -> None:
+        self.renderer.close()
+
+
+def measure(engine: str, seconds: float, cameras: bool) -> dict:
+    sim = Simulation(engine, cameras="on" if cameras else "off", resolution="320x240")
+    try:
+        timings = instrument(sim)
+        sim.run(0.5)  # warm up (first renders, first module calls)
+        for values in timings.values():
+            values.clear()
+        start = time.perf_counter()
+        sim.run(seconds)
+        wall = time.perf_counter() - start
+    finally:
+        sim.close()
+    steps = sum(timings["steps"])
+    result = {"realtime_factor": round(seconds / wall, 2), "wall_s": round(wall, 2)}
+    if steps:
+        result["physics_step_us"] = round(sum(timings["advance"]) / steps * 1e6, 1)
+    if timings["render"]:
+        result["render_ms"] = round(statistics.fmean(timings["render"]) * 1e3, 2)
+        result["renders_per_sim_s"] = round(len(timings["render"]) / seconds, 1)
+    return result
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seconds", type=float, default=20.0, help="simulated seconds per run (default 20)")
+    args = parser.parse_args()
+    report = {}
+    for engine in ENGINES:
+        report[engine] = {
+            "cameras_on": measure(engine, args.seconds, cameras=True),
+            "cameras_off": measure(engine, args.seconds, cameras=False),
+        }
+    report["targets"] = {"realtime_factor_cameras_on_min": 1.0, "realtime_factor_cameras_off_min": 10.0}
+    print(json.dumps(report))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,40 @@
+"""Run the real program in-process on a simulator, with access to ground truth, for tests."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from core.config import load_config
+from core.platform import load_platform
+from core.program import plan_program
+from core.runtime import LockstepRuntime
+from tools.cli import DEFAULT_CONFIG, discover_modules
+
+
+class Simulation:
+    """The default configuration on a simulated platform, stepped by hand; the platform is ground truth."""
+
+    def __init__(self, platform: str, overrides: list[str] | None = None, **options: Any) -> None:
+        discover_modules()
+        self.platform = load_platform(platform)(options)
+        self.plans = plan_program(load_config(DEFAULT_CONFIG, platform, overrides=overrides or []), self.platform)
+        self.runtime = LockstepRuntime(self.plans, self.platform)
+        self.runtime.open()
+
+    def blackboard(self, context: str) -> Any:
+        return self.runtime.runners[context].manager.blackboard
+
+    @property
+    def time(self) -> float:
+        """Simulated seconds of the last tick."""
+        return self.runtime.time_ns * 1e-9
+
+    def run(self, seconds: float, every_tick: Callable[[Simulation], None] | None = None) -> None:
+        for _ in range(int(round(seconds * self.plans["motion"].rate_hz))):
+            self.runtime.tick()
+            if every_tick is not None:
+                every_tick(self)
+
+    def close(self) -> None:
+        self.runtime.close()

@@ -1,0 +1,184 @@
+"""The MuJoCo platform and the first pipeline: standing, seeing the ball, tracking it with the head."""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from core.testing import ModuleHarness
+from modules.motion.camera_matrix_provider import CameraMatrixProvider
+from modules.perception.ball_detector import BallDetector
+from representations.field import BALL_RADIUS
+from representations.modeling import BallModel
+from representations.motion import HEAD_YAW, InertialModel, InertialSensorData, JointSensorData
+from representations.perception import BallPercept, CameraImageBottom, CameraImageTop
+from tests.support.simulation import Simulation
+from tests.test_cli_runtime import REPO, frames, tafel
+
+STANDING_TORSO_HEIGHT = 250.0  # mm: a fallen robot's torso is below 150
+
+
+@pytest.fixture
+def sim(request):
+    simulation = Simulation("mujoco", **getattr(request, "param", {}))
+    yield simulation
+    simulation.close()
+
+
+@pytest.mark.parametrize("sim", [{"cameras": "off"}], indirect=True)
+def test_the_robot_stands_for_20_seconds(sim: Simulation) -> None:
+    heights: list[float] = []
+    sim.run(20.0, lambda s: heights.append(s.platform.torso_height()))
+    assert min(heights) > STANDING_TORSO_HEIGHT, min(heights)
+    assert heights[-1] == pytest.approx(heights[-500], abs=1.0)  # settled, not sinking
+    roll, pitch = sim.platform.torso_angles()
+    assert abs(roll) < 0.05 and abs(pitch) < 0.1
+
+
+def head_yaw_error(sim: Simulation) -> float:
+    """Degrees between where the head points and where the ball is (seen from the robot)."""
+    yaw = sim.blackboard("motion")[JointSensorData].position[HEAD_YAW]
+    x, y = sim.platform.ball_in_robot_frame()
+    return abs(math.degrees(yaw - math.atan2(y, x)))
+
+
+def model_distance_error(sim: Simulation) -> float:
+    """Relative error of the ball model's distance against the true distance."""
+    model = sim.blackboard("cognition")[BallModel]
+    x, y = sim.platform.ball_in_robot_frame()
+    return abs(math.hypot(model.x, model.y) - math.hypot(x, y)) / math.hypot(x, y)
+
+
+@pytest.mark.parametrize("sim", [{"ball": "1500,500"}], indirect=True)
+def test_the_head_tracks_the_ball_and_follows_when_it_moves(sim: Simulation) -> None:
+    sim.run(3.0)
+    assert sim.blackboard("cognition")[BallModel].valid
+    assert head_yaw_error(sim) < 5.0
+    assert model_distance_error(sim) < 0.10
+    sim.platform.move_ball(1500, -500)
+    sim.run(2.0)
+    assert head_yaw_error(sim) < 5.0
+    assert sim.blackboard("cognition")[BallModel].y < 0
+    assert sim.platform.torso_height() > STANDING_TORSO_HEIGHT
+
+
+@pytest.mark.parametrize(
+    ("ball", "camera"),
+    [((700.0, 0.0), "top"), ((1500.0, 400.0), "top"), ((2500.0, -500.0), "top"), ((250.0, 60.0), "bottom")],
+)
+def test_detector_finds_the_ball_in_rendered_images(ball: tuple[float, float], camera: str) -> None:
+    sim = Simulation("mujoco", ball=f"{ball[0]},{ball[1]}")
+    try:
+        sim.run(1.5)  # stand up first, so the cameras are where the stand puts them
+        sim.platform.move_ball(*ball)
+        sim.run(0.1)
+        motion, cognition = sim.blackboard("motion"), sim.blackboard("cognition")
+        # the detector alone, on what the platform rendered and the kinematics computed
+        matrices = ModuleHarness(CameraMatrixProvider, motion[JointSensorData], InertialModel(roll=motion[InertialSensorData].angles[0],
+                                                                                                 pitch=motion[InertialSensorData].angles[1])).execute()
+        from representations.motion import CameraMatrixBottom, CameraMatrixTop
+
+        percept = ModuleHarness(BallDetector, cognition[CameraImageTop], cognition[CameraImageBottom],
+                                matrices[CameraMatrixTop], matrices[CameraMatrixBottom]).execute()[BallPercept]
+        truth = sim.platform.ball_in_robot_frame()
+        assert percept.seen and percept.camera == camera
+        distance = math.hypot(*truth)
+        assert math.hypot(percept.x - truth[0], percept.y - truth[1]) < max(40.0, 0.05 * distance)
+        assert percept.radius > 1.0
+    finally:
+        sim.close()
+
+
+def test_no_ball_in_view_no_percept(sim: Simulation) -> None:
+    sim.platform.move_ball(-2000, 0)  # behind the robot
+    sim.run(0.5)
+    assert not sim.blackboard("cognition")[BallPercept].seen
+
+
+def test_detector_rejects_orange_that_is_not_a_ball() -> None:
+    image = CameraImageTop(horizontal_fov=math.radians(56.3), vertical_fov=math.radians(43.7))
+    image.image = np.zeros((240, 320, 3), np.uint8)
+    image.image[:, :] = (40, 140, 50)
+    image.image[100:104, 20:300] = (255, 107, 0)  # an orange stripe: not round
+    from representations.motion import CameraMatrixTop
+
+    matrix = CameraMatrixTop(valid=True, translation=np.array([0.0, 0.0, 500.0]))
+    matrix.rotation = np.array([[math.cos(0.3), 0, math.sin(0.3)], [0, 1, 0], [-math.sin(0.3), 0, math.cos(0.3)]])
+    bb = ModuleHarness(BallDetector, image, matrix).execute()
+    assert not bb[BallPercept].seen
+
+
+def test_images_have_the_published_field_of_view(sim: Simulation) -> None:
+    sim.run(0.1)
+    image = sim.blackboard("cognition")[CameraImageTop]
+    assert image.image.shape == (240, 320, 3) and image.image.dtype == np.uint8
+    assert math.degrees(image.vertical_fov) == pytest.approx(43.7)
+    assert math.degrees(image.horizontal_fov) == pytest.approx(56.3, abs=0.2)
+    assert image.image.std() > 5  # something was rendered
+
+
+def test_sensors_have_the_projects_units(sim: Simulation) -> None:
+    sim.run(2.0)
+    motion = sim.blackboard("motion")
+    assert motion[InertialSensorData].accelerometer[2] == pytest.approx(9.81, abs=0.5)  # upright
+    from representations.motion import FsrData
+
+    total_kg = motion[FsrData].pressure.sum()
+    assert total_kg == pytest.approx(5.36, rel=0.15)  # the robot's weight on its soles
+
+
+def test_debug_commands_move_things_and_pause_physics(sim: Simulation) -> None:
+    commands = sim.platform.commands()
+    assert commands["sim:move_ball"][1]({"x": "2000", "y": "-300"}) == "ball at x=2000 y=-300 mm"
+    assert sim.platform.ball_position() == pytest.approx((2000.0, -300.0))
+    commands["sim:pause"][1]({})
+    before = sim.platform.data.time
+    sim.run(0.2)
+    assert sim.platform.data.time == before
+    commands["sim:resume"][1]({})
+    sim.run(0.2)
+    assert sim.platform.data.time > before
+    commands["sim:move_robot"][1]({"x": "500", "y": "0", "rotation": "1.0"})
+    assert sim.platform.robot_pose()[2] == pytest.approx(1.0, abs=1e-6)
+    assert "ball x=2000" in commands["sim:status"][1]({})
+
+
+def test_runs_are_deterministic() -> None:
+    runs = [tafel("run", "--platform", "mujoco", "--no-debug", "--frames", "150", "--speed", "max") for _ in range(2)]
+    assert runs[0].returncode == 0, runs[0].stderr
+    assert runs[0].stdout == runs[1].stdout
+    assert frames(runs[0].stdout) == {"cognition": 45, "motion": 150}
+
+
+def test_tafel_run_without_arguments_runs_the_simulator_with_the_debug_server() -> None:
+    process = subprocess.Popen([sys.executable, "-m", "tools.cli", "run", "--seconds", "3", "--status-interval", "1"],
+                               cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               env={**os.environ, "PYTHONPATH": str(REPO)})
+    out, err = process.communicate(timeout=120)
+    assert process.returncode == 0, err
+    assert re.search(r"debug server listening on 127\.0\.0\.1:\d+", out) or "running without the debug server" in err
+    assert "platform mujoco (lockstep)" in out
+    assert re.search(r"ball seen at x=\d+ y=\d+ mm", err), err
+
+
+def test_viewer_without_a_display_says_so_and_runs_headless() -> None:
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    result = subprocess.run([sys.executable, "-m", "tools.cli", "run", "--viewer", "--frames", "20", "--speed", "max", "--no-debug"],
+                            cwd=REPO, capture_output=True, text=True, timeout=120, env={**env, "PYTHONPATH": str(REPO)})
+    assert result.returncode == 0, result.stderr
+    assert "--viewer needs a display" in result.stderr
+
+
+def test_concurrent_is_refused_with_a_reason() -> None:
+    result = tafel("run", "--platform", "mujoco", "--concurrent", "--frames", "10", "--no-debug")
+    assert result.returncode == 1 and "run it without --concurrent" in result.stderr
+
+
+def test_ball_radius_constant_matches_the_model(sim: Simulation) -> None:
+    assert sim.platform.model.geom("ball").size[0] * 1000 == pytest.approx(BALL_RADIUS)
