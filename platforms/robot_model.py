@@ -176,13 +176,33 @@ def _body_xml(link: str, children: dict[str, list], indent: str) -> list[str]:
     return lines
 
 
-def _field_xml() -> list[str]:
-    """Carpet, lines (visual only), goals and ball."""
+@dataclass(frozen=True)
+class FieldPart:
+    """One piece of the field world (m). ``kind``: plane, box (size = half extents, turned by ``yaw``),
+    cylinder (radius, half height), capsule (radius; from ``start`` to ``end``), or sphere (the ball)."""
+
+    name: str
+    kind: str
+    position: tuple[float, float, float]
+    size: tuple[float, ...]
+    rgba: tuple[float, float, float, float]
+    collides: bool = True
+    yaw: float = 0.0
+    end: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    mass: float = 0.0  # > 0: a free body (the ball)
+
+
+CARPET_RGBA = (0.18, 0.55, 0.2, 1.0)
+WHITE = (1.0, 1.0, 1.0, 1.0)
+BALL_RGBA = (1.0, 0.42, 0.0, 1.0)
+
+
+def field_parts(ball: tuple[float, float] = (1.0, 0.0)) -> list[FieldPart]:
+    """Carpet, lines (visual only), goals and the ball at ``ball`` (m), from ``representations.field``."""
     half_x, half_y = field.LENGTH / 2 * M, field.WIDTH / 2 * M
-    carpet_x, carpet_y = half_x + field.BORDER_STRIP * M, half_y + field.BORDER_STRIP * M
+    carpet = (half_x + field.BORDER_STRIP * M, half_y + field.BORDER_STRIP * M, 0.1)
+    parts = [FieldPart("carpet", "plane", (0.0, 0.0, 0.0), carpet, CARPET_RGBA)]
     w = field.LINE_WIDTH / 2 * M
-    lines = [f'<geom name="carpet" type="plane" size="{carpet_x:.4g} {carpet_y:.4g} 0.1" material="carpet" '
-             f'contype="{WORLD_GROUP}" conaffinity="{ROBOT_GROUP | WORLD_GROUP}" friction="1.0 0.02 0.002"/>']
     segments: list[tuple[float, float, float, float]] = [
         (-half_x, -half_y, half_x, -half_y), (-half_x, half_y, half_x, half_y),
         (-half_x, -half_y, -half_x, half_y), (half_x, -half_y, half_x, half_y), (0.0, -half_y, 0.0, half_y),
@@ -198,27 +218,43 @@ def _field_xml() -> list[str]:
         segments.append((radius * math.cos(a), radius * math.sin(a), radius * math.cos(b), radius * math.sin(b)))
     for i, (x1, y1, x2, y2) in enumerate(segments):
         length = math.hypot(x2 - x1, y2 - y1)
-        angle = math.atan2(y2 - y1, x2 - x1)
-        lines.append(f'<geom name="line{i}" type="box" size="{length / 2 + w:.4g} {w:.4g} 0.0005" pos="{(x1 + x2) / 2:.4g} {(y1 + y2) / 2:.4g} 0.0005" '
-                     f'euler="0 0 {angle:.6g}" rgba="1 1 1 1" contype="0" conaffinity="0"/>')
-    for sign in (-1.0, 1.0):
+        parts.append(FieldPart(f"line{i}", "box", ((x1 + x2) / 2, (y1 + y2) / 2, 0.0005), (length / 2 + w, w, 0.0005),
+                               WHITE, collides=False, yaw=math.atan2(y2 - y1, x2 - x1)))
+    for sign, side in ((1.0, "opponent"), (-1.0, "own")):
         x = sign * (half_x + field.GOAL_POST_DIAMETER / 2 * M)
         y = (field.GOAL_INNER_WIDTH + field.GOAL_POST_DIAMETER) / 2 * M
         r, h = field.GOAL_POST_DIAMETER / 2 * M, field.GOAL_HEIGHT * M
         for post, py in (("left", y), ("right", -y)):
-            lines.append(f'<geom name="goal_{"opponent" if sign > 0 else "own"}_{post}" type="cylinder" size="{r:.4g} {h / 2:.4g}" '
-                         f'pos="{x:.4g} {py:.4g} {h / 2:.4g}" rgba="1 1 1 1" contype="{WORLD_GROUP}" conaffinity="{WORLD_GROUP | ROBOT_GROUP}"/>')
-        lines.append(f'<geom name="goal_{"opponent" if sign > 0 else "own"}_bar" type="capsule" size="{r:.4g}" '
-                     f'fromto="{x:.4g} {-y:.4g} {h:.4g} {x:.4g} {y:.4g} {h:.4g}" rgba="1 1 1 1" contype="0" conaffinity="0"/>')
+            parts.append(FieldPart(f"goal_{side}_{post}", "cylinder", (x, py, h / 2), (r, h / 2), WHITE))
+        parts.append(FieldPart(f"goal_{side}_bar", "capsule", (x, -y, h), (r,), WHITE, collides=False, end=(x, y, h)))
     ball_r = field.BALL_RADIUS * M
-    lines += [
-        f'<body name="ball" pos="1 0 {ball_r:.4g}">',
-        '  <freejoint name="ball"/>',
-        f'  <geom name="ball" type="sphere" size="{ball_r:.4g}" mass="{field.BALL_MASS}" rgba="1 0.42 0 1" '
-        f'contype="{WORLD_GROUP}" conaffinity="{WORLD_GROUP | ROBOT_GROUP}" condim="6" friction="0.6 0.01 0.002"/>',
-        "</body>",
-    ]
+    parts.append(FieldPart("ball", "sphere", (ball[0], ball[1], ball_r), (ball_r,), BALL_RGBA, mass=field.BALL_MASS))
+    return parts
+
+
+def _field_xml() -> list[str]:
+    lines = []
+    for part in field_parts():
+        rgba = _vec(part.rgba)
+        groups = f'contype="{WORLD_GROUP}" conaffinity="{WORLD_GROUP | ROBOT_GROUP}"' if part.collides else 'contype="0" conaffinity="0"'
+        if part.kind == "plane":
+            lines.append(f'<geom name="{part.name}" type="plane" size="{_vec(part.size)}" rgba="{rgba}" {groups} friction="1.0 0.02 0.002"/>')
+        elif part.kind == "box":
+            lines.append(f'<geom name="{part.name}" type="box" size="{_vec(part.size)}" pos="{_vec(part.position)}" '
+                         f'euler="0 0 {part.yaw:.6g}" rgba="{rgba}" {groups}/>')
+        elif part.kind == "cylinder":
+            lines.append(f'<geom name="{part.name}" type="cylinder" size="{_vec(part.size)}" pos="{_vec(part.position)}" rgba="{rgba}" {groups}/>')
+        elif part.kind == "capsule":
+            lines.append(f'<geom name="{part.name}" type="capsule" size="{_vec(part.size)}" fromto="{_vec(part.position)} {_vec(part.end)}" rgba="{rgba}" {groups}/>')
+        elif part.kind == "sphere":
+            lines += [f'<body name="{part.name}" pos="{_vec(part.position)}">', f'  <freejoint name="{part.name}"/>',
+                      f'  <geom name="{part.name}" type="sphere" size="{_vec(part.size)}" mass="{part.mass}" rgba="{rgba}" '
+                      f'{groups} condim="6" friction="{BALL_FRICTION}"/>', "</body>"]
     return lines
+
+
+#: sliding, torsional and rolling friction of the ball (MuJoCo's three coefficients)
+BALL_FRICTION = "0.6 0.01 0.002"
 
 
 def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002) -> str:
@@ -229,7 +265,7 @@ def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002) ->
     torso_shapes = shapes("torso")
     center, diagonal = inertia(TORSO_MASS, torso_shapes)
     robot = [
-        f'<body name="torso" pos="0 0 {STANDING_HEIGHT + 0.002:.4f}">',
+        f'<body name="torso" pos="0 0 {STANDING_HEIGHT + 0.002:.7g}">',
         '  <freejoint name="root"/>',
         f'  <inertial pos="{_vec(center)}" mass="{TORSO_MASS}" diaginertia="{_vec(diagonal)}"/>',
         "  " + _geom_xml(torso_shapes[0], "torso_geom0"),
@@ -250,7 +286,6 @@ def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002) ->
         '  <compiler angle="radian" autolimits="true"/>',
         f'  <visual><global offwidth="{width}" offheight="{height}"/><quality shadowsize="0"/>'
         '<headlight ambient="0.45 0.45 0.45" diffuse="0.5 0.5 0.5" specular="0 0 0"/></visual>',
-        '  <asset><material name="carpet" rgba="0.18 0.55 0.2 1" reflectance="0"/></asset>',
         "  <worldbody>",
         '    <light name="sun" pos="0 0 6" dir="0 0 -1" directional="true" diffuse="0.6 0.6 0.6" castshadow="false"/>',
         *("    " + line for line in _field_xml()),

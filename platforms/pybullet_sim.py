@@ -1,0 +1,223 @@
+"""The PyBullet platform: the same robot, field and ball as MuJoCo, from the same description.
+
+The robot is the URDF that ``platforms.robot_model`` generates from ``representations.nao``; the field
+is built from the same ``field_parts``. Cameras render with PyBullet's CPU renderer (no OpenGL at all).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+from typing import Any
+
+import numpy as np
+import pybullet
+
+from core.platform import PlatformError
+from platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, SERVO_TORQUE, FieldPart, field_parts, fsr_sites, urdf
+from platforms.simulated import TIMESTEP, SimulatedRobotPlatform
+from representations.motion import JOINT_NAMES
+from representations.nao import CAMERAS, COUPLED_JOINTS, SOLE_BACK, SOLE_FRONT, VERTICAL_FOV
+
+POSITION_GAIN = 0.1  # PyBullet's position motors: share of the position error corrected per step
+ROBOT_RGBA = (0.87, 0.87, 0.9, 1.0)
+M = 0.001
+
+
+def _quaternion_yaw(yaw: float) -> tuple[float, float, float, float]:
+    return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
+
+
+def _matrix(quaternion: tuple[float, ...]) -> np.ndarray:
+    return np.array(pybullet.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
+
+
+class PybulletPlatform(SimulatedRobotPlatform):
+    name = "pybullet"
+    engine = "PyBullet"
+    description = "PyBullet physics: the same robot, field and ball, cameras on the CPU renderer"
+
+    def __init__(self, options: dict[str, Any] | None = None) -> None:
+        super().__init__(options)
+        self.client: int | None = None
+
+    # ------------------------------------------------------------------------------- the world
+    def build(self, contexts: frozenset[str], viewer: bool) -> None:
+        self.client = pybullet.connect(pybullet.GUI if viewer else pybullet.DIRECT)
+        if self.client < 0:
+            raise PlatformError("PyBullet could not start its physics server")
+        c = self.client
+        pybullet.resetSimulation(physicsClientId=c)
+        pybullet.setGravity(0, 0, -9.81, physicsClientId=c)
+        pybullet.setTimeStep(TIMESTEP, physicsClientId=c)
+        pybullet.setPhysicsEngineParameter(numSolverIterations=50, deterministicOverlappingPairs=1, physicsClientId=c)
+        self.bodies: dict[str, int] = {}
+        ball = (self.initial_ball[0] * M, self.initial_ball[1] * M)
+        for part in field_parts(ball):
+            self.bodies[part.name] = self._field_body(part)
+        self._load_robot()
+        self.previous_velocity = np.zeros(3)
+
+    def _field_body(self, part: FieldPart) -> int:
+        c = self.client
+        kind = {"plane": pybullet.GEOM_PLANE, "box": pybullet.GEOM_BOX, "cylinder": pybullet.GEOM_CYLINDER,
+                "capsule": pybullet.GEOM_CAPSULE, "sphere": pybullet.GEOM_SPHERE}[part.kind]
+        position, orientation = part.position, _quaternion_yaw(part.yaw)
+        shape: dict[str, Any] = {}
+        if part.kind == "box":
+            shape = {"halfExtents": part.size}
+        elif part.kind == "cylinder":
+            shape = {"radius": part.size[0], "length": 2 * part.size[1]}
+        elif part.kind == "sphere":
+            shape = {"radius": part.size[0]}
+        elif part.kind == "capsule":
+            start, end = np.array(part.position), np.array(part.end)
+            direction = end - start
+            shape = {"radius": part.size[0], "length": float(np.linalg.norm(direction))}
+            position = tuple((start + end) / 2)
+            # PyBullet capsules lie along z: tip z over onto the direction
+            orientation = pybullet.getQuaternionFromEuler([0.0, math.atan2(math.hypot(direction[0], direction[1]), direction[2]),
+                                                           math.atan2(direction[1], direction[0])])
+        if part.kind == "plane":
+            visual = pybullet.createVisualShape(pybullet.GEOM_BOX, halfExtents=[part.size[0], part.size[1], 0.0005],
+                                                rgbaColor=part.rgba, visualFramePosition=[0, 0, -0.0005], physicsClientId=c)
+        else:
+            visual = pybullet.createVisualShape(kind, rgbaColor=part.rgba, physicsClientId=c, **shape)
+        if part.collides:  # collision shapes call the length of cylinders and capsules "height"
+            collision_shape = {("height" if k == "length" else k): v for k, v in shape.items()}
+            collision = pybullet.createCollisionShape(kind, physicsClientId=c, **collision_shape)
+        else:
+            collision = -1
+        body = pybullet.createMultiBody(baseMass=part.mass, baseCollisionShapeIndex=collision, baseVisualShapeIndex=visual,
+                                        basePosition=position, baseOrientation=orientation, physicsClientId=c)
+        if part.name == "ball":
+            sliding, spinning, rolling = (float(v) for v in BALL_FRICTION.split())
+            pybullet.changeDynamics(body, -1, lateralFriction=sliding, spinningFriction=spinning, rollingFriction=rolling,
+                                    physicsClientId=c)
+        elif part.kind == "plane":
+            pybullet.changeDynamics(body, -1, lateralFriction=1.0, physicsClientId=c)
+        return body
+
+    def _load_robot(self) -> None:
+        c = self.client
+        with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as handle:
+            handle.write(urdf())
+        try:
+            self.robot = pybullet.loadURDF(handle.name, basePosition=[0, 0, STANDING_HEIGHT + 0.002],
+                                           flags=pybullet.URDF_USE_INERTIA_FROM_FILE, physicsClientId=c)
+        finally:
+            os.unlink(handle.name)
+        names = {pybullet.getJointInfo(self.robot, i, physicsClientId=c)[1].decode(): i
+                 for i in range(pybullet.getNumJoints(self.robot, physicsClientId=c))}
+        self.joint_ids = [names[name] for name in JOINT_NAMES]
+        self.follower_ids = [(names[follower], JOINT_NAMES.index(leader)) for follower, leader in COUPLED_JOINTS.items()]
+        self.head_link = names["HeadPitch"]
+        self.foot_links = {"L": names["LAnkleRoll"], "R": names["RAnkleRoll"]}
+        self.base_inertial = np.array(pybullet.getDynamicsInfo(self.robot, -1, physicsClientId=c)[3])
+        all_joints = list(names.values())
+        pybullet.setJointMotorControlArray(self.robot, all_joints, pybullet.VELOCITY_CONTROL, forces=[0.0] * len(all_joints),
+                                           physicsClientId=c)
+        for link in [-1, *all_joints]:
+            pybullet.changeVisualShape(self.robot, link, rgbaColor=ROBOT_RGBA, physicsClientId=c)
+        for link in self.foot_links.values():
+            pybullet.changeDynamics(self.robot, link, lateralFriction=1.0, spinningFriction=0.02, physicsClientId=c)
+        self.move_ball(*self.initial_ball)
+
+    def stop(self) -> None:
+        if self.client is not None:
+            try:
+                pybullet.disconnect(physicsClientId=self.client)
+            except pybullet.error:
+                pass
+            self.client = None
+
+    # ---------------------------------------------------------------------------------- engine
+    def step_physics(self, steps: int) -> None:
+        before = self._base_velocity()
+        for _ in range(steps):
+            pybullet.stepSimulation(physicsClientId=self.client)
+        after = self._base_velocity()
+        self.acceleration = (after - before) / (steps * TIMESTEP)
+
+    def _base_velocity(self) -> np.ndarray:
+        return np.array(pybullet.getBaseVelocity(self.robot, physicsClientId=self.client)[0])
+
+    def joint_angles(self) -> np.ndarray:
+        states = pybullet.getJointStates(self.robot, self.joint_ids, physicsClientId=self.client)
+        return np.array([state[0] for state in states])
+
+    def joint_torques(self) -> np.ndarray:
+        states = pybullet.getJointStates(self.robot, self.joint_ids, physicsClientId=self.client)
+        return np.array([state[3] for state in states])
+
+    def imu(self) -> tuple[np.ndarray, np.ndarray]:
+        """Proper acceleration (what an accelerometer measures) and angular velocity, in the torso frame."""
+        _, rotation = self.torso_pose()
+        angular = np.array(pybullet.getBaseVelocity(self.robot, physicsClientId=self.client)[1])
+        acceleration = getattr(self, "acceleration", np.zeros(3))
+        return rotation.T @ (acceleration + np.array([0.0, 0.0, 9.81])), rotation.T @ angular
+
+    def foot_forces(self) -> np.ndarray:
+        """Each contact's normal force shared between the sole's four corners by where it is."""
+        forces = np.zeros(8)
+        for index, side in enumerate("LR"):
+            link = self.foot_links[side]
+            state = pybullet.getLinkState(self.robot, link, computeForwardKinematics=True, physicsClientId=self.client)
+            origin, rotation = np.array(state[4]), _matrix(state[5])
+            corners = [np.array(p) for _, p in fsr_sites(side)]
+            left, right = corners[0][1], corners[1][1]
+            for contact in pybullet.getContactPoints(bodyA=self.robot, linkIndexA=link, physicsClientId=self.client):
+                local = rotation.T @ (np.array(contact[5]) - origin)
+                u = min(1.0, max(0.0, (local[0] + SOLE_BACK * M) / ((SOLE_FRONT + SOLE_BACK) * M)))  # 1 at the front
+                v = min(1.0, max(0.0, (local[1] - right) / (left - right)))  # 1 at the left edge
+                force = contact[9]
+                forces[index * 4 : index * 4 + 4] += force * np.array([u * v, u * (1 - v), (1 - u) * v, (1 - u) * (1 - v)])
+        return forces
+
+    def render(self, camera: str) -> np.ndarray:
+        mount = next(m for m in CAMERAS if m.name == camera)
+        state = pybullet.getLinkState(self.robot, self.head_link, computeForwardKinematics=True, physicsClientId=self.client)
+        head_position, head_rotation = np.array(state[4]), _matrix(state[5])
+        c, s = math.cos(mount.tilt), math.sin(mount.tilt)
+        tilt = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])  # pitched down by the mount's tilt
+        eye = head_position + head_rotation @ (np.array(mount.position) * M)
+        axes = head_rotation @ tilt
+        view = pybullet.computeViewMatrix(eye.tolist(), (eye + axes[:, 0]).tolist(), axes[:, 2].tolist())
+        projection = pybullet.computeProjectionMatrixFOV(math.degrees(VERTICAL_FOV), self.width / self.height, 0.01, 30.0)
+        _, _, rgba, _, _ = pybullet.getCameraImage(self.width, self.height, view, projection, renderer=pybullet.ER_TINY_RENDERER,
+                                                   flags=pybullet.ER_NO_SEGMENTATION_MASK, shadow=0,
+                                                   lightDirection=[0.3, 0.2, 1.0], physicsClientId=self.client)
+        return np.asarray(rgba, dtype=np.uint8).reshape(self.height, self.width, 4)[:, :, :3].copy()
+
+    def drive(self, targets: np.ndarray, stiffness: np.ndarray) -> None:
+        joints = list(self.joint_ids) + [follower for follower, _ in self.follower_ids]
+        goals = list(targets) + [targets[leader] for _, leader in self.follower_ids]
+        strength = list(stiffness) + [stiffness[leader] for _, leader in self.follower_ids]
+        pybullet.setJointMotorControlArray(
+            self.robot, joints, pybullet.POSITION_CONTROL, targetPositions=goals,
+            forces=[SERVO_TORQUE * s for s in strength], positionGains=[POSITION_GAIN] * len(joints),
+            velocityGains=[1.0] * len(joints), physicsClientId=self.client,
+        )
+
+    def torso_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        position, orientation = pybullet.getBasePositionAndOrientation(self.robot, physicsClientId=self.client)
+        rotation = _matrix(orientation)
+        return np.array(position) - rotation @ self.base_inertial, rotation  # the link frame, not the centre of mass
+
+    def ball_position(self) -> tuple[float, float]:
+        position, _ = pybullet.getBasePositionAndOrientation(self.bodies["ball"], physicsClientId=self.client)
+        return position[0] * 1000.0, position[1] * 1000.0
+
+    def move_ball(self, x_mm: float, y_mm: float) -> None:
+        ball = self.bodies["ball"]
+        pybullet.resetBasePositionAndOrientation(ball, [x_mm * M, y_mm * M, 0.05], [0, 0, 0, 1], physicsClientId=self.client)
+        pybullet.resetBaseVelocity(ball, [0, 0, 0], [0, 0, 0], physicsClientId=self.client)
+
+    def move_robot(self, x_mm: float, y_mm: float, heading: float = 0.0) -> None:
+        position, _ = self.torso_pose()
+        height = position[2] if position[2] > 0.2 else STANDING_HEIGHT + 0.002
+        rotation = _matrix(_quaternion_yaw(heading))
+        base = np.array([x_mm * M, y_mm * M, height]) + rotation @ self.base_inertial
+        pybullet.resetBasePositionAndOrientation(self.robot, base.tolist(), _quaternion_yaw(heading), physicsClientId=self.client)
+        pybullet.resetBaseVelocity(self.robot, [0, 0, 0], [0, 0, 0], physicsClientId=self.client)

@@ -1,0 +1,243 @@
+"""What every simulated NAO platform shares: options, the representations, sensing, acting, commands.
+
+An engine (MuJoCo, PyBullet) only builds the world from the shared description and answers a handful
+of questions (joint angles, IMU, foot forces, a camera image, where things are); this class turns the
+answers into representations with the same units, frames and joint order for every engine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+from collections.abc import Mapping
+from typing import Any, ClassVar
+
+import numpy as np
+
+from core.manager import Blackboard
+from core.platform import Platform, PlatformOptionError
+from representations.infrastructure import FrameInfo
+from representations.motion import JOINT_NAMES, FsrData, InertialSensorData, JointCommand, JointSensorData
+from representations.nao import VERTICAL_FOV
+from representations.perception import CameraImageBottom, CameraImageTop
+
+GRAVITY = 9.81
+TIMESTEP = 0.002  # s of physics per step
+
+
+def parse_pair(text: str, what: str) -> tuple[float, float]:
+    try:
+        x, y = (float(v) for v in str(text).split(","))
+    except ValueError:
+        raise PlatformOptionError(f"{what} takes X,Y in mm, e.g. 1000,300; got {text!r}") from None
+    return x, y
+
+
+def parse_resolution(text: str) -> tuple[int, int]:
+    try:
+        width, height = (int(v) for v in str(text).lower().split("x"))
+    except ValueError:
+        raise PlatformOptionError(f"--resolution takes WIDTHxHEIGHT, e.g. 320x240; got {text!r}") from None
+    if not (16 <= width <= 4096 and 16 <= height <= 4096):
+        raise PlatformOptionError(f"--resolution {text} is out of range (16..4096 pixels a side)")
+    return width, height
+
+
+def has_display() -> bool:
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def number(args: Mapping[str, Any], name: str, default: float = 0.0) -> float:
+    """A numeric debug command argument, with an error that names it."""
+    text = args.get(name, default)
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        raise PlatformOptionError(f"-{name} takes a number, got {text!r}") from None
+
+
+class SimulatedRobotPlatform(Platform):
+    """Base of the simulator platforms: one world feeds both contexts in lockstep."""
+
+    clock = "simulated"
+    concurrent = False  # images and joints must come from the same simulated world
+    provides: ClassVar[Mapping[str, tuple[type, ...]]] = {
+        "motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData),
+        "cognition": (FrameInfo, CameraImageTop, CameraImageBottom),
+    }
+    consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {"motion": (JointCommand,)}
+    #: the engine's name in help texts
+    engine = ""
+
+    def __init__(self, options: Mapping[str, Any] | None = None) -> None:
+        super().__init__(options)
+        self.seed = int(self.options.get("seed") or 0)
+        self.cameras = str(self.options.get("cameras", "on")).lower() not in ("off", "false", "0", "no")
+        self.width, self.height = parse_resolution(self.options.get("resolution") or "320x240")
+        self.initial_ball = parse_pair(self.options.get("ball") or "1000,300", "--ball")
+        self.viewer_requested = bool(self.options.get("viewer"))
+        self.rng = np.random.default_rng(self.seed)
+        self.stiffness = np.zeros(len(JOINT_NAMES))
+        self.paused = False
+        self.time_ns = 0
+        self.last_steps = 0  # physics steps of the last advance (benchmarks read it)
+
+    @classmethod
+    def add_arguments(cls, parser: argparse.ArgumentParser) -> None:
+        name = cls.name
+        parser.add_argument("--seed", type=int, default=0, help=f"{name}: seed of the sensor noise")
+        parser.add_argument("--cameras", choices=["on", "off"], default="on", help=f"{name}: render the cameras")
+        parser.add_argument("--resolution", default="320x240", help=f"{name}: camera image size WIDTHxHEIGHT")
+        parser.add_argument("--ball", default="1000,300", help=f"{name}: ball start X,Y in mm on the field")
+        parser.add_argument("--viewer", action="store_true", help=f"{name}: open the {cls.engine} viewer (needs a display)")
+
+    # ------------------------------------------------------------------ what an engine implements
+    def build(self, contexts: frozenset[str], viewer: bool) -> None:
+        """Create the world (robot at the field's centre facing +x, ball at ``initial_ball``)."""
+        raise NotImplementedError
+
+    def step_physics(self, steps: int) -> None:
+        raise NotImplementedError
+
+    def joint_angles(self) -> np.ndarray:
+        """Measured joint angles (rad) in ``JOINT_NAMES`` order."""
+        raise NotImplementedError
+
+    def joint_torques(self) -> np.ndarray:
+        """Torques the servos apply (N m) in ``JOINT_NAMES`` order."""
+        raise NotImplementedError
+
+    def imu(self) -> tuple[np.ndarray, np.ndarray]:
+        """(accelerometer m/s^2, gyroscope rad/s) in the torso frame."""
+        raise NotImplementedError
+
+    def foot_forces(self) -> np.ndarray:
+        """Normal force (N) on the eight pressure sensors in FsrData order."""
+        raise NotImplementedError
+
+    def render(self, camera: str) -> np.ndarray:
+        """The image of ``top`` or ``bottom`` (height x width x 3 RGB uint8)."""
+        raise NotImplementedError
+
+    def drive(self, targets: np.ndarray, stiffness: np.ndarray) -> None:
+        """Position targets (rad) with stiffness 0..1 per joint in ``JOINT_NAMES`` order."""
+        raise NotImplementedError
+
+    def torso_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """(position m, rotation 3x3) of the torso in the world."""
+        raise NotImplementedError
+
+    def ball_position(self) -> tuple[float, float]:
+        """The ball on the field (mm)."""
+        raise NotImplementedError
+
+    def move_ball(self, x_mm: float, y_mm: float) -> None:
+        raise NotImplementedError
+
+    def move_robot(self, x_mm: float, y_mm: float, heading: float = 0.0) -> None:
+        raise NotImplementedError
+
+    # ------------------------------------------------------------------------------ platform
+    def start(self, contexts: frozenset[str]) -> None:
+        viewer = self.viewer_requested and has_display()
+        if self.viewer_requested and not viewer:
+            print(f"{self.name}: --viewer needs a display (DISPLAY is not set); running headless", file=sys.stderr)
+        self.build(contexts, viewer)
+
+    def advance(self, time_ns: int) -> None:
+        steps = int(round((time_ns - self.time_ns) * 1e-9 / TIMESTEP))
+        self.time_ns = time_ns
+        self.last_steps = 0 if self.paused else max(steps, 0)
+        if self.last_steps:
+            self.step_physics(self.last_steps)
+
+    def sense(self, context: str, blackboard: Blackboard, frame_number: int, time_ns: int) -> None:
+        blackboard.set(FrameInfo(frame_number=frame_number, time_ns=time_ns))
+        if context == "motion":
+            joints = blackboard[JointSensorData]
+            joints.position = self.joint_angles() + self.rng.normal(0.0, 0.0005, len(JOINT_NAMES))
+            joints.stiffness = self.stiffness.copy()
+            joints.current = np.abs(self.joint_torques()) / 10.0  # a rough N m -> A of the NAO's motors
+            joints.temperature = np.full(len(JOINT_NAMES), 30.0)
+            accelerometer, gyroscope = self.imu()
+            inertial = blackboard[InertialSensorData]
+            inertial.accelerometer = accelerometer + self.rng.normal(0.0, 0.02, 3)
+            inertial.gyroscope = gyroscope + self.rng.normal(0.0, 0.002, 3)
+            inertial.angles = np.array(self.torso_angles())
+            blackboard[FsrData].pressure = self.foot_forces() / GRAVITY
+        elif context == "cognition" and self.cameras:
+            for camera, rep in (("top", CameraImageTop), ("bottom", CameraImageBottom)):
+                image = blackboard[rep]
+                image.image = self.render(camera)
+                image.horizontal_fov, image.vertical_fov = self.fov()
+
+    def act(self, context: str, blackboard: Blackboard) -> None:
+        if context != "motion":
+            return
+        command = blackboard[JointCommand]
+        self.stiffness = np.clip(np.asarray(command.stiffness, dtype=float), 0.0, 1.0)
+        self.drive(np.asarray(command.position, dtype=float), self.stiffness)
+
+    def fov(self) -> tuple[float, float]:
+        """(horizontal, vertical) field of view of the rendered images (rad)."""
+        return 2 * math.atan(math.tan(VERTICAL_FOV / 2) * self.width / self.height), VERTICAL_FOV
+
+    # ------------------------------------------------------------------------- ground truth
+    def torso_angles(self) -> tuple[float, float]:
+        """Torso roll and pitch relative to the ground (rad)."""
+        _, matrix = self.torso_pose()
+        pitch = math.asin(max(-1.0, min(1.0, -matrix[2, 0])))
+        return math.atan2(matrix[2, 1], matrix[2, 2]), pitch
+
+    def torso_height(self) -> float:
+        """mm above the ground."""
+        return float(self.torso_pose()[0][2]) * 1000.0
+
+    def robot_pose(self) -> tuple[float, float, float]:
+        """The torso on the field: x, y (mm) and heading (rad)."""
+        position, matrix = self.torso_pose()
+        return float(position[0]) * 1000.0, float(position[1]) * 1000.0, math.atan2(matrix[1, 0], matrix[0, 0])
+
+    def ball_in_robot_frame(self) -> tuple[float, float]:
+        """The ball relative to the robot (mm): the frame between the feet, turned with the torso."""
+        bx, by = self.ball_position()
+        x, y, heading = self.robot_pose()
+        dx, dy = bx - x, by - y
+        c, s = math.cos(-heading), math.sin(-heading)
+        return dx * c - dy * s, dx * s + dy * c
+
+    # ------------------------------------------------------------------------ debug commands
+    def commands(self) -> Mapping[str, tuple[str, Any]]:
+        def ball(args: Mapping[str, Any]) -> str:
+            x, y = number(args, "x"), number(args, "y")
+            self.move_ball(x, y)
+            return f"ball at x={x:.0f} y={y:.0f} mm"
+
+        def robot(args: Mapping[str, Any]) -> str:
+            x, y, heading = number(args, "x"), number(args, "y"), number(args, "rotation")
+            self.move_robot(x, y, heading)
+            return f"robot at x={x:.0f} y={y:.0f} mm, rotation {heading:.3f} rad"
+
+        def pause(args: Mapping[str, Any]) -> str:
+            self.paused = True
+            return "physics paused"
+
+        def resume(args: Mapping[str, Any]) -> str:
+            self.paused = False
+            return "physics running"
+
+        def status(args: Mapping[str, Any]) -> str:
+            bx, by = self.ball_position()
+            x, y, heading = self.robot_pose()
+            return (f"time {self.time_ns * 1e-9:.3f} s{' (paused)' if self.paused else ''}; robot x={x:.0f} y={y:.0f} mm "
+                    f"rotation {heading:.3f} rad, torso height {self.torso_height():.0f} mm; ball x={bx:.0f} y={by:.0f} mm")
+
+        return {
+            "sim:move_ball": ("put the ball at -x X -y Y (mm, field)", ball),
+            "sim:move_robot": ("put the robot at -x X -y Y (mm, field) -rotation R (rad)", robot),
+            "sim:pause": ("stop the physics (the loops go on)", pause),
+            "sim:resume": ("run the physics again", resume),
+            "sim:status": ("where the robot and the ball are (ground truth)", status),
+        }
