@@ -53,7 +53,7 @@ class TimedRecorder(Recorder):
 def record(path: Path) -> dict:
     config = load_config(DEFAULT_CONFIG, "dummy")
     plans = plan_program(config, DummyPlatform)
-    recorder = TimedRecorder(select(plans, config["recording"]["representations"]),
+    recorder = TimedRecorder(select(plans, config["recording"]["representations"], strict=False),
                              {f"{c}_hz": str(p.rate_hz) for c, p in plans.items()})
     recorder.start(path)
     recorder.writer._queue.maxsize = 10**7  # the loop never waits, and nothing is dropped

@@ -46,8 +46,10 @@ class Selection:
 
 
 def select(plans: Mapping[str, ContextPlan], names: Iterable[str] | None, *, include_sensors: bool = True,
-           extra: Iterable[type] = ()) -> list[Selection]:
-    """The representations to record; unknown names fail with the closest known ones.
+           extra: Iterable[type] = (), strict: bool = True) -> list[Selection]:
+    """The representations to record; with ``strict``, unknown names fail with the closest known ones
+    (names a user typed), otherwise names that this program does not have are skipped (defaults from
+    configuration that another platform's modules provide).
 
     ``extra`` are representations every running context can fill besides its modules (debug data).
     """
@@ -66,7 +68,7 @@ def select(plans: Mapping[str, ContextPlan], names: Iterable[str] | None, *, inc
             owners.setdefault(rep.__name__, []).append(Selection(context, rep, "module", provider))
     chosen_names = list(dict.fromkeys(names or []))
     for name in chosen_names:
-        if name not in owners:
+        if name not in owners and strict:
             raise UnknownModuleError(f"cannot record {name!r}: no context has it; {did_you_mean(name, owners)}")
     result: list[Selection] = []
     for name, selections in owners.items():

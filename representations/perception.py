@@ -44,3 +44,26 @@ class CameraImageTop(CameraImage):
 @representation
 class CameraImageBottom(CameraImage):
     """The bottom camera's image."""
+
+
+@dataclass
+class BallCandidate:
+    """A round orange blob in one image: centre and radius (px), and the share of its enclosing circle
+    that is orange; with the image's size (px) and field of view (rad) to turn it into a ray."""
+
+    camera: str = ""
+    x: float = 0.0
+    y: float = 0.0
+    radius: float = 0.0
+    fill: float = 0.0
+    image_width: int = 0
+    image_height: int = 0
+    horizontal_fov: float = 0.0
+    vertical_fov: float = 0.0
+
+
+@representation
+class BallImagePercept:
+    """Ball candidates found in this frame's images, largest first (image positions only)."""
+
+    candidates: list[BallCandidate]

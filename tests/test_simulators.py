@@ -18,10 +18,12 @@ import pytest
 from core.testing import ModuleHarness
 from modules.motion.camera_matrix_provider import CameraMatrixProvider
 from modules.perception.ball_detector import BallDetector
+from modules.perception.ball_locator import BallLocator
 from representations.field import BALL_RADIUS
 from representations.modeling import BallModel
 from representations.motion import HEAD_YAW, InertialModel, InertialSensorData, JointSensorData
-from representations.perception import BallPercept, CameraImageBottom, CameraImageTop
+from representations.motion import CameraMatrixBottom, CameraMatrixTop
+from representations.perception import BallCandidate, BallImagePercept, BallPercept, CameraImageBottom, CameraImageTop
 from tests.support.simulation import Simulation
 from tests.test_cli_runtime import REPO, frames, tafel
 
@@ -111,10 +113,8 @@ def test_detector_finds_the_ball_in_rendered_images(engine: str, ball: tuple[flo
         # the detector alone, on what the platform rendered and the kinematics computed
         matrices = ModuleHarness(CameraMatrixProvider, motion[JointSensorData], InertialModel(roll=motion[InertialSensorData].angles[0],
                                                                                                  pitch=motion[InertialSensorData].angles[1])).execute()
-        from representations.motion import CameraMatrixBottom, CameraMatrixTop
-
-        percept = ModuleHarness(BallDetector, cognition[CameraImageTop], cognition[CameraImageBottom],
-                                matrices[CameraMatrixTop], matrices[CameraMatrixBottom]).execute()[BallPercept]
+        candidates = ModuleHarness(BallDetector, cognition[CameraImageTop], cognition[CameraImageBottom]).execute()[BallImagePercept]
+        percept = ModuleHarness(BallLocator, candidates, matrices[CameraMatrixTop], matrices[CameraMatrixBottom]).execute()[BallPercept]
         truth = sim.platform.ball_in_robot_frame()
         assert percept.seen and percept.camera == camera
         distance = math.hypot(*truth)
@@ -135,12 +135,18 @@ def test_detector_rejects_orange_that_is_not_a_ball() -> None:
     image.image = np.zeros((240, 320, 3), np.uint8)
     image.image[:, :] = (40, 140, 50)
     image.image[100:104, 20:300] = (255, 107, 0)  # an orange stripe: not round
-    from representations.motion import CameraMatrixTop
+    bb = ModuleHarness(BallDetector, image, CameraImageBottom(image=np.zeros((0, 0, 3), np.uint8))).execute()
+    assert bb[BallImagePercept].candidates == []
 
+
+def test_locator_rejects_a_ball_whose_size_does_not_fit_its_distance() -> None:
     matrix = CameraMatrixTop(valid=True, translation=np.array([0.0, 0.0, 500.0]))
     matrix.rotation = np.array([[math.cos(0.3), 0, math.sin(0.3)], [0, 1, 0], [-math.sin(0.3), 0, math.cos(0.3)]])
-    bb = ModuleHarness(BallDetector, image, matrix).execute()
-    assert not bb[BallPercept].seen
+    fov = (math.radians(56.3), math.radians(43.7))
+    huge = BallCandidate("top", 160.0, 150.0, 60.0, 0.9, 320, 240, *fov)  # at about 1.4 m a ball is ~17 px
+    assert not ModuleHarness(BallLocator, BallImagePercept([huge]), matrix).execute()[BallPercept].seen
+    fitting = BallCandidate("top", 160.0, 150.0, 17.0, 0.9, 320, 240, *fov)
+    assert ModuleHarness(BallLocator, BallImagePercept([fitting]), matrix).execute()[BallPercept].seen
 
 
 def test_images_have_the_published_field_of_view(sim: Simulation) -> None:

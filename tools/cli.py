@@ -333,7 +333,8 @@ def make_recorder(args: argparse.Namespace, plans: dict[str, ContextPlan], confi
         [n.strip() for n in args.record_reps.split(",") if n.strip()] if args.record_reps
         else list(config.get("recording", {}).get("representations", []))
     )
-    selections = select(plans, names, include_sensors=not args.record_reps, extra=DEBUG_REPRESENTATIONS)
+    selections = select(plans, names, include_sensors=not args.record_reps, extra=DEBUG_REPRESENTATIONS,
+                        strict=bool(args.record_reps))
     metadata = {"platform": platform, **{f"{c}_hz": str(p.rate_hz) for c, p in plans.items()}}
     recorder = Recorder(selections, metadata)
     # Without a beat to keep (lockstep at --speed max) recording waits for the writer rather than drop.
@@ -347,8 +348,7 @@ def report_recording(recorder: Recorder | None) -> None:
     if recorder is None or recorder.path is None:
         return
     status = recorder.status()
-    frames = ", ".join(f"{c} {n}" for c, n in sorted(status["frames"].items()))
-    print(f"recorded {recorder.path}: frames {frames}; {recorder.dropped_total()} messages dropped"
+    print(f"recorded {recorder.path}: {status['messages']} messages; {recorder.dropped_total()} dropped"
           + (f"; problems: {status['error']}" if status["error"] else ""))
 
 
@@ -357,7 +357,7 @@ def report_pruned(plans: dict[str, ContextPlan]) -> None:
         for module, reps in plan.replaced.items():
             print(f"{plan.name}: {module} replaced, the platform provides {', '.join(reps)}", file=sys.stderr)
         for module, missing in plan.pruned.items():
-            print(f"{plan.name}: {module} disabled, platform provides no {', '.join(missing)}", file=sys.stderr)
+            print(f"{plan.name}: {module} disabled: nothing provides {', '.join(missing)} on this platform", file=sys.stderr)
 
 
 # ----------------------------------------------------------------------------------- platforms

@@ -1,0 +1,78 @@
+"""BallLocator: where on the ground the detected ball is, through the camera matrices."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from core import Module, provides, requires
+from debug import drawing, plot, request
+from representations.field import BALL_RADIUS
+from representations.motion import CameraMatrixBottom, CameraMatrixTop
+from representations.perception import BallCandidate, BallImagePercept, BallPercept
+
+DRAW_PERCEPT = request("BallLocator:draw_percept", "the located ball in its image and on the field")
+
+
+def pixel_ray(x: float, y: float, width: int, height: int, horizontal_fov: float, vertical_fov: float) -> np.ndarray:
+    """The direction of a pixel in the camera frame (x along the optical axis, y left, z up)."""
+    fx = (width / 2) / math.tan(horizontal_fov / 2)
+    fy = (height / 2) / math.tan(vertical_fov / 2)
+    return np.array([1.0, -(x - width / 2) / fx, -(y - height / 2) / fy])
+
+
+def ground_point(ray_camera: np.ndarray, rotation: np.ndarray, translation: np.ndarray, height: float) -> np.ndarray | None:
+    """Where a camera ray meets the plane ``z = height`` in the robot frame (mm), None above the horizon."""
+    direction = np.asarray(rotation) @ ray_camera
+    if direction[2] >= -1e-6:
+        return None
+    scale = (height - translation[2]) / direction[2]
+    return np.asarray(translation) + scale * direction
+
+
+@requires(BallImagePercept, CameraMatrixTop, CameraMatrixBottom)
+@provides(BallPercept)
+class BallLocator(Module):
+    """Intersects each candidate's ray with the plane at ball height and keeps the largest candidate
+    whose size in the image fits the distance: a ball far away cannot look large."""
+
+    @dataclass
+    class Parameters:
+        size_tolerance: float = 0.45
+        """the radius may differ by this share from what the distance predicts"""
+
+    def execute(self) -> None:
+        percept = self.ball_percept
+        percept.seen = False
+        for candidate in self.ball_image_percept.candidates:
+            matrix = self.camera_matrix_top if candidate.camera == "top" else self.camera_matrix_bottom
+            position = self.locate(candidate, matrix)
+            if position is None:
+                continue
+            percept.seen = True
+            percept.x, percept.y = float(position[0]), float(position[1])
+            percept.image_x, percept.image_y, percept.radius = candidate.x, candidate.y, candidate.radius
+            percept.camera = candidate.camera
+            plot("BallLocator:distance", math.hypot(percept.x, percept.y))
+            if DRAW_PERCEPT:
+                drawing(f"image:{candidate.camera}").circle(candidate.x, candidate.y, candidate.radius, color="blue", width=2)
+                drawing("field").circle(percept.x, percept.y, BALL_RADIUS, color="orange")
+            return
+
+    def locate(self, candidate: BallCandidate, matrix: CameraMatrixTop | CameraMatrixBottom) -> np.ndarray | None:
+        """The ball's centre on the ground (mm, robot frame), or None if position and size disagree."""
+        if not matrix.valid or candidate.horizontal_fov <= 0:
+            return None
+        ray = pixel_ray(candidate.x, candidate.y, candidate.image_width, candidate.image_height,
+                        candidate.horizontal_fov, candidate.vertical_fov)
+        position = ground_point(ray, matrix.rotation, matrix.translation, BALL_RADIUS)
+        if position is None:
+            return None
+        distance = float(np.linalg.norm(position - np.asarray(matrix.translation)))
+        focal = (candidate.image_width / 2) / math.tan(candidate.horizontal_fov / 2)
+        expected = focal * BALL_RADIUS / distance
+        if abs(candidate.radius - expected) > self.parameters.size_tolerance * expected + 1.0:
+            return None
+        return position
