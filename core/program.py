@@ -15,6 +15,7 @@ from typing import Any
 
 from core.config import CONTEXTS, ConfigError, context_section
 from core.errors import ConflictingProvidersError, MissingProviderError
+from core.graph import build_plan
 from core.manager import ModuleManager
 from core.module import find_module
 from core.platform import Platform
@@ -60,18 +61,26 @@ class ContextPlan:
 
     def build_manager(self, strict: bool = False) -> ModuleManager:
         parameters = {m: v for m, v in self.parameters.items() if m in {c.__name__ for c in self.modules}}
-        off = {*self.disabled, *self.pruned, *self.replaced}
-        from_platform = {r.__name__ for r in self.platform_provides}
-        providers = {r: m for r, m in self.providers.items() if m not in off and r not in from_platform}
         return ModuleManager(
             self.modules,
             name=self.name,
             external=self.external,
-            providers=providers,
+            providers=self.effective_providers(),
             strict=strict,
             parameters=parameters,
-            disabled=[name for name in (*self.disabled, *self.pruned, *self.replaced) if name in {m.__name__ for m in self.modules}],
+            disabled=self.effective_disabled(),
         )
+
+    def effective_providers(self) -> dict[str, str]:
+        """Provider choices for the modules that run here (a choice of a module another layer removed,
+        or of a representation the platform provides instead, does not apply)."""
+        running = {m.__name__ for m in self.active_modules()}
+        from_platform = {r.__name__ for r in self.platform_provides}
+        return {r: m for r, m in self.providers.items() if m in running and r not in from_platform}
+
+    def effective_disabled(self) -> list[str]:
+        listed = {m.__name__ for m in self.modules}
+        return [name for name in (*self.disabled, *self.pruned, *self.replaced) if name in listed]
 
 
 def plan_program(config: Mapping[str, Any], platform: type[Platform] | Platform, *, strict: bool = False) -> dict[str, ContextPlan]:
@@ -111,8 +120,13 @@ def plan_program(config: Mapping[str, Any], platform: type[Platform] | Platform,
             outputs = module.requirements().provides
             if module.__name__ not in plan.disabled and outputs and any(r in from_platform for r in outputs):
                 plan.replaced[module.__name__] = [r.__name__ for r in outputs if r in from_platform]
+    for plan in plans.values():
+        for module_name in plan.providers.values():
+            find_module(module_name)
     _check_single_provider(plans)
     _route(plans)
+    for plan in plans.values():  # the graph of each context must hold before any process starts
+        build_plan(plan.modules, external=plan.external, providers=plan.effective_providers(), disabled=plan.effective_disabled())
     if strict:
         problems = [
             f"{plan.name}: {module} needs {', '.join(missing)}"

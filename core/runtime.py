@@ -434,7 +434,10 @@ def run_context_loop(
                 report(_snapshot_stats(runner, stats, start_ns))
     except EndOfData:
         pass
-    except Exception as exc:  # noqa: BLE001 - a platform failure ends this context with a report
+    except PlatformError as exc:  # a known failure (lost device, bad data): say it plainly
+        stats.failure = str(exc)
+        log.error("%s stopped: %s", plan.name, exc)
+    except Exception as exc:  # noqa: BLE001 - anything else ends this context with a report
         stats.failure = f"{type(exc).__name__}: {exc}"
         log.exception("%s loop failed", plan.name)
     final = _snapshot_stats(runner, stats, start_ns)

@@ -121,3 +121,38 @@ class TorsoPose:
 
     rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
     translation: np.ndarray = array((3,))
+
+
+@representation
+class TouchSensorData:
+    """Touch sensors and bumpers (1 pressed, 0 not): chest button, head front/middle/rear, left foot
+    bumper left/right, left hand back/left/right, right foot bumper left/right, right hand back/left/right."""
+
+    pressed: np.ndarray = array((14,))
+
+
+@representation
+class BatteryData:
+    """``charge`` 0..1, ``current`` (A, negative while discharging), ``temperature`` (deg C), and the
+    raw ``status`` flags of the battery board."""
+
+    charge: float = 1.0
+    status: float = 0.0
+    current: float = 0.0
+    temperature: float = 0.0
+
+
+@representation
+class LedRequest:
+    """LED colours and brightness, 0..1: ``chest``, ``left_foot``, ``right_foot`` (R, G, B);
+    ``left_eye``, ``right_eye`` (8 red, 8 green, 8 blue); ``left_ear``, ``right_ear`` (10 segments);
+    ``skull`` (12)."""
+
+    chest: np.ndarray = array((3,))
+    left_foot: np.ndarray = array((3,))
+    right_foot: np.ndarray = array((3,))
+    left_eye: np.ndarray = array((24,))
+    right_eye: np.ndarray = array((24,))
+    left_ear: np.ndarray = array((10,))
+    right_ear: np.ndarray = array((10,))
+    skull: np.ndarray = array((12,))

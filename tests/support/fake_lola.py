@@ -1,0 +1,99 @@
+"""A stand-in for the NAO's LoLA daemon: a Unix socket that sends 896-byte sensor packets at 83 Hz
+and records every answer, for testing the nao platform without a robot."""
+
+from __future__ import annotations
+
+import socket
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import msgpack
+
+PERIOD = 0.012
+PACKET_SIZE = 896
+
+
+def sensor_packet(positions: list[float], stiffness: list[float], index: int) -> bytes:
+    """One well-formed packet of exactly 896 bytes, values as LoLA sends them (float32)."""
+    packet: dict[str, Any] = {
+        "Stiffness": stiffness, "Position": positions, "Temperature": [35.0] * 25, "Current": [0.1] * 25,
+        "Battery": [0.9, 0.0, -1.2, 30.0], "Accelerometer": [0.1, 0.0, -9.81], "Gyroscope": [0.0, 0.0, 0.01],
+        "Angles": [0.0, 0.01], "Sonar": [2.0, 2.0], "FSR": [0.6] * 8, "Touch": [0.0] * 14, "Status": [0] * 25,
+        "RobotConfig": ["", "6.0.0", f"P{index % 10}", "6.0.0"],
+    }
+    packer = msgpack.Packer(use_single_float=True)
+    data = packer.pack(packet)
+    padding = PACKET_SIZE - len(data)
+    packet["RobotConfig"][0] = "B" * padding  # grow the body id until the packet is the real size
+    data = packer.pack(packet)
+    while len(data) != PACKET_SIZE:  # the string's own header grows with its length
+        packet["RobotConfig"][0] = packet["RobotConfig"][0][: len(packet["RobotConfig"][0]) - (len(data) - PACKET_SIZE)]
+        data = packer.pack(packet)
+    return data
+
+
+class FakeLola:
+    """Serve one client; ``garbage_after`` sends bytes that are no msgpack after that many packets."""
+
+    def __init__(self, path: Path, *, garbage_after: int | None = None) -> None:
+        self.path = path
+        self.garbage_after = garbage_after
+        self.sent = 0
+        self.answers: list[dict[str, Any]] = []
+        self.sizes: set[int] = set()
+        self.positions = [0.0] * 25
+        self.stiffness = [0.0] * 25
+        self.stop = threading.Event()
+        self.server = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        self.server.bind(str(path))
+        self.server.listen(1)
+        self.thread = threading.Thread(target=self.serve, daemon=True)
+        self.thread.start()
+
+    def serve(self) -> None:
+        self.server.settimeout(30)
+        try:
+            client, _ = self.server.accept()
+        except OSError:
+            return
+        client.setblocking(False)
+        unpacker = msgpack.Unpacker(raw=False)
+        deadline = time.monotonic()
+        try:
+            while not self.stop.is_set():
+                deadline += PERIOD
+                if self.garbage_after is not None and self.sent >= self.garbage_after:
+                    data = b"\xc1" * PACKET_SIZE  # 0xc1 is never used by msgpack
+                else:
+                    data = sensor_packet(self.positions, self.stiffness, self.sent)
+                self.sizes.add(len(data))
+                try:
+                    client.sendall(data)
+                except (BlockingIOError, BrokenPipeError, ConnectionResetError):
+                    break
+                self.sent += 1
+                while time.monotonic() < deadline:
+                    try:
+                        chunk = client.recv(65536)
+                    except BlockingIOError:
+                        time.sleep(0.001)
+                        continue
+                    except OSError:
+                        return
+                    if not chunk:
+                        return
+                    unpacker.feed(chunk)
+                    for answer in unpacker:
+                        self.answers.append(answer)
+                        if isinstance(answer, dict) and "Position" in answer:
+                            self.positions = list(answer["Position"])  # ideal servos
+                            self.stiffness = list(answer["Stiffness"])
+        finally:
+            client.close()
+
+    def close(self) -> None:
+        self.stop.set()
+        self.server.close()
+        self.thread.join(timeout=5)

@@ -1,0 +1,129 @@
+"""The nao platform against a fake LoLA: packets, answers, sensor mapping, safety, errors."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from core.logfile import read_log
+from core.serialization import deserialize
+from platforms.nao import CROUCH, LolaProtocolError, crouch_pose, parse_sensors
+from representations.motion import JOINT_INDEX, BatteryData, FsrData, InertialSensorData, TouchSensorData
+from tests.support.fake_lola import PACKET_SIZE, FakeLola, sensor_packet
+from tests.test_cli_runtime import REPO
+
+LOOK_LEFT = "tests.support.nao_support:LookLeft"
+
+
+def run_nao(socket_path: Path, *args: str, modules: str = f'["{LOOK_LEFT}"]') -> subprocess.CompletedProcess:
+    command = [sys.executable, "-m", "tools.cli", "run", "--platform", "nao", "--lola", str(socket_path), "--cameras", "off",
+               "--no-debug", "--set", f"cognition.modules={modules}", *args]
+    return subprocess.run(command, capture_output=True, text=True, timeout=120, cwd=REPO, env={**os.environ, "PYTHONPATH": str(REPO)})
+
+
+@pytest.fixture
+def lola(tmp_path: Path):
+    fake = FakeLola(tmp_path / "robocup")
+    yield fake
+    fake.close()
+
+
+def finished(fake: FakeLola) -> None:
+    time.sleep(0.2)
+    fake.close()
+
+
+def test_every_packet_gets_exactly_one_well_formed_answer(lola: FakeLola, tmp_path: Path) -> None:
+    log = tmp_path / "nao.mcap"
+    result = run_nao(lola.path, "--frames", "200", "--record", str(log),
+                     "--record-reps", "InertialSensorData,FsrData,TouchSensorData,BatteryData")
+    finished(lola)
+    assert result.returncode == 0, result.stderr
+    assert "motion: 200 frames" in result.stdout
+    assert lola.sizes == {PACKET_SIZE}
+    assert len(lola.answers) == lola.sent  # one answer per packet, through the shutdown too
+    for answer in lola.answers[:200]:
+        assert len(answer["Position"]) == 25 and len(answer["Stiffness"]) == 25
+        assert len(answer["Chest"]) == 3 and len(answer["LEye"]) == 24 and len(answer["LEar"]) == 10 and len(answer["Skull"]) == 12
+    # sensors arrive in the project's frame and units
+    contents = read_log(log)
+    inertial = deserialize(InertialSensorData, next(m.data for m in contents.messages if m.topic == "motion/InertialSensorData"))
+    assert inertial.accelerometer.tolist() == pytest.approx([-0.1, 0.0, 9.81], abs=1e-5)  # upright: +9.81 on z
+    assert inertial.gyroscope[2] == pytest.approx(-0.01, abs=1e-6)
+    assert deserialize(FsrData, next(m.data for m in contents.messages if m.topic == "motion/FsrData")).pressure.tolist() == pytest.approx([0.6] * 8)
+    assert deserialize(TouchSensorData, next(m.data for m in contents.messages if m.topic == "motion/TouchSensorData")).pressed.shape == (14,)
+    battery = deserialize(BatteryData, next(m.data for m in contents.messages if m.topic == "motion/BatteryData"))
+    assert battery.charge == pytest.approx(0.9) and battery.current == pytest.approx(-1.2)
+
+
+def test_motion_falls_back_to_a_safe_motion_when_cognition_dies(lola: FakeLola) -> None:
+    result = run_nao(lola.path, "--frames", "400", "--set", "parameters.CrashCognitionProcess.after_frames=60",
+                     modules=f'["{LOOK_LEFT}", "tests.support.runtime_faults:CrashCognitionProcess"]')
+    finished(lola)
+    assert result.returncode == 0, result.stderr
+    assert "cognition process died (exit code 3)" in result.stderr
+    yaws = [answer["Position"][JOINT_INDEX["HeadYaw"]] for answer in lola.answers]
+    chest = [tuple(answer["Chest"]) for answer in lola.answers]
+    assert max(yaws[:200]) == pytest.approx(0.5, abs=0.01)  # cognition's request, while it ran
+    assert abs(yaws[399]) < 0.05  # back to the safe position without cognition
+    assert chest[50] == (0.0, 1.0, 0.0) and chest[399] == (1.0, 0.0, 0.0)  # green while alive, red without
+    assert len(lola.answers) == lola.sent
+
+
+def test_the_program_ends_with_a_crouch_that_goes_limp(lola: FakeLola) -> None:
+    result = run_nao(lola.path, "--frames", "100")
+    finished(lola)
+    assert result.returncode == 0, result.stderr
+    tail = lola.answers[100:]
+    assert len(tail) >= 100  # a second more of answers after the program's last frame
+    assert tail[-1]["Stiffness"] == pytest.approx([0.0] * 25)
+    assert np.allclose(tail[-1]["Position"], crouch_pose(), atol=1e-5)
+    stiffness = [answer["Stiffness"][JOINT_INDEX["LKneePitch"]] for answer in tail]
+    assert stiffness[0] > 0.5 and all(a >= b - 1e-6 for a, b in zip(stiffness[len(stiffness) // 2 :], stiffness[len(stiffness) // 2 + 1 :]))
+
+
+def test_malformed_packets_give_a_clear_error_and_a_safe_stop(tmp_path: Path) -> None:
+    fake = FakeLola(tmp_path / "robocup", garbage_after=50)
+    try:
+        result = run_nao(fake.path, "--seconds", "30")
+    finally:
+        finished(fake)
+    assert result.returncode == 1
+    assert "malformed LoLA packet" in result.stderr and "Traceback" not in result.stderr
+    assert fake.answers[-1]["Stiffness"] == pytest.approx([0.0] * 25)  # it let go limp, once
+    assert len(fake.answers) <= 52
+
+
+def test_a_missing_socket_is_a_clear_error(tmp_path: Path) -> None:
+    result = run_nao(tmp_path / "nothing-here")
+    assert result.returncode == 1
+    assert f"LoLA's socket {tmp_path / 'nothing-here'} does not exist: is lola running" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+def test_missing_cameras_are_a_clear_error(lola: FakeLola) -> None:
+    command = [sys.executable, "-m", "tools.cli", "run", "--platform", "nao", "--lola", str(lola.path), "--no-debug",
+               "--camera-top", "/dev/no-such-camera"]
+    result = subprocess.run(command, capture_output=True, text=True, timeout=60, cwd=REPO, env={**os.environ, "PYTHONPATH": str(REPO)})
+    assert result.returncode == 1 and "the top camera /dev/no-such-camera does not exist" in result.stderr
+
+
+def test_sensor_packets_are_checked() -> None:
+    import msgpack
+
+    good = msgpack.unpackb(sensor_packet([0.0] * 25, [0.0] * 25, 0))
+    assert parse_sensors(good)["Position"].shape == (25,)
+    with pytest.raises(LolaProtocolError, match="expected a map"):
+        parse_sensors([1, 2, 3])
+    broken = dict(good, Position=[0.0] * 24)
+    with pytest.raises(LolaProtocolError, match="Position should hold 25 numbers, found 24 values"):
+        parse_sensors(broken)
+    with pytest.raises(LolaProtocolError, match="FSR holds something that is not a number"):
+        parse_sensors(dict(good, FSR=["x"] * 8))
+    assert set(CROUCH) <= set(JOINT_INDEX)
