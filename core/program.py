@@ -52,8 +52,8 @@ class ContextPlan:
 
     @property
     def runs(self) -> bool:
-        """A context runs when it has modules or platform data to process."""
-        return bool(self.active_modules() or self.platform_provides)
+        """A context runs when the platform feeds it: its frames are driven by the platform's data."""
+        return bool(self.platform_provides)
 
     def active_modules(self) -> list[type]:
         off = set(self.disabled) | set(self.pruned) | set(self.replaced)

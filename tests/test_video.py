@@ -58,7 +58,7 @@ def test_the_detector_reports_the_ball_frame_by_frame(video: Path, tmp_path: Pat
 def test_modules_that_need_more_than_an_image_are_pruned_with_a_report(video: Path) -> None:
     result = tafel("run", "--platform", "video", "--source", str(video), "--fps", "200", "--no-debug")
     assert result.returncode == 0, result.stderr
-    assert "motion: StandMotion disabled: nothing provides JointSensorData" in result.stderr
+    assert "motion: not running: the platform provides nothing to it" in result.stderr
     assert "cognition: BallLocator disabled: nothing provides CameraMatrixTop, CameraMatrixBottom" in result.stderr
     assert "cognition: KalmanBallModeler disabled: nothing provides BallPercept" in result.stderr
     assert "Traceback" not in result.stderr

@@ -354,6 +354,9 @@ def report_recording(recorder: Recorder | None) -> None:
 
 def report_pruned(plans: dict[str, ContextPlan]) -> None:
     for plan in plans.values():
+        if not plan.runs:
+            print(f"{plan.name}: not running: the platform provides nothing to it", file=sys.stderr)
+            continue
         for module, reps in plan.replaced.items():
             print(f"{plan.name}: {module} replaced, the platform provides {', '.join(reps)}", file=sys.stderr)
         for module, missing in plan.pruned.items():
@@ -391,7 +394,7 @@ def command_modules(args: argparse.Namespace, extra: Sequence[str]) -> int:
         manager = managers.get(name)
         print(f"\n{name} ({plan.rate_hz:g} Hz)")
         if manager is None:
-            print("  not running: no modules and no platform data")
+            print("  not running: the platform provides nothing to it")
             continue
         print("  order: " + (" -> ".join(manager.order) or "(no modules)"))
         graph = manager.graph()

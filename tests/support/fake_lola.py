@@ -84,14 +84,27 @@ class FakeLola:
                         return
                     if not chunk:
                         return
-                    unpacker.feed(chunk)
-                    for answer in unpacker:
-                        self.answers.append(answer)
-                        if isinstance(answer, dict) and "Position" in answer:
-                            self.positions = list(answer["Position"])  # ideal servos
-                            self.stiffness = list(answer["Stiffness"])
+                    self._take(unpacker, chunk)
         finally:
+            self._drain(client, unpacker)
             client.close()
+
+    def _take(self, unpacker: msgpack.Unpacker, chunk: bytes) -> None:
+        unpacker.feed(chunk)
+        for answer in unpacker:
+            self.answers.append(answer)
+            if isinstance(answer, dict) and "Position" in answer:
+                self.positions = list(answer["Position"])  # ideal servos
+                self.stiffness = list(answer["Stiffness"])
+
+    def _drain(self, client: socket.socket, unpacker: msgpack.Unpacker) -> None:
+        """Read the answers still on their way when the client let go."""
+        client.settimeout(0.5)
+        try:
+            while chunk := client.recv(65536):
+                self._take(unpacker, chunk)
+        except OSError:
+            pass
 
     def close(self) -> None:
         self.stop.set()
