@@ -147,8 +147,8 @@ def serialization() -> dict:
         assert serialize(rep) == hand(rep), name  # the same bytes: a fair comparison
         auto_times, hand_times = [], []
         for _ in range(7):  # alternate, so machine noise hits both alike
-            auto_times.append(min(timeit.repeat(lambda: serialize(rep), number=2000, repeat=3)) / 2000)
-            hand_times.append(min(timeit.repeat(lambda: hand(rep), number=2000, repeat=3)) / 2000)
+            auto_times.append(min(timeit.repeat(lambda r=rep: serialize(r), number=2000, repeat=3)) / 2000)
+            hand_times.append(min(timeit.repeat(lambda r=rep, h=hand: h(r), number=2000, repeat=3)) / 2000)
         auto, manual = statistics.median(auto_times), statistics.median(hand_times)
         result[name] = {"auto_us": round(auto * 1e6, 3), "hand_us": round(manual * 1e6, 3), "ratio": round(auto / manual, 3)}
     return result

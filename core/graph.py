@@ -19,7 +19,7 @@ from core.errors import (
 )
 from core.module import Module
 from core.naming import did_you_mean
-from core.representation import is_representation, registered_representations
+from core.representation import is_representation
 
 
 @dataclass
@@ -33,9 +33,6 @@ class Plan:
     candidates: dict[type, list[type]]
     #: enabled modules that do not run because they were chosen as provider of nothing
     idle: list[type] = field(default_factory=list)
-
-    def representations(self) -> list[type]:
-        return list(self.provider)
 
 
 def module_names(modules: Sequence[type]) -> dict[str, type]:
@@ -59,13 +56,6 @@ def resolve_module(name: str, by_name: Mapping[str, type], what: str = "module")
         return by_name[name]
     except KeyError:
         raise UnknownModuleError(f"unknown {what} {name!r}: {did_you_mean(name, by_name)}") from None
-
-
-def resolve_representation(name: str, known: Iterable[type] = ()) -> type:
-    known_by_name = {r.__name__: r for r in known} or registered_representations()
-    if name in known_by_name:
-        return known_by_name[name]
-    raise UnknownModuleError(f"unknown representation {name!r}: {did_you_mean(name, known_by_name)}")
 
 
 def build_plan(

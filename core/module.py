@@ -107,17 +107,13 @@ _ATTRIBUTE_NAMES: dict[type, dict[str, type]] = {}
 _KNOWN: dict[str, type] = {}
 
 
-def known_modules() -> dict[str, type]:
-    """Every Module subclass defined so far, by class name (the newest definition of a name wins).
-
-    Configuration names modules by class name; ``tools`` imports the ``modules`` package so that all
-    of them are known. A name of the form ``package.module:ClassName`` is imported on demand.
-    """
-    return dict(_KNOWN)
-
-
 def find_module(name: str) -> type:
-    """The module class called ``name`` (or ``package.module:ClassName``), with suggestions if unknown."""
+    """The module class called ``name`` (or ``package.module:ClassName``), with suggestions if unknown.
+
+    Every Module subclass registers itself by class name when it is defined (the newest definition of a
+    name wins); ``tools`` imports the ``modules`` package so that all of them are known. A name of the
+    form ``package.module:ClassName`` is imported on demand.
+    """
     from core.errors import UnknownModuleError
     from core.naming import did_you_mean
 

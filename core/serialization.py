@@ -257,7 +257,7 @@ class _Builder:
         if info.kind == "enum":
             return [f"    m.{n} = obj.{n}.name"]
         if info.kind == "ndarray":
-            return [f"    a = obj.{n}", f"    t = m.{n}", "    t.dtype = a.dtype.str", "    t.shape.extend(a.shape)", "    t.data = a.tobytes()"]
+            return [f"    a = obj.{n}", f"    t = m.{n}", *_ARRAY_LINES]
         if info.kind == "nested":
             return [f"    fill_{ids[info.type]}(m.{n}, obj.{n})"]
         element = info.element
@@ -267,7 +267,7 @@ class _Builder:
         if element.kind == "enum":
             return [f"    m.{n}.extend([e.name for e in obj.{n}])"]
         if element.kind == "ndarray":
-            return [f"    for a in obj.{n}:", f"        t = m.{n}.add()", "        t.dtype = a.dtype.str", "        t.shape.extend(a.shape)", "        t.data = a.tobytes()"]
+            return [f"    for a in obj.{n}:", f"        t = m.{n}.add()", *("    " + line for line in _ARRAY_LINES)]
         return [f"    for e in obj.{n}:", f"        fill_{ids[element.type]}(m.{n}.add(), e)"]
 
     def read_expression(self, info: FieldInfo, ids: dict[type, int], default: str, owner: int) -> str:
@@ -291,6 +291,10 @@ class _Builder:
         if element.kind == "ndarray":
             return f"[_array(e) for e in m.{n}]"
         return f"[read_{ids[element.type]}(e) for e in m.{n}]"
+
+
+#: generated code that fills NDArray message ``t`` from array ``a``
+_ARRAY_LINES = ("    t.dtype = a.dtype.str", "    t.shape.extend(a.shape)", "    t.data = a.tobytes()")
 
 
 def _read_array(message: Any) -> np.ndarray:

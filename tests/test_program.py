@@ -13,7 +13,6 @@ from core.program import plan_program
 from core.runtime import Limits, LockstepRuntime
 from representations.behavior import HeadMotionRequest
 from representations.infrastructure import CognitionStatus, FrameInfo
-from representations.modeling import BallModel
 from representations.motion import JointCommand, JointSensorData
 from representations.perception import BallPercept
 from tools.cli import discover_modules

@@ -19,7 +19,6 @@ from core.testing import ModuleHarness
 from modules.motion.camera_matrix_provider import CameraMatrixProvider
 from modules.perception.ball_detector import BallDetector
 from modules.perception.ball_locator import BallLocator
-from representations.field import BALL_RADIUS
 from representations.modeling import BallModel
 from representations.motion import HEAD_YAW, InertialModel, InertialSensorData, JointSensorData
 from representations.motion import CameraMatrixBottom, CameraMatrixTop

@@ -53,15 +53,13 @@ def discover_modules() -> None:
 
 
 def parse_speed(text: str) -> float | None:
+    """``--speed``: a factor against the wall clock, or ``max`` (None: as fast as possible)."""
     if text == "max":
         return None
     try:
-        speed = float(text)
-    except ValueError:
+        return positive(float)(text)
+    except argparse.ArgumentTypeError:
         raise argparse.ArgumentTypeError(f"--speed takes a positive number or 'max', got {text!r}") from None
-    if speed <= 0:
-        raise argparse.ArgumentTypeError(f"--speed must be positive, got {text!r}")
-    return speed
 
 
 def positive(kind: type) -> Any:
