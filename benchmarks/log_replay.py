@@ -145,12 +145,15 @@ def serialization() -> dict:
     result = {}
     for name, (rep, hand) in cases.items():
         assert serialize(rep) == hand(rep), name  # the same bytes: a fair comparison
-        auto_times, hand_times = [], []
-        for _ in range(7):  # alternate, so machine noise hits both alike
-            auto_times.append(min(timeit.repeat(lambda r=rep: serialize(r), number=2000, repeat=3)) / 2000)
-            hand_times.append(min(timeit.repeat(lambda r=rep, h=hand: h(r), number=2000, repeat=3)) / 2000)
-        auto, manual = statistics.median(auto_times), statistics.median(hand_times)
-        result[name] = {"auto_us": round(auto * 1e6, 3), "hand_us": round(manual * 1e6, 3), "ratio": round(auto / manual, 3)}
+        auto_times, hand_times, ratios = [], [], []
+        for _ in range(31):  # short rounds, alternating: machine noise hits both alike, and drifts cancel
+            auto = min(timeit.repeat(lambda r=rep: serialize(r), number=500, repeat=3)) / 500
+            manual = min(timeit.repeat(lambda r=rep, h=hand: h(r), number=500, repeat=3)) / 500
+            auto_times.append(auto)
+            hand_times.append(manual)
+            ratios.append(auto / manual)
+        result[name] = {"auto_us": round(statistics.median(auto_times) * 1e6, 3),
+                        "hand_us": round(statistics.median(hand_times) * 1e6, 3), "ratio": round(statistics.median(ratios), 3)}
     return result
 
 

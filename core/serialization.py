@@ -84,13 +84,19 @@ def codec(cls: type) -> MessageCodec:
     return found
 
 
+_ENCODERS: dict[type, Callable[[Any], bytes]] = {}
+
+
 def serialize(rep: Any) -> bytes:
     """Protobuf bytes of a representation instance."""
-    found = codec(type(rep))
+    cls = type(rep)
+    encode = _ENCODERS.get(cls)
+    if encode is None:
+        encode = _ENCODERS[cls] = codec(cls).encode
     try:
-        return found.encode(rep)
+        return encode(rep)
     except (TypeError, ValueError, AttributeError) as exc:
-        raise SerializationError(_explain(type(rep), rep, exc)) from None
+        raise SerializationError(_explain(cls, rep, exc)) from None
 
 
 def deserialize(cls: type, data: bytes, *, schema: descriptor_pb2.FileDescriptorProto | None = None) -> Any:
@@ -321,19 +327,15 @@ def _build(cls: type) -> MessageCodec:
     builder.describe(builder.top, cls)
     builder.finish()
     ids = {c: i for i, c in enumerate(builder.order)}
-    _generate(builder, ids)
     try:
         _POOL.Add(builder.file)
     except TypeError as exc:
         raise SerializationError(f"cannot register the schema of {cls.__name__}: {exc}") from None
     message_class = message_factory.GetMessageClass(_POOL.FindMessageTypeByName(builder.full_name))
     top = ids[cls]
-    fill, read = builder.namespace[f"fill_{top}"], builder.namespace[f"read_{top}"]
-
-    def encode(rep: Any) -> bytes:
-        message = message_class()
-        fill(message, rep)
-        return message.SerializeToString()
+    builder.namespace[f"Message{top}"] = message_class
+    _generate(builder, ids)
+    fill, read, encode = builder.namespace[f"fill_{top}"], builder.namespace[f"read_{top}"], builder.namespace[f"encode_{top}"]
 
     def decode(data: bytes) -> Any:
         return read(message_class.FromString(data))
@@ -358,12 +360,13 @@ def _generate(builder: _Builder, ids: dict[type, int]) -> None:
             if element is not None and element.kind == "enum":
                 builder.namespace[f"Enum_{i}_{info.name}"] = element.type
         fill.append("    return m")
+        encode = [f"def encode_{i}(obj):", f"    m = Message{i}()", *fill[1:-1], "    return m.SerializeToString()"]
         body = "{" + ", ".join(values) + "}"
         if _has_dict(cls):
             read = [f"def read_{i}(m):", f"    obj = Cls{i}.__new__(Cls{i})", f"    obj.__dict__.update({body})", "    return obj"]
         else:
             read = [f"def read_{i}(m):", f"    return Cls{i}(**{body})"]
-        source += fill + [""] + read + [""]
+        source += fill + [""] + read + [""] + (encode + [""] if cls is builder.cls else [])
     exec(compile("\n".join(source), f"<tafel serializer {builder.cls.__name__}>", "exec"), builder.namespace)  # noqa: S102
 
 

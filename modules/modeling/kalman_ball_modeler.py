@@ -5,14 +5,45 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
 from core import Module, provides, requires
 from representations.infrastructure import FrameInfo
 from representations.modeling import BallModel
 from representations.perception import BallPercept
 
-_H = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]])
+
+@dataclass
+class AxisFilter:
+    """A constant-velocity Kalman filter along one axis: position p (mm), velocity v (mm/s) and their
+    covariance. The ball model is separable (same motion and noise along x and y, no coupling), so two
+    of these are exactly one 4-state filter, at a fraction of the cost."""
+
+    p: float
+    v: float
+    pp: float  # var(p)
+    pv: float  # cov(p, v)
+    vv: float  # var(v)
+
+    def predict(self, dt: float, decay: float, q: float) -> None:
+        """x' = F x with F = [[1, dt], [0, decay]]; P' = F P F^T + Q (white-noise acceleration)."""
+        pp, pv, vv = self.pp, self.pv, self.vv
+        self.p += dt * self.v
+        self.v *= decay
+        self.pp = pp + 2 * dt * pv + dt * dt * vv + q * dt**4 / 4
+        self.pv = decay * (pv + dt * vv) + q * dt**3 / 2
+        self.vv = decay * decay * vv + q * dt * dt
+
+    def innovation(self, measured: float, r: float) -> tuple[float, float]:
+        """(measured - predicted position, its variance)."""
+        return measured - self.p, self.pp + r
+
+    def update(self, residual: float, s: float) -> None:
+        gain_p, gain_v = self.pp / s, self.pv / s
+        self.p += gain_p * residual
+        self.v += gain_v * residual
+        pp, pv, vv = self.pp, self.pv, self.vv
+        self.pp = (1 - gain_p) * pp
+        self.pv = (1 - gain_p) * pv
+        self.vv = vv - gain_v * pv
 
 
 @requires(BallPercept, FrameInfo)
@@ -45,8 +76,7 @@ class KalmanBallModeler(Module):
         """s, step used when the frame clock does not advance"""
 
     def __init__(self) -> None:
-        self.state: np.ndarray | None = None
-        self.covariance = np.zeros((4, 4))
+        self.axes: tuple[AxisFilter, AxisFilter] | None = None
         self.last_time_ns: int | None = None
         self.last_seen_ns: int | None = None
 
@@ -56,50 +86,39 @@ class KalmanBallModeler(Module):
         if self.last_time_ns is not None and now_ns > self.last_time_ns:
             dt = (now_ns - self.last_time_ns) * 1e-9
         self.last_time_ns = now_ns
-        if self.state is not None:
-            self.predict(dt)
+        p = self.parameters
+        if self.axes is not None:
+            decay, q = math.exp(-p.friction * dt), p.acceleration_noise**2
+            for axis in self.axes:
+                axis.predict(dt, decay, q)
         percept = self.ball_percept
         if percept.seen:
             self.update(percept.x, percept.y)
             self.last_seen_ns = now_ns
         self.publish(now_ns, percept.seen)
 
-    def predict(self, dt: float) -> None:
-        p = self.parameters
-        decay = math.exp(-p.friction * dt)
-        transition = np.array([[1, 0, dt, 0], [0, 1, 0, dt], [0, 0, decay, 0], [0, 0, 0, decay]], dtype=float)
-        q = p.acceleration_noise**2
-        axis = np.array([[dt**4 / 4, dt**3 / 2], [dt**3 / 2, dt**2]]) * q
-        noise = np.zeros((4, 4))
-        noise[np.ix_([0, 2], [0, 2])] = axis
-        noise[np.ix_([1, 3], [1, 3])] = axis
-        self.state = transition @ self.state
-        self.covariance = transition @ self.covariance @ transition.T + noise
-
     def update(self, x: float, y: float) -> None:
         p = self.parameters
         std = p.measurement_std + p.measurement_std_per_m * math.hypot(x, y) / 1000.0
-        noise = np.eye(2) * std**2
-        measurement = np.array([x, y])
-        if self.state is not None:
-            innovation = measurement - _H @ self.state
-            innovation_cov = _H @ self.covariance @ _H.T + noise
-            distance = float(innovation @ np.linalg.solve(innovation_cov, innovation))
+        r = std * std
+        if self.axes is not None:
+            innovations = [axis.innovation(measured, r) for axis, measured in zip(self.axes, (x, y))]
+            distance = sum(residual * residual / s for residual, s in innovations)
             if distance <= p.restart_gate:
-                gain = self.covariance @ _H.T @ np.linalg.inv(innovation_cov)
-                self.state = self.state + gain @ innovation
-                self.covariance = (np.eye(4) - gain @ _H) @ self.covariance
+                for axis, (residual, s) in zip(self.axes, innovations):
+                    axis.update(residual, s)
                 return
-        self.state = np.array([x, y, 0.0, 0.0])
-        self.covariance = np.diag([std**2, std**2, p.initial_velocity_std**2, p.initial_velocity_std**2])
+        v = p.initial_velocity_std**2
+        self.axes = (AxisFilter(x, 0.0, r, 0.0, v), AxisFilter(y, 0.0, r, 0.0, v))
 
     def publish(self, now_ns: int, seen: bool) -> None:
         model = self.ball_model
         model.seen = seen
-        if self.state is None or self.last_seen_ns is None:
+        if self.axes is None or self.last_seen_ns is None:
             model.valid = False
             return
-        model.x, model.y, model.vx, model.vy = (float(v) for v in self.state)
-        model.position_std = math.sqrt(max(0.0, (self.covariance[0, 0] + self.covariance[1, 1]) / 2))
+        ax, ay = self.axes
+        model.x, model.y, model.vx, model.vy = ax.p, ay.p, ax.v, ay.v
+        model.position_std = math.sqrt(max(0.0, (ax.pp + ay.pp) / 2))
         model.time_since_seen = max(0.0, (now_ns - self.last_seen_ns) * 1e-9)
         model.valid = model.time_since_seen <= self.parameters.forget_after

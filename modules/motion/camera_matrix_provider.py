@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from core import Module, provides, requires
-from modules.motion.kinematics import angles_by_name, camera_pose_in_torso, link_poses, robot_frame_from_torso
+from modules.motion.kinematics import CAMERA_LINKS, angles_by_name, camera_pose_in_torso, link_poses, robot_frame_from_torso
 from representations.motion import CameraMatrixBottom, CameraMatrixTop, InertialModel, JointSensorData, TorsoPose
 from representations.nao import BOTTOM_CAMERA, TOP_CAMERA
 
@@ -15,7 +15,7 @@ class CameraMatrixProvider(Module):
     head joints and the camera mounts of the reference figures."""
 
     def execute(self) -> None:
-        poses = link_poses(angles_by_name(self.joint_sensor_data.position))
+        poses = link_poses(angles_by_name(self.joint_sensor_data.position), CAMERA_LINKS)
         torso = robot_frame_from_torso(poses, self.inertial_model.roll, self.inertial_model.pitch)
         self.torso_pose.rotation = torso[:3, :3].copy()
         self.torso_pose.translation = torso[:3, 3].copy()

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from functools import lru_cache
+from typing import Any
 
 import numpy as np
 
@@ -44,18 +46,73 @@ def angles_by_name(positions: np.ndarray) -> dict[str, float]:
     return angles
 
 
-def link_poses(angles: Mapping[str, float]) -> dict[str, np.ndarray]:
-    """Every link's pose in the torso frame for the given joint angles (missing joints count as 0)."""
+def _skew(axis: tuple[float, float, float]) -> np.ndarray:
+    x, y, z = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+def _terms(joint: Any) -> np.ndarray:
+    """(A, B, C) with the joint's local transform = A + sin(angle) B + (1 - cos(angle)) C (Rodrigues)."""
+    k = _skew(joint.axis)
+    a, b, c = np.eye(4), np.zeros((4, 4)), np.zeros((4, 4))
+    a[:3, 3] = joint.offset
+    b[:3, :3], c[:3, :3] = k, k @ k
+    return np.stack([a, b, c]).reshape(3, 16)
+
+
+#: per joint, computed once, so that a joint's transform is one small matrix product
+_TERMS = {joint.name: _terms(joint) for joint in JOINTS}
+_PARENT = {joint.link: joint for joint in JOINTS}
+
+
+@lru_cache(maxsize=None)
+def _chain(links: tuple[str, ...]) -> tuple:
+    """The joints from the torso to ``links``, parents first."""
+    needed: list = []
+    for link in links:
+        path = []
+        while link in _PARENT:
+            joint = _PARENT[link]
+            path.append(joint)
+            link = joint.parent
+        needed += [j for j in reversed(path) if j not in needed]
+    return tuple(needed)
+
+
+_ALL_LINKS = tuple(joint.link for joint in JOINTS)
+
+
+def link_poses(angles: Mapping[str, float], links: tuple[str, ...] = _ALL_LINKS) -> dict[str, np.ndarray]:
+    """Link poses in the torso frame for the given joint angles (missing joints count as 0): of
+    ``links`` and the links on their way from the torso (all links by default)."""
+    chain, terms = _chain(links), _chain_terms(links)
+    q = np.array([angles.get(joint.name, 0.0) for joint in chain])
+    coefficients = np.stack([np.ones_like(q), np.sin(q), 1.0 - np.cos(q)], axis=1)
+    local = np.einsum("jk,jkl->jl", coefficients, terms).reshape(-1, 4, 4)  # every joint's transform at once
     poses = {"torso": np.eye(4)}
-    for joint in JOINTS:
-        local = transform(rotation(joint.axis, angles.get(joint.name, 0.0)), joint.offset)
-        poses[joint.link] = poses[joint.parent] @ local
+    for joint, transform_ in zip(chain, local):
+        poses[joint.link] = poses[joint.parent] @ transform_
     return poses
+
+
+@lru_cache(maxsize=None)
+def _chain_terms(links: tuple[str, ...]) -> np.ndarray:
+    return np.stack([_TERMS[joint.name] for joint in _chain(links)])
+
+
+#: the links the camera matrices need: the head, and both feet for the ground
+CAMERA_LINKS = ("Head", "LFoot", "RFoot")
+
+
+@lru_cache(maxsize=None)
+def camera_mount(camera: CameraMount) -> np.ndarray:
+    """The camera frame in the head frame (constant)."""
+    return transform(rotation((0, 1, 0), camera.tilt), camera.position)
 
 
 def camera_pose_in_torso(poses: Mapping[str, np.ndarray], camera: CameraMount) -> np.ndarray:
     """The camera frame (x along the optical axis, y left, z up in the image) in the torso frame."""
-    return poses["Head"] @ transform(rotation((0, 1, 0), camera.tilt), camera.position)
+    return poses["Head"] @ camera_mount(camera)
 
 
 def sole_in_torso(poses: Mapping[str, np.ndarray], side: str) -> np.ndarray:
@@ -64,8 +121,9 @@ def sole_in_torso(poses: Mapping[str, np.ndarray], side: str) -> np.ndarray:
 
 
 def tilt(roll: float, pitch: float) -> np.ndarray:
-    """The torso's rotation relative to the ground from its roll and pitch (rad)."""
-    return rotation((1, 0, 0), roll) @ rotation((0, 1, 0), pitch)
+    """The torso's rotation relative to the ground from its roll and pitch (rad): Rx(roll) Ry(pitch)."""
+    cr, sr, cp, sp = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch)
+    return np.array([[cp, 0.0, sp], [sr * sp, cr, -sr * cp], [-cr * sp, sr, cr * cp]])
 
 
 def robot_frame_from_torso(poses: Mapping[str, np.ndarray], roll: float, pitch: float) -> np.ndarray:

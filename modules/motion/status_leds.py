@@ -8,7 +8,8 @@ from core import Module, provides, requires
 from representations.infrastructure import CognitionStatus
 from representations.motion import LedRequest
 
-GREEN, RED, BLUE = np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
+GREEN, RED = np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0])
+BLUE_EYE = np.concatenate([np.zeros(16), np.ones(8)])  # 8 red, 8 green, 8 blue segments
 
 
 @requires(CognitionStatus)
@@ -17,12 +18,10 @@ class StatusLeds(Module):
     """Chest green while cognition runs, red when it stalled or died (motion then moves safely);
     eyes blue, ears on."""
 
-    def execute(self) -> None:
-        leds = self.led_request
-        leds.chest = GREEN.copy() if self.cognition_status.alive else RED.copy()
-        eye = np.zeros(24)
-        eye[16:] = 1.0  # the blue segments
-        leds.left_eye, leds.right_eye = eye, eye.copy()
+    def __init__(self) -> None:
+        leds = self.led_request  # the same every frame but for the chest
+        leds.left_eye, leds.right_eye = BLUE_EYE.copy(), BLUE_EYE.copy()
         leds.left_ear, leds.right_ear = np.ones(10), np.ones(10)
-        leds.left_foot, leds.right_foot = np.zeros(3), np.zeros(3)
-        leds.skull = np.zeros(12)
+
+    def execute(self) -> None:
+        self.led_request.chest = GREEN if self.cognition_status.alive else RED
