@@ -4,7 +4,8 @@ Starts ``tafel run`` (dummy platform, paced to the wall clock) and measures over
 1. round trips of ``ping`` and ``representation:print BallModel`` from one client, p50 and p99;
 2. the loops' achieved rates (frames per wall second, as the program measures them) when idle, and
    while 20 clients each keep pipelining batches of commands, with the round trips of a 21st client.
-Done for the lockstep runtime and for the concurrent runtime. Prints one JSON line.
+Done for the default program (MuJoCo, lockstep), and on the dummy platform for the lockstep and the
+concurrent runtime. Prints one JSON line.
 """
 
 from __future__ import annotations
@@ -122,8 +123,9 @@ def measure(*args: str) -> dict:
 
 def main() -> None:
     print(json.dumps({
-        "lockstep": measure(),
-        "concurrent": measure("--concurrent"),
+        "lockstep_mujoco": measure("--platform", "mujoco"),  # the default program
+        "lockstep_dummy": measure("--platform", "dummy"),
+        "concurrent_dummy": measure("--platform", "dummy", "--concurrent"),
         "frame_periods_ms": {"motion": 10.0, "cognition": 33.3},
     }))
 

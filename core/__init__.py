@@ -19,6 +19,7 @@ from core.graph import prune_unsatisfiable
 from core.manager import Blackboard, ModuleManager, ModuleTiming
 from core.module import Module, Requirements, provides, requires, uses
 from core.naming import snake_case
+from core.serialization import SerializationError, deserialize, schema_of, serialize
 from core.representation import (
     array,
     fields_of,
@@ -43,9 +44,11 @@ __all__ = [
     "ReadOnlyRepresentationError",
     "RepresentationDefinitionError",
     "Requirements",
+    "SerializationError",
     "TafelError",
     "UnknownModuleError",
     "array",
+    "deserialize",
     "fields_of",
     "get_representation",
     "is_representation",
@@ -54,6 +57,8 @@ __all__ = [
     "registered_representations",
     "representation",
     "requires",
+    "schema_of",
+    "serialize",
     "snake_case",
     "uses",
     "values_equal",

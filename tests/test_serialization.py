@@ -161,3 +161,12 @@ def test_garbage_bytes_give_a_clear_error() -> None:
 def test_numpy_scalars_are_accepted_in_scalar_fields() -> None:
     back = deserialize(EvoV1, serialize(EvoV1(a=np.int64(4), b=np.float32(0.5))))
     assert (back.a, back.b) == (4, 0.5)
+
+
+def test_the_core_package_offers_serialization() -> None:
+    import core
+    from representations.modeling import BallModel
+
+    model = BallModel(valid=True, x=1200.0, y=-40.0)
+    assert core.deserialize(BallModel, core.serialize(model)) == model
+    assert core.schema_of(BallModel).message_type[0].name == "BallModel"
