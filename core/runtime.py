@@ -115,6 +115,8 @@ class ContextRunner:
         self.time_ns = 0
         #: called after every frame (recording, debug data)
         self.after_step: list[Callable[[ContextRunner], None]] = []
+        #: waits until the next frame in the concurrent runtime; replaced to do work meanwhile (debug commands)
+        self.idle: Callable[[float], None] = time.sleep
 
     @property
     def frames(self) -> int:
@@ -416,7 +418,7 @@ def run_context_loop(
                 break
             if not own_clock:
                 if now < deadline:
-                    time.sleep((deadline - now) * 1e-9)
+                    runner.idle((deadline - now) * 1e-9)
                     now = time.monotonic_ns()
                 stats.period_errors_ms.append((now - deadline) / 1e6)
                 deadline += period_ns

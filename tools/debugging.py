@@ -29,6 +29,8 @@ from debug.protocol import Command
 from debug.server import DebugRouter, DebugServer, Executor
 
 DEBUG_REPRESENTATIONS = (DebugDrawings, DebugPlots)
+#: s before a context's next frame when command work stops, so the frame starts on time
+RESERVE = 0.002
 
 
 class RateMeter:
@@ -171,15 +173,30 @@ def worker_debug_setup(runner: ContextRunner, args: Mapping[str, Any]) -> None:
     if connection is None:
         return
 
+    def answer(budget_s: float) -> None:
+        batch, (kind, payload) = connection.recv()
+        if kind == "commands":
+            connection.send((batch, debug.execute_batch(payload, budget_s=budget_s)))
+        else:
+            connection.send((batch, internal_answer(debug, *payload)))
+
     def serve(_runner: ContextRunner) -> None:
         while connection.poll():
-            batch, (kind, payload) = connection.recv()
-            if kind == "commands":
-                connection.send((batch, debug.execute_batch(payload, budget_s=budget)))
-            else:
-                connection.send((batch, internal_answer(debug, *payload)))
+            answer(budget)
+
+    def idle(seconds: float) -> None:
+        """While the loop waits for its next frame: answer batches as they arrive, stopping in time."""
+        end = time.perf_counter() + seconds
+        work_until = end - min(RESERVE, seconds / 2)
+        while (left := work_until - time.perf_counter()) > 0:
+            if connection.poll(min(left, 0.005)):
+                answer(max(0.0, work_until - time.perf_counter()))
+        rest = end - time.perf_counter()
+        if rest > 0:
+            time.sleep(rest)
 
     runner.after_step.append(serve)
+    runner.idle = idle
 
 
 class ProgramDebug:
