@@ -137,6 +137,7 @@ def answer_bytes(text: str | bytes, *, base64_answer: bool = False) -> bytes:
 
 
 IAC, SB, SE = 255, 250, 240
+MAX_SUBNEGOTIATION = 512  # real ones are a few bytes; a longer one is garbage, and reading goes on
 _NEGOTIATION = {251, 252, 253, 254}  # WILL, WONT, DO, DONT
 
 
@@ -144,13 +145,15 @@ class TelnetDecoder:
     """Strips telnet option negotiation from a byte stream and splits it into lines.
 
     Accepts ``\\n``, ``\\r\\n`` and ``\\r\\0`` line ends; ``IAC IAC`` is a literal 0xFF. State survives
-    chunk boundaries. Lines longer than ``MAX_LINE`` are reported (``None`` in the output) and skipped.
+    chunk boundaries. Lines longer than ``MAX_LINE`` are reported (``None`` in the output) and skipped; a
+    subnegotiation that does not end within ``MAX_SUBNEGOTIATION`` bytes is given up.
     """
 
     def __init__(self, max_line: int = MAX_LINE) -> None:
         self.max_line = max_line
         self.buffer = bytearray()
         self.state = "data"
+        self.sub_length = 0
         self.overlong = False
         self.pending_cr = False
 
@@ -171,13 +174,18 @@ class TelnetDecoder:
                     self.state = "option"
                 elif byte == SB:
                     self.state = "sub"
+                    self.sub_length = 0
                 else:
                     self.state = "data"  # two-byte command (NOP, GA, ...)
             elif state == "option":
                 self.state = "data"
             elif state == "sub":
+                self.sub_length += 1
                 if byte == IAC:
                     self.state = "sub-iac"
+                elif self.sub_length > MAX_SUBNEGOTIATION:
+                    self.state = "data"  # no IAC SE came: not a subnegotiation after all
+                    self._data(byte, lines)
             elif state == "sub-iac":
                 self.state = "data" if byte == SE else "sub"
         return lines

@@ -105,3 +105,9 @@ def test_answers_end_with_newline_and_nul() -> None:
     assert answer_bytes("pong") == b"pong\n\0"
     assert answer_bytes("pong", base64_answer=True) == b"cG9uZw==\n\0"
     assert answer_bytes(b"\x00\x01") == b"AAE=\n\0"
+
+
+def test_an_endless_subnegotiation_is_given_up_and_lines_follow() -> None:
+    decoder = TelnetDecoder()
+    lines = decoder.feed(bytes([255, 250]) + b"x" * 600 + b"\nping\n")
+    assert lines[-1] == b"ping"

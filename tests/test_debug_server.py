@@ -5,6 +5,7 @@ from __future__ import annotations
 import base64
 import json
 import os
+import random
 import re
 import shutil
 import socket
@@ -232,7 +233,8 @@ def test_bad_clients_never_stop_the_program_or_other_clients(program: Program) -
     with program.client() as watcher:
         # an overlong line, invalid UTF-8 and binary garbage get error answers and the connection goes on
         with socket.create_connection((program.host, program.port)) as raw:
-            garbage = os.urandom(2000).replace(b"\n", b"").replace(b"\r", b"")
+            # binary garbage (seeded: the same bytes every run), without telnet's IAC, tested on its own
+            garbage = random.Random(7).randbytes(2000).replace(b"\n", b"").replace(b"\r", b"").replace(b"\xff", b"")
             raw.sendall(b"x" * (70 * 1024) + b"\n" + b"\xfe\xfd garbage \xc3\x28\n" + garbage + b"\nping\n")
             data = b""
             raw.settimeout(10)
