@@ -13,6 +13,7 @@ Both call the same ``ContextRunner.step`` per frame: sense, take hand-overs, exe
 
 from __future__ import annotations
 
+import faulthandler
 import hashlib
 import logging
 import multiprocessing
@@ -161,15 +162,27 @@ class StopFlag:
         return self._event.is_set()
 
 
-def install_signal_handlers(stop: Any, on_force: Callable[[], None] | None = None) -> None:
-    """First Ctrl-C or SIGTERM asks for a clean stop; a second Ctrl-C forces (KeyboardInterrupt)."""
+#: s a clean stop may take before the program dumps every thread's stack and exits anyway
+SHUTDOWN_GRACE_S = 15.0
+
+
+def install_signal_handlers(stop: Any, on_force: Callable[[], None] | None = None, grace_s: float = SHUTDOWN_GRACE_S) -> None:
+    """First Ctrl-C or SIGTERM asks for a clean stop; a second one forces (KeyboardInterrupt).
+
+    A stop that has not finished after ``grace_s`` dumps all threads' stacks to stderr and exits (a
+    module stuck in an endless loop, say): a robot program must go away when it is told to, and the
+    dump says what held it.
+    """
 
     def handle(signum: int, _frame: Any) -> None:
-        if stop.is_set() and signum == signal.SIGINT:
+        if stop.is_set():
             if on_force is not None:
                 on_force()
             raise KeyboardInterrupt
         stop.set()
+        print(f"stopping; if that takes more than {grace_s:g} s, every thread's stack is dumped and the program exits",
+              file=sys.stderr, flush=True)
+        faulthandler.dump_traceback_later(grace_s, exit=True)
         if signum == signal.SIGINT:
             print("\nstopping (Ctrl-C again to force)", file=sys.stderr, flush=True)
 

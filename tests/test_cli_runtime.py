@@ -168,3 +168,17 @@ def test_motion_sees_a_stalled_cognition_and_its_return() -> None:
     # a 2 s stall with a 1 s timeout: roughly 100 motion frames without cognition, then it is back
     assert 30 < without < 200, without
     assert frames(result.stdout)["cognition"] > 20
+
+
+def test_a_stuck_module_cannot_keep_the_program_from_stopping() -> None:
+    process = subprocess.Popen(
+        [*TAFEL, "run", "--platform", "dummy", "--no-debug", "--set", "runtime.shutdown_grace_s=1",
+         "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "tests.support.runtime_faults:StuckForever"]'],
+        cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(REPO)},
+    )
+    time.sleep(3)  # well inside the stuck frame
+    process.send_signal(signal.SIGTERM)
+    out, err = process.communicate(timeout=30)
+    assert process.returncode != 0
+    assert "every thread's stack is dumped" in err
+    assert "StuckForever" not in out and "runtime_faults.py" in err  # the dump shows where it was stuck

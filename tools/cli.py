@@ -200,7 +200,7 @@ def command_run(args: argparse.Namespace, extra: Sequence[str]) -> int:
     limits = Limits(frames=args.frames, seconds=args.seconds, speed=args.speed)
     if args.concurrent or type(platform).clock == "own":
         return run_concurrent(args, platform, options, plans, config, recorder, limits)
-    return run_lockstep(args, platform, plans, recorder, limits)
+    return run_lockstep(args, platform, plans, recorder, limits, config)
 
 
 def start_debug(args: argparse.Namespace, recorder: Recorder | None, plans: dict[str, ContextPlan]) -> ProgramDebug | None:
@@ -226,7 +226,12 @@ def listen(args: argparse.Namespace, debug: ProgramDebug | None) -> None:
     print(f"debug server listening on {host}:{port}", flush=True)
 
 
-def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, ContextPlan], recorder: Recorder | None, limits: Limits) -> int:
+def shutdown_grace(config: dict[str, Any]) -> float:
+    return float(config.get("runtime", {}).get("shutdown_grace_s", 15.0))
+
+
+def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, ContextPlan], recorder: Recorder | None,
+                 limits: Limits, config: dict[str, Any]) -> int:
     runtime = LockstepRuntime(plans, platform, strict=args.strict, recorder=recorder)
     debug = start_debug(args, recorder, plans)
     if debug is not None:
@@ -236,8 +241,8 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
         debug.add_platform_commands(platform)
         runtime.after_tick.append(lambda _runtime: debug.server.process_pending())
         runtime.idle = debug.server.serve_while_idle
-        listen(args, debug)
-    install_signal_handlers(runtime.stop)
+    install_signal_handlers(runtime.stop, grace_s=shutdown_grace(config))
+    listen(args, debug)
     started = time.monotonic()
     last = [started]
 
@@ -284,7 +289,8 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
             print(format_status(platform_class.name, now - started, rt.stats, rt.notices), file=sys.stderr, flush=True)
 
     runtime.on_report.append(on_report)
-    install_signal_handlers(runtime.stop, on_force=lambda: [p.kill() for p in runtime.processes.values()])
+    install_signal_handlers(runtime.stop, on_force=lambda: [p.kill() for p in runtime.processes.values()],
+                            grace_s=shutdown_grace(config))
     if debug is not None:
         listen(args, debug)
         threading.Thread(target=debug.server.dispatch_forever, args=(runtime.stop,), name="tafel-debug-dispatch", daemon=True).start()

@@ -50,3 +50,12 @@ class RaiseEveryFrame(Module):
 
     def execute(self) -> None:
         raise RuntimeError(f"deliberate failure in frame {self.frame_info.frame_number}")
+
+
+@requires(FrameInfo)
+class StuckForever(Module):
+    """Never returns from its first frame (ignores stop requests): the shutdown watchdog's case."""
+
+    def execute(self) -> None:
+        while True:
+            time.sleep(0.1)
