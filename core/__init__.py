@@ -19,7 +19,6 @@ from core.graph import prune_unsatisfiable
 from core.manager import Blackboard, ModuleManager, ModuleTiming
 from core.module import Module, Requirements, provides, requires, uses
 from core.naming import snake_case
-from core.serialization import SerializationError, deserialize, schema_of, serialize
 from core.representation import (
     array,
     fields_of,
@@ -29,6 +28,7 @@ from core.representation import (
     representation,
     values_equal,
 )
+from core.serialization import SerializationError, deserialize, schema_of, serialize
 
 __all__ = [
     "Blackboard",

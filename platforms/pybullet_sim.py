@@ -15,7 +15,7 @@ import numpy as np
 import pybullet
 
 from core.platform import PlatformError
-from platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, SERVO_TORQUE, FieldPart, field_parts, fsr_sites, urdf
+from platforms.robot_model import BALL_FRICTION, SERVO_TORQUE, STANDING_HEIGHT, FieldPart, field_parts, fsr_sites, urdf
 from platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from representations.motion import JOINT_NAMES
 from representations.nao import CAMERAS, COUPLED_JOINTS, SOLE_BACK, SOLE_FRONT, VERTICAL_FOV

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from core import ModuleManager, Module, provides, representation
+from core import Module, ModuleManager, provides, representation
 from core.handover import HandoverError, LocalChannel, SharedChannel, apply_bundle, make_bundle, snapshot
 
 

@@ -20,8 +20,7 @@ from modules.motion.camera_matrix_provider import CameraMatrixProvider
 from modules.perception.ball_detector import BallDetector
 from modules.perception.ball_locator import BallLocator
 from representations.modeling import BallModel
-from representations.motion import HEAD_YAW, InertialModel, InertialSensorData, JointSensorData
-from representations.motion import CameraMatrixBottom, CameraMatrixTop
+from representations.motion import HEAD_YAW, CameraMatrixBottom, CameraMatrixTop, InertialModel, InertialSensorData, JointSensorData
 from representations.perception import BallCandidate, BallImagePercept, BallPercept, CameraImageBottom, CameraImageTop
 from tests.support.simulation import Simulation
 from tests.test_cli_runtime import REPO, frames, tafel

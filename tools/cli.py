@@ -19,6 +19,7 @@ from core.errors import TafelError
 from core.platform import Platform, PlatformError, PlatformOptionError, available_platforms, load_platform
 from core.program import ContextPlan, plan_program
 from core.recording import Recorder, select
+from core.runtime import ConcurrentRuntime, ContextStats, Limits, LockstepRuntime, install_signal_handlers
 from representations.modeling import BallModel
 from tools.debugging import (
     DEBUG_REPRESENTATIONS,
@@ -30,7 +31,6 @@ from tools.debugging import (
     handovers_of,
     worker_debug_setup,
 )
-from core.runtime import ConcurrentRuntime, ContextStats, Limits, LockstepRuntime, install_signal_handlers
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_CONFIG = REPO_ROOT / "config"
