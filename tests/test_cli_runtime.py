@@ -86,6 +86,9 @@ def test_platforms_lists_what_each_provides_and_consumes() -> None:
     assert result.returncode == 0
     assert "dummy: deterministic clock" in result.stdout
     assert "motion: provides FrameInfo, JointSensorData, InertialSensorData, FsrData; consumes JointCommand" in result.stdout
+    verbose = tafel("platforms", "--verbose")
+    assert "option --seed: dummy: seed of the synthetic sensor noise" in verbose.stdout
+    assert "option --lola: nao: LoLA's Unix socket" in verbose.stdout
 
 
 def test_modules_shows_order_providers_and_hand_overs() -> None:

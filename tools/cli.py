@@ -92,7 +92,8 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", metavar="COMMAND")
     commands.required = True
 
-    run = commands.add_parser("run", help="run the program on a platform")
+    run = commands.add_parser("run", help="run the program on a platform",
+                              epilog="Each platform has options of its own: tafel platforms --verbose lists them.")
     add_program_arguments(run)
     limit = run.add_mutually_exclusive_group()
     limit.add_argument("--seconds", type=positive(float), help="stop after this much platform time")
@@ -117,7 +118,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_console_command(commands)
 
     platforms = commands.add_parser("platforms", help="list the platforms and what they provide and consume")
-    platforms.add_argument("--verbose", "-v", action="store_true")
+    platforms.add_argument("--verbose", "-v", action="store_true", help="also list each platform's options")
 
     modules = commands.add_parser("modules", help="show the module graph of both contexts")
     add_program_arguments(modules)
@@ -380,6 +381,11 @@ def command_platforms(args: argparse.Namespace, extra: Sequence[str]) -> int:
             provided = ", ".join(r.__name__ for r in cls.provides.get(context, ())) or "-"
             consumed = ", ".join(r.__name__ for r in cls.consumes.get(context, ())) or "-"
             print(f"  {context}: provides {provided}; consumes {consumed}")
+        if args.verbose:
+            options = argparse.ArgumentParser(prog=f"tafel run --platform {name}", add_help=False)
+            cls.add_arguments(options)
+            for action in options._actions:
+                print(f"  option {', '.join(action.option_strings)}: {action.help}")
     return 0
 
 
