@@ -334,7 +334,3 @@ def writer_view(target: Any, mark: AccessMark, undo: list) -> WriterView:
         _WRITE_VIEWS[cls] = view_cls
     return view_cls(target, mark, undo)
 
-
-def target_of(view: Any) -> Any:
-    """The representation behind a view (or the object itself if it is none)."""
-    return view._t if isinstance(view, (ReadOnlyView, WriterView)) else view

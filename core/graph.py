@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import heapq
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from core.errors import (
     ConflictingProvidersError,
@@ -29,10 +29,6 @@ class Plan:
     order: list[type]
     #: representation class -> providing module class, or None when it comes from outside
     provider: dict[type, type | None]
-    #: representation class -> every enabled module class that could provide it
-    candidates: dict[type, list[type]]
-    #: enabled modules that do not run because they were chosen as provider of nothing
-    idle: list[type] = field(default_factory=list)
 
 
 def module_names(modules: Sequence[type]) -> dict[str, type]:
@@ -87,10 +83,9 @@ def build_plan(
     provider.update(chosen)
 
     active = [m for m in enabled if not declared[m].provides or any(chosen.get(r) is m for r in declared[m].provides)]
-    idle = [m for m in enabled if m not in active]
     _check_missing(active, declared, provider, modules, disabled, candidates)
     order = _topological_order(active, declared, provider)
-    return Plan(order=order, provider=provider, candidates=candidates, idle=idle)
+    return Plan(order=order, provider=provider)
 
 
 def _choose_providers(

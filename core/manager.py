@@ -235,15 +235,6 @@ class ModuleManager:
         """Every module that could provide ``rep_name`` (enabled or not)."""
         return [m.__name__ for m in self._modules if any(r.__name__ == rep_name for r in m.requirements().provides)]
 
-    def provided_representations(self) -> list[type]:
-        """Representations some module of this manager provides (not the external ones)."""
-        return [rep for rep, module in self._plan.provider.items() if module is not None]
-
-    def read_representations(self) -> list[type]:
-        """Representations some active module requires or uses."""
-        active = {slot.cls for slot in self._slots}
-        return list(dict.fromkeys(r for m in self._modules if m in active for r in m.requirements().reads()))
-
     def timings(self) -> dict[str, ModuleTiming]:
         """Execution times per running module (window of the last ``TIMING_WINDOW`` frames)."""
         result = {}

@@ -24,10 +24,6 @@ JOINT_INDEX: dict[str, int] = {name: i for i, name in enumerate(JOINT_NAMES)}
 HEAD_YAW, HEAD_PITCH = JOINT_INDEX["HeadYaw"], JOINT_INDEX["HeadPitch"]
 
 
-def joint_array() -> np.ndarray:
-    return np.zeros(JOINT_COUNT)
-
-
 @representation
 class JointSensorData:
     """Measured joint state: ``position`` (rad; hands 0..1 open), ``stiffness`` (0..1), ``current`` (A),

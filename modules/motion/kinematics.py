@@ -10,12 +10,11 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from functools import lru_cache
-from typing import Any
 
 import numpy as np
 
 from representations.motion import JOINT_INDEX
-from representations.nao import COUPLED_JOINTS, FOOT_HEIGHT, JOINTS, CameraMount
+from representations.nao import COUPLED_JOINTS, FOOT_HEIGHT, JOINTS, CameraMount, Joint
 
 
 def rotation(axis: tuple[float, float, float] | np.ndarray, angle: float) -> np.ndarray:
@@ -51,7 +50,7 @@ def _skew(axis: tuple[float, float, float]) -> np.ndarray:
     return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
 
 
-def _terms(joint: Any) -> np.ndarray:
+def _terms(joint: Joint) -> np.ndarray:
     """(A, B, C) with the joint's local transform = A + sin(angle) B + (1 - cos(angle)) C (Rodrigues)."""
     k = _skew(joint.axis)
     a, b, c = np.eye(4), np.zeros((4, 4)), np.zeros((4, 4))
