@@ -23,14 +23,14 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
-from debug.client import DebugClient  # noqa: E402
+from tafel.debug.client import DebugClient  # noqa: E402
 
 HAMMER_SECONDS = 5.0
 CLIENTS = 20
 
 
 def start(*args: str) -> tuple[subprocess.Popen, int]:
-    process = subprocess.Popen([sys.executable, "-m", "tools.cli", "run", "--debug-port", "0", "--status-interval", "3600", *args],
+    process = subprocess.Popen([sys.executable, "-m", "tafel.tools.cli", "run", "--debug-port", "0", "--status-interval", "3600", *args],
                                cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
                                env={**os.environ, "PYTHONPATH": str(REPO)})
     line = process.stdout.readline()

@@ -13,9 +13,9 @@ import json
 import statistics
 import time
 
-from core import Module, ModuleManager, provides, representation, requires
-from core.manager import make_module
-from core.naming import snake_case
+from tafel.core import Module, ModuleManager, provides, representation, requires
+from tafel.core.manager import make_module
+from tafel.core.naming import snake_case
 
 CHAIN = 100
 FRAMES = 2000

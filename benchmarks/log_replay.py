@@ -20,17 +20,17 @@ from pathlib import Path
 
 import numpy as np
 
-from core.config import load_config
-from core.program import plan_program
-from core.recording import Recorder, select
-from core.runtime import Limits, LockstepRuntime
-from core.serialization import codec, serialize
-from platforms.dummy import DummyPlatform
-from platforms.log import LogPlatform
-from representations.infrastructure import FrameInfo
-from representations.modeling import BallModel
-from representations.motion import InertialSensorData, JointSensorData
-from tools.cli import DEFAULT_CONFIG, discover_modules
+from tafel.core.config import load_config
+from tafel.core.program import plan_program
+from tafel.core.recording import Recorder, select
+from tafel.core.runtime import Limits, LockstepRuntime
+from tafel.core.serialization import codec, serialize
+from tafel.platforms.dummy import DummyPlatform
+from tafel.platforms.log import LogPlatform
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.modeling import BallModel
+from tafel.representations.motion import InertialSensorData, JointSensorData
+from tafel.tools.cli import DEFAULT_CONFIG, discover_modules
 
 MOTION_FRAMES = 10_000
 

@@ -16,12 +16,12 @@ import json
 import os
 import threading
 
-from core.config import load_config
-from core.handover import LocalChannel
-from core.program import plan_program
-from core.runtime import ConcurrentRuntime, ContextRunner, Limits, StopFlag, cognition_watcher, run_context_loop, try_realtime
-from platforms.dummy import DummyPlatform
-from tools.cli import DEFAULT_CONFIG, discover_modules
+from tafel.core.config import load_config
+from tafel.core.handover import LocalChannel
+from tafel.core.program import plan_program
+from tafel.core.runtime import ConcurrentRuntime, ContextRunner, Limits, StopFlag, cognition_watcher, run_context_loop, try_realtime
+from tafel.platforms.dummy import DummyPlatform
+from tafel.tools.cli import DEFAULT_CONFIG, discover_modules
 
 
 def plans(load_ms: float):
@@ -85,7 +85,7 @@ def run_bare_floor(frames: int) -> dict:
     """The machine's floor: a bare 100 Hz sleep loop with nothing else running (same SCHED_FIFO request)."""
     import time
 
-    from core.runtime import ContextStats
+    from tafel.core.runtime import ContextStats
 
     try_realtime(50)
     stats = ContextStats(name="floor")

@@ -3,8 +3,8 @@
 Depends on nothing else in the project; everything else depends on it.
 """
 
-from core.access import ReadOnlyArray
-from core.errors import (
+from tafel.core.access import ReadOnlyArray
+from tafel.core.errors import (
     ConflictingProvidersError,
     DependencyCycleError,
     MissingProviderError,
@@ -15,11 +15,11 @@ from core.errors import (
     TafelError,
     UnknownModuleError,
 )
-from core.graph import prune_unsatisfiable
-from core.manager import Blackboard, ModuleManager, ModuleTiming
-from core.module import Module, Requirements, provides, requires, uses
-from core.naming import snake_case
-from core.representation import (
+from tafel.core.graph import prune_unsatisfiable
+from tafel.core.manager import Blackboard, ModuleManager, ModuleTiming
+from tafel.core.module import Module, Requirements, provides, requires, uses
+from tafel.core.naming import snake_case
+from tafel.core.representation import (
     array,
     fields_of,
     get_representation,
@@ -28,7 +28,7 @@ from core.representation import (
     representation,
     values_equal,
 )
-from core.serialization import SerializationError, deserialize, schema_of, serialize
+from tafel.core.serialization import SerializationError, deserialize, schema_of, serialize
 
 __all__ = [
     "Blackboard",

@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from core.errors import ReadOnlyRepresentationError
-from core.representation import fields_of
+from tafel.core.errors import ReadOnlyRepresentationError
+from tafel.core.representation import fields_of
 
 _SCALAR_KINDS = frozenset({"bool", "int", "float", "str", "bytes", "enum"})
 

@@ -1,5 +1,8 @@
 """Layered TOML configuration: general -> platform/<name> -> robot/<name> -> private -> --set.
 
+The layers are read from one or more configuration folders in order: the defaults that ship inside the
+package first, then each folder given with ``--config DIR``, each folder with all four layers.
+
 Each layer is optional and overrides what came before, table by table; lists are replaced whole.
 A configuration file looks like::
 
@@ -21,11 +24,11 @@ from __future__ import annotations
 
 import copy
 import tomllib
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from core.errors import TafelError
+from tafel.core.errors import TafelError
 
 CONTEXTS = ("cognition", "motion")
 PRIVATE_FILE = "private/private.toml"
@@ -35,12 +38,19 @@ class ConfigError(TafelError, ValueError):
     """A configuration file or override that cannot be used as written."""
 
 
-def layer_paths(config_dir: Path, platform: str, robot: str | None) -> list[Path]:
+def config_folders(config_dirs: Path | Sequence[Path]) -> list[Path]:
+    """One folder or several, as a list in override order."""
+    return [Path(config_dirs)] if isinstance(config_dirs, (str, Path)) else [Path(d) for d in config_dirs]
+
+
+def layer_paths(config_dirs: Path | Sequence[Path], platform: str, robot: str | None) -> list[Path]:
     """The layer files in override order (only those that exist are read)."""
-    paths = [config_dir / "general.toml", config_dir / "platform" / f"{platform}.toml"]
-    if robot:
-        paths.append(config_dir / "robot" / f"{robot}.toml")
-    paths.append(config_dir / PRIVATE_FILE)
+    paths = []
+    for config_dir in config_folders(config_dirs):
+        paths += [config_dir / "general.toml", config_dir / "platform" / f"{platform}.toml"]
+        if robot:
+            paths.append(config_dir / "robot" / f"{robot}.toml")
+        paths.append(config_dir / PRIVATE_FILE)
     return paths
 
 
@@ -94,14 +104,23 @@ def apply_overrides(config: dict[str, Any], overrides: Iterable[str]) -> dict[st
 
 
 def load_config(
-    config_dir: Path, platform: str, robot: str | None = None, overrides: Iterable[str] = ()
+    config_dirs: Path | Sequence[Path], platform: str, robot: str | None = None, overrides: Iterable[str] = ()
 ) -> dict[str, Any]:
-    """The merged configuration for a platform (and robot), with ``--set`` overrides applied last."""
-    if not config_dir.is_dir():
-        raise ConfigError(f"configuration folder {config_dir} does not exist; pass --config DIR")
+    """The merged configuration for a platform (and robot), with ``--set`` overrides applied last.
+
+    ``config_dirs`` is one folder or several, read in order, later ones overriding earlier ones.
+    """
+    folders = config_folders(config_dirs)
+    for config_dir in folders:
+        if not config_dir.is_dir():
+            raise ConfigError(f"configuration folder {config_dir} does not exist; pass --config DIR with an existing folder")
+    if robot and not any((d / "robot" / f"{robot}.toml").is_file() for d in folders):
+        known = sorted({p.stem for d in folders for p in (d / "robot").glob("*.toml")})
+        raise ConfigError(f"--robot {robot}: no file robot/{robot}.toml in {', '.join(map(str, folders))}; "
+                          + (f"known robots: {', '.join(known)}" if known else "there are no robot files yet"))
     config: dict[str, Any] = {}
     sources = []
-    for path in layer_paths(config_dir, platform, robot):
+    for path in layer_paths(folders, platform, robot):
         if path.is_file():
             config = merge(config, read_toml(path))
             sources.append(str(path))

@@ -10,16 +10,16 @@ import heapq
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
-from core.errors import (
+from tafel.core.errors import (
     ConflictingProvidersError,
     DependencyCycleError,
     MissingProviderError,
     ModuleDefinitionError,
     UnknownModuleError,
 )
-from core.module import Module
-from core.naming import did_you_mean
-from core.representation import is_representation
+from tafel.core.module import Module
+from tafel.core.naming import did_you_mean
+from tafel.core.representation import is_representation
 
 
 @dataclass

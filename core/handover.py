@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from core.errors import TafelError
-from core.manager import Blackboard
+from tafel.core.errors import TafelError
+from tafel.core.manager import Blackboard
 
 
 class HandoverError(TafelError, RuntimeError):

@@ -27,8 +27,8 @@ from mcap.records import Channel, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader
 from mcap.writer import CompressionType, Writer
 
-from core.errors import TafelError
-from core.serialization import file_descriptor_set, message_name
+from tafel.core.errors import TafelError
+from tafel.core.serialization import file_descriptor_set, message_name
 
 PROFILE = "tafel"
 

@@ -9,13 +9,13 @@ from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
-from core.access import AccessMark, read_view, undo_writes, writer_view
-from core.errors import ModuleDefinitionError, UnknownModuleError
-from core.graph import Plan, build_plan, module_names, resolve_module
-from core.module import Module
-from core.naming import did_you_mean, snake_case
-from core.parameters import make_parameters
-from core.representation import reset
+from tafel.core.access import AccessMark, read_view, undo_writes, writer_view
+from tafel.core.errors import ModuleDefinitionError, UnknownModuleError
+from tafel.core.graph import Plan, build_plan, module_names, resolve_module
+from tafel.core.module import Module
+from tafel.core.naming import did_you_mean, snake_case
+from tafel.core.parameters import make_parameters
+from tafel.core.representation import reset
 
 R = TypeVar("R")
 
@@ -311,7 +311,7 @@ class ModuleManager:
 
     def to_dot(self) -> str:
         """Graphviz DOT text of the graph: modules as boxes, representations as ellipses."""
-        from core.dot import manager_dot
+        from tafel.core.dot import manager_dot
 
         return manager_dot(self.graph())
 

@@ -19,9 +19,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
-from core.errors import ModuleDefinitionError
-from core.naming import snake_case
-from core.representation import is_representation
+from tafel.core.errors import ModuleDefinitionError
+from tafel.core.naming import snake_case
+from tafel.core.representation import is_representation
 
 M = TypeVar("M", bound=type)
 
@@ -99,7 +99,7 @@ class _Unbound:
         raise AttributeError(
             f"{owner.__name__}.{snake_case(self.rep.__name__)} is not connected to a blackboard: modules "
             "get their representations from a ModuleManager; in tests use the run_module fixture or "
-            "core.testing.ModuleHarness"
+            "tafel.core.testing.ModuleHarness"
         )
 
 
@@ -114,8 +114,8 @@ def find_module(name: str) -> type:
     name wins); ``tools`` imports the ``modules`` package so that all of them are known. A name of the
     form ``package.module:ClassName`` is imported on demand.
     """
-    from core.errors import UnknownModuleError
-    from core.naming import did_you_mean
+    from tafel.core.errors import UnknownModuleError
+    from tafel.core.naming import did_you_mean
 
     if ":" in name:
         import importlib

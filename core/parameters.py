@@ -13,8 +13,8 @@ import typing
 from collections.abc import Mapping
 from typing import Any
 
-from core.errors import TafelError
-from core.naming import did_you_mean
+from tafel.core.errors import TafelError
+from tafel.core.naming import did_you_mean
 
 
 class ParameterError(TafelError, ValueError):

@@ -13,13 +13,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from core.config import CONTEXTS, ConfigError, context_section
-from core.errors import ConflictingProvidersError, MissingProviderError
-from core.graph import build_plan
-from core.manager import ModuleManager
-from core.module import find_module
-from core.platform import Platform
-from core.status import CognitionStatus
+from tafel.core.config import CONTEXTS, ConfigError, context_section
+from tafel.core.errors import ConflictingProvidersError, MissingProviderError
+from tafel.core.graph import build_plan
+from tafel.core.manager import ModuleManager
+from tafel.core.module import find_module
+from tafel.core.platform import Platform
+from tafel.core.status import CognitionStatus
 
 DEFAULT_RATES = {"cognition": 30.0, "motion": 100.0}
 

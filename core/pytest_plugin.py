@@ -7,8 +7,8 @@ from typing import Any
 
 import pytest
 
-from core.testing import ModuleHarness
-from core.testing import run_module as _run_module
+from tafel.core.testing import ModuleHarness
+from tafel.core.testing import run_module as _run_module
 
 
 @pytest.fixture

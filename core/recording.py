@@ -14,12 +14,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from core.errors import UnknownModuleError
-from core.logfile import LogWriter
-from core.manager import Blackboard
-from core.naming import did_you_mean
-from core.program import ContextPlan
-from core.serialization import SerializationError, serialize
+from tafel.core.errors import UnknownModuleError
+from tafel.core.logfile import LogWriter
+from tafel.core.manager import Blackboard
+from tafel.core.naming import did_you_mean
+from tafel.core.program import ContextPlan
+from tafel.core.serialization import SerializationError, serialize
 
 
 class Sink(Protocol):

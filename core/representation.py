@@ -19,7 +19,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from core.errors import RepresentationDefinitionError
+from tafel.core.errors import RepresentationDefinitionError
 
 T = TypeVar("T")
 
@@ -119,7 +119,7 @@ def get_representation(name: str) -> type:
     try:
         return _REGISTRY[name]
     except KeyError:
-        from core.naming import did_you_mean
+        from tafel.core.naming import did_you_mean
 
         raise KeyError(f"no representation named {name!r}; {did_you_mean(name, _REGISTRY)}") from None
 

@@ -29,12 +29,12 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
 
-from core.handover import Bundle, LocalChannel, SharedChannel, apply_bundle, make_bundle
-from core.manager import ModuleManager
-from core.platform import EndOfData, Platform, PlatformError
-from core.program import ContextPlan
-from core.recording import QueueSink, Recorder
-from core.status import CognitionStatus
+from tafel.core.handover import Bundle, LocalChannel, SharedChannel, apply_bundle, make_bundle
+from tafel.core.manager import ModuleManager
+from tafel.core.platform import EndOfData, Platform, PlatformError
+from tafel.core.program import ContextPlan
+from tafel.core.recording import QueueSink, Recorder
+from tafel.core.status import CognitionStatus
 
 log = logging.getLogger("tafel.runtime")
 

@@ -17,8 +17,8 @@ from typing import Any, TypeVar
 
 import numpy as np
 
-from core.manager import Blackboard, ModuleManager
-from core.representation import FieldInfo, fields_of, is_representation
+from tafel.core.manager import Blackboard, ModuleManager
+from tafel.core.representation import FieldInfo, fields_of, is_representation
 
 R = TypeVar("R")
 

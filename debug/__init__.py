@@ -5,6 +5,6 @@ Module code uses ``request``, ``modify``, ``stopwatch``, ``plot`` and ``drawing`
 a telnet-friendly text protocol (``debug.protocol``).
 """
 
-from debug.concepts import DebugDrawings, DebugPlots, drawing, modify, plot, request, stopwatch
+from tafel.debug.concepts import DebugDrawings, DebugPlots, drawing, modify, plot, request, stopwatch
 
 __all__ = ["DebugDrawings", "DebugPlots", "drawing", "modify", "plot", "request", "stopwatch"]

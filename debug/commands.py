@@ -22,14 +22,14 @@ from typing import Any
 
 import numpy as np
 
-from core.errors import TafelError
-from core.manager import ModuleManager
-from core.naming import did_you_mean
-from core.parameters import ParameterError, parameter_values, set_parameter
-from core.representation import fields_of
-from core.serialization import SerializationError, deserialize, serialize
-from debug.concepts import STATE, DebugState
-from debug.protocol import Command
+from tafel.core.errors import TafelError
+from tafel.core.manager import ModuleManager
+from tafel.core.naming import did_you_mean
+from tafel.core.parameters import ParameterError, parameter_values, set_parameter
+from tafel.core.representation import fields_of
+from tafel.core.serialization import SerializationError, deserialize, serialize
+from tafel.debug.concepts import STATE, DebugState
+from tafel.debug.protocol import Command
 
 
 class CommandError(TafelError):

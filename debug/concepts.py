@@ -1,6 +1,6 @@
 """Debug concepts for module authors: Pythonic counterparts of the NaoTH debug macros.
 
-    from debug import drawing, modify, plot, request, stopwatch
+    from tafel.debug import drawing, modify, plot, request, stopwatch
 
     DRAW_PERCEPT = request("BallDetector:draw_percept", "circle around the ball in the image")
 
@@ -25,7 +25,7 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import Any
 
-from core import representation
+from tafel.core import representation
 
 HISTORY = 300  # values kept per plot and per stopwatch
 

@@ -24,9 +24,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from core.naming import did_you_mean
-from debug.commands import SPECS, CommandError, merge_answers
-from debug.protocol import Command, ParseError, TelnetDecoder, answer_bytes, parse
+from tafel.core.naming import did_you_mean
+from tafel.debug.commands import SPECS, CommandError, merge_answers
+from tafel.debug.protocol import Command, ParseError, TelnetDecoder, answer_bytes, parse
 
 log = logging.getLogger("tafel.debug")
 

@@ -14,11 +14,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from core.manager import Blackboard
-from core.platform import Platform
-from representations.infrastructure import FrameInfo
-from representations.motion import HEAD_YAW, JOINT_COUNT, FsrData, InertialSensorData, JointCommand, JointSensorData
-from representations.perception import BallPercept
+from tafel.core.manager import Blackboard
+from tafel.core.platform import Platform
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.motion import HEAD_YAW, JOINT_COUNT, FsrData, InertialSensorData, JointCommand, JointSensorData
+from tafel.representations.perception import BallPercept
 
 GRAVITY = 9.81
 

@@ -16,13 +16,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from core.errors import TafelError
-from core.logfile import LogContents, read_log
-from core.manager import Blackboard
-from core.platform import EndOfData, Platform, PlatformError, PlatformOptionError
-from core.representation import get_representation
-from core.serialization import SerializationError, check_compatible, codec
-from representations import load_all
+from tafel.core.errors import TafelError
+from tafel.core.logfile import LogContents, read_log
+from tafel.core.manager import Blackboard
+from tafel.core.platform import EndOfData, Platform, PlatformError, PlatformOptionError
+from tafel.core.representation import get_representation
+from tafel.core.serialization import SerializationError, check_compatible, codec
+from tafel.representations import load_all
 
 log = logging.getLogger("tafel.platform.log")
 CONTEXT_ORDER = ("motion", "cognition")
@@ -88,7 +88,7 @@ class LogPlatform(Platform):
         recorded = {c.representation for c in contents.channels.values()}
         unknown = [name for name in replace if name not in recorded]
         if unknown:
-            from core.naming import did_you_mean
+            from tafel.core.naming import did_you_mean
 
             raise PlatformOptionError(
                 f"--replace names {', '.join(unknown)}, which the log does not hold; "

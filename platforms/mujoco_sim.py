@@ -10,10 +10,10 @@ from typing import Any
 
 import numpy as np
 
-from core.platform import PlatformError
-from platforms.robot_model import SERVO_GAIN, STANDING_HEIGHT, fsr_sites, mjcf
-from platforms.simulated import TIMESTEP, SimulatedRobotPlatform
-from representations.motion import JOINT_NAMES
+from tafel.core.platform import PlatformError
+from tafel.platforms.robot_model import SERVO_GAIN, STANDING_HEIGHT, fsr_sites, mjcf
+from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
+from tafel.representations.motion import JOINT_NAMES
 
 SERVO_DAMPING_RATIO = 0.02  # kv = ratio * kp (s): damps the servos without making them sluggish
 

@@ -27,10 +27,10 @@ import cv2
 import msgpack
 import numpy as np
 
-from core.manager import Blackboard
-from core.platform import Platform, PlatformError
-from representations.infrastructure import FrameInfo
-from representations.motion import (
+from tafel.core.manager import Blackboard
+from tafel.core.platform import Platform, PlatformError
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.motion import (
     JOINT_COUNT,
     JOINT_INDEX,
     BatteryData,
@@ -41,8 +41,8 @@ from representations.motion import (
     LedRequest,
     TouchSensorData,
 )
-from representations.nao import HORIZONTAL_FOV, VERTICAL_FOV
-from representations.perception import CameraImageBottom, CameraImageTop
+from tafel.representations.nao import HORIZONTAL_FOV, VERTICAL_FOV
+from tafel.representations.perception import CameraImageBottom, CameraImageTop
 
 log = logging.getLogger("tafel.platform.nao")
 

@@ -14,11 +14,11 @@ from typing import Any
 import numpy as np
 import pybullet
 
-from core.platform import PlatformError
-from platforms.robot_model import BALL_FRICTION, SERVO_TORQUE, STANDING_HEIGHT, FieldPart, field_parts, fsr_sites, urdf
-from platforms.simulated import TIMESTEP, SimulatedRobotPlatform
-from representations.motion import JOINT_NAMES
-from representations.nao import CAMERAS, COUPLED_JOINTS, SOLE_BACK, SOLE_FRONT, VERTICAL_FOV
+from tafel.core.platform import PlatformError
+from tafel.platforms.robot_model import BALL_FRICTION, SERVO_TORQUE, STANDING_HEIGHT, FieldPart, field_parts, fsr_sites, urdf
+from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
+from tafel.representations.motion import JOINT_NAMES
+from tafel.representations.nao import CAMERAS, COUPLED_JOINTS, SOLE_BACK, SOLE_FRONT, VERTICAL_FOV
 
 POSITION_GAIN = 0.1  # PyBullet's position motors: share of the position error corrected per step
 ROBOT_RGBA = (0.87, 0.87, 0.9, 1.0)

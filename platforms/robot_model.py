@@ -14,8 +14,8 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from representations import field
-from representations.nao import (
+from tafel.representations import field
+from tafel.representations.nao import (
     CAMERAS,
     COUPLED_JOINTS,
     ELBOW_OFFSET_Y,

@@ -16,12 +16,12 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from core.manager import Blackboard
-from core.platform import Platform, PlatformOptionError
-from representations.infrastructure import FrameInfo
-from representations.motion import JOINT_NAMES, FsrData, InertialSensorData, JointCommand, JointSensorData
-from representations.nao import VERTICAL_FOV
-from representations.perception import CameraImageBottom, CameraImageTop
+from tafel.core.manager import Blackboard
+from tafel.core.platform import Platform, PlatformOptionError
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.motion import JOINT_NAMES, FsrData, InertialSensorData, JointCommand, JointSensorData
+from tafel.representations.nao import VERTICAL_FOV
+from tafel.representations.perception import CameraImageBottom, CameraImageTop
 
 GRAVITY = 9.81
 TIMESTEP = 0.002  # s of physics per step

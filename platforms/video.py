@@ -18,10 +18,10 @@ from typing import Any, ClassVar
 import cv2
 import numpy as np
 
-from core.manager import Blackboard
-from core.platform import EndOfData, Platform, PlatformError, PlatformOptionError
-from representations.infrastructure import FrameInfo
-from representations.perception import CameraImageBottom, CameraImageTop
+from tafel.core.manager import Blackboard
+from tafel.core.platform import EndOfData, Platform, PlatformError, PlatformOptionError
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.perception import CameraImageBottom, CameraImageTop
 
 
 class VideoPlatform(Platform):

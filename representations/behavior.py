@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from core import representation
+from tafel.core import representation
 
 
 @representation

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from core import representation
+from tafel.core import representation
 
 
 @representation
@@ -19,6 +19,6 @@ class FrameInfo:
 
 
 # Provided by the runtime to motion; defined in core because the runtime fills it.
-from core.status import CognitionStatus  # noqa: E402
+from tafel.core.status import CognitionStatus  # noqa: E402
 
 __all__ = ["CognitionStatus", "FrameInfo"]

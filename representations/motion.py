@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from core import array, representation
+from tafel.core import array, representation
 
 JOINT_NAMES: tuple[str, ...] = (
     "HeadYaw", "HeadPitch",

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from representations.motion import JOINT_NAMES
+from tafel.representations.motion import JOINT_NAMES
 
 # ------------------------------------------------------------------------------ link offsets (mm)
 NECK_OFFSET_Z = 126.5

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core import array, representation
+from tafel.core import array, representation
 
 
 @representation

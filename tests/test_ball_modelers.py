@@ -7,13 +7,13 @@ import math
 import numpy as np
 import pytest
 
-from core import ModuleManager
-from core.testing import ModuleHarness
-from modules.modeling.kalman_ball_modeler import KalmanBallModeler
-from modules.modeling.simple_ball_modeler import SimpleBallModeler
-from representations.infrastructure import FrameInfo
-from representations.modeling import BallModel
-from representations.perception import BallPercept
+from tafel.core import ModuleManager
+from tafel.core.testing import ModuleHarness
+from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler
+from tafel.modules.modeling.simple_ball_modeler import SimpleBallModeler
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.modeling import BallModel
+from tafel.representations.perception import BallPercept
 
 FRAME_NS = 33_333_333
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parent.parent
-TAFEL = [sys.executable, "-m", "tools.cli"]
+TAFEL = [sys.executable, "-m", "tafel.tools.cli"]
 
 
 def tafel(*args: str, timeout: float = 120) -> subprocess.CompletedProcess:

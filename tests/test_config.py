@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from core.config import (
+from tafel.core.config import (
     ConfigError,
     apply_overrides,
     context_section,

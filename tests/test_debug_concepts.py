@@ -7,16 +7,16 @@ import sys
 
 import pytest
 
-from core import ModuleManager
-from core.testing import ModuleHarness
-from debug.commands import ContextDebug, pretty
-from debug.concepts import STATE, frame_debug_data
-from debug.protocol import parse
-from representations.infrastructure import FrameInfo
+from tafel.core import ModuleManager
+from tafel.core.testing import ModuleHarness
+from tafel.debug.commands import ContextDebug, pretty
+from tafel.debug.concepts import STATE, frame_debug_data
+from tafel.debug.protocol import parse
+from tafel.representations.infrastructure import FrameInfo
 from tests.support.debug_user import DRAW, DebugUser, DebugUserOutput
 from tests.test_debug_server import Program
-from tools.console import Completer
-from tools.debugging import RateMeter, instrument
+from tafel.tools.console import Completer
+from tafel.tools.debugging import RateMeter, instrument
 
 
 @pytest.fixture
@@ -88,14 +88,14 @@ def test_pretty_prints_nested_values() -> None:
 def test_console_completion_and_an_interactive_session() -> None:
     program = Program()
     try:
-        from debug.client import DebugClient
+        from tafel.debug.client import DebugClient
 
         with DebugClient(program.host, program.port) as client:
             completer = Completer(client)
             assert completer.candidates("modules:l", "modules:l") == ["modules:list"]
             assert "KalmanBallModeler" in completer.candidates("Kal", "modules:set -module Kal")
             assert "BallModel" in completer.candidates("BallM", "representation:print BallM")
-        session = subprocess.run([sys.executable, "-m", "tools.cli", "console", "--port", str(program.port)],
+        session = subprocess.run([sys.executable, "-m", "tafel.tools.cli", "console", "--port", str(program.port)],
                                  input="ping\nrepresentation:print BallModel\nquit\n", capture_output=True, text=True, timeout=30)
         assert session.returncode == 0, session.stderr
         assert "connected to" in session.stdout and "pong" in session.stdout and "BallModel (cognition" in session.stdout
@@ -104,9 +104,9 @@ def test_console_completion_and_an_interactive_session() -> None:
 
 
 def test_debug_data_is_recorded_like_representations(tmp_path) -> None:
-    from core.logfile import read_log
-    from core.serialization import deserialize
-    from debug.concepts import DebugPlots
+    from tafel.core.logfile import read_log
+    from tafel.core.serialization import deserialize
+    from tafel.debug.concepts import DebugPlots
     from tests.test_cli_runtime import tafel
 
     path = tmp_path / "debug.mcap"

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from debug.protocol import Command, ParseError, TelnetDecoder, answer_bytes, format_command, parse
+from tafel.debug.protocol import Command, ParseError, TelnetDecoder, answer_bytes, format_command, parse
 
 
 def test_the_example_from_the_protocol() -> None:

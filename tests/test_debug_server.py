@@ -18,10 +18,10 @@ from pathlib import Path
 
 import pytest
 
-from core.logfile import read_log
-from core.serialization import deserialize
-from debug.client import DebugClient
-from representations.modeling import BallModel
+from tafel.core.logfile import read_log
+from tafel.core.serialization import deserialize
+from tafel.debug.client import DebugClient
+from tafel.representations.modeling import BallModel
 from tests.test_cli_runtime import REPO, tafel
 
 DEBUG_USER = "tests.support.debug_user:DebugUser"
@@ -32,7 +32,7 @@ class Program:
 
     def __init__(self, *args: str, cwd: Path = REPO) -> None:
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "tools.cli", "run", "--debug-port", "0", *args] + ([] if "--platform" in args else ["--platform", "dummy"]),
+            [sys.executable, "-m", "tafel.tools.cli", "run", "--debug-port", "0", *args] + ([] if "--platform" in args else ["--platform", "dummy"]),
             cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
             env={**os.environ, "PYTHONPATH": str(REPO)},
         )

@@ -5,7 +5,7 @@ from __future__ import annotations
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from core import DependencyCycleError, Module, ModuleGraphError, ModuleManager, provides, representation, requires
+from tafel.core import DependencyCycleError, Module, ModuleGraphError, ModuleManager, provides, representation, requires
 
 POOL = [representation(type(f"PropRep{i}", (), {"__annotations__": {"v": int}, "__module__": __name__})) for i in range(8)]
 

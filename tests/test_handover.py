@@ -10,8 +10,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from core import Module, ModuleManager, provides, representation
-from core.handover import HandoverError, LocalChannel, SharedChannel, apply_bundle, make_bundle, snapshot
+from tafel.core import Module, ModuleManager, provides, representation
+from tafel.core.handover import HandoverError, LocalChannel, SharedChannel, apply_bundle, make_bundle, snapshot
 
 
 @representation
@@ -100,7 +100,7 @@ def test_local_channel_between_threads_never_shows_a_torn_value(sequence: list[i
     thread = threading.Thread(target=publish)
     thread.start()
     consumer = HoConsistent()
-    from core.manager import Blackboard
+    from tafel.core.manager import Blackboard
 
     board = Blackboard()
     board.ensure(HoConsistent)

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from core.testing import ModuleHarness
-from modules.motion.camera_matrix_provider import CameraMatrixProvider
-from modules.motion.kinematics import (
+from tafel.core.testing import ModuleHarness
+from tafel.modules.motion.camera_matrix_provider import CameraMatrixProvider
+from tafel.modules.motion.kinematics import (
     angles_by_name,
     camera_pose_in_torso,
     link_poses,
@@ -17,8 +17,8 @@ from modules.motion.kinematics import (
     rotation,
     sole_in_torso,
 )
-from representations.motion import JOINT_INDEX, CameraMatrixBottom, CameraMatrixTop, InertialModel, JointSensorData, TorsoPose
-from representations.nao import BOTTOM_CAMERA, TOP_CAMERA, total_mass
+from tafel.representations.motion import JOINT_INDEX, CameraMatrixBottom, CameraMatrixTop, InertialModel, JointSensorData, TorsoPose
+from tafel.representations.nao import BOTTOM_CAMERA, TOP_CAMERA, total_mass
 
 LEG = 85.0 + 100.0 + 102.9 + 45.19  # hip offset, thigh, tibia, foot height (mm)
 

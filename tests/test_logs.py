@@ -16,11 +16,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core import array, representation
-from core.logfile import LogWriter, read_log
-from core.platform import PlatformError, PlatformOptionError
-from core.serialization import serialize
-from platforms.log import LogPlatform
+from tafel.core import array, representation
+from tafel.core.logfile import LogWriter, read_log
+from tafel.core.platform import PlatformError, PlatformOptionError
+from tafel.core.serialization import serialize
+from tafel.platforms.log import LogPlatform
 from tests.test_cli_runtime import REPO, dummy, frames, tafel
 
 
@@ -151,7 +151,7 @@ def test_truncated_files_yield_what_was_complete_and_name_the_position(recorded:
 
 def test_sigkill_while_recording_loses_at_most_the_last_second(tmp_path: Path) -> None:
     path = tmp_path / "killed.mcap"
-    process = subprocess.Popen([sys.executable, "-m", "tools.cli", "run", "--platform", "dummy", "--no-debug", "--record", str(path), "--status-interval", "0.5"],
+    process = subprocess.Popen([sys.executable, "-m", "tafel.tools.cli", "run", "--platform", "dummy", "--no-debug", "--record", str(path), "--status-interval", "0.5"],
                                cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                env={**os.environ, "PYTHONPATH": str(REPO)})
     last_status_time = 0.0

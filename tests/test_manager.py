@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import pytest
 
-from core import (
+from tafel.core import (
     Blackboard,
     ConflictingProvidersError,
     DependencyCycleError,
@@ -23,7 +23,7 @@ from core import (
     requires,
     uses,
 )
-from core.parameters import ParameterError
+from tafel.core.parameters import ParameterError
 
 
 @representation

@@ -8,7 +8,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from core import (
+from tafel.core import (
     Module,
     ModuleDefinitionError,
     ModuleManager,
@@ -205,7 +205,7 @@ def test_read_only_arrays_compute_into_plain_arrays() -> None:
 
 def test_read_only_array_slices_stay_read_only() -> None:
     base = np.arange(6.0)
-    from core.access import read_only_array
+    from tafel.core.access import read_only_array
 
     view = read_only_array(base, "M", "R", ".f")
     part = view[2:4]

@@ -7,15 +7,15 @@ import math
 import numpy as np
 import pytest
 
-from core.testing import ModuleHarness
-from modules.behavior.look_at_ball_behavior import LookAtBallBehavior
-from modules.motion.head_motion import HeadMotion
-from modules.motion.motion_combinator import MotionCombinator
-from modules.motion.stand_motion import StandMotion, stand_pose
-from representations.behavior import HeadMotionRequest
-from representations.infrastructure import CognitionStatus, FrameInfo
-from representations.modeling import BallModel
-from representations.motion import HEAD_PITCH, HEAD_YAW, JOINT_COUNT, BodyJointTargets, HeadJointTargets, JointCommand, JointSensorData
+from tafel.core.testing import ModuleHarness
+from tafel.modules.behavior.look_at_ball_behavior import LookAtBallBehavior
+from tafel.modules.motion.head_motion import HeadMotion
+from tafel.modules.motion.motion_combinator import MotionCombinator
+from tafel.modules.motion.stand_motion import StandMotion, stand_pose
+from tafel.representations.behavior import HeadMotionRequest
+from tafel.representations.infrastructure import CognitionStatus, FrameInfo
+from tafel.representations.modeling import BallModel
+from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, JOINT_COUNT, BodyJointTargets, HeadJointTargets, JointCommand, JointSensorData
 
 TICK_NS = 10_000_000
 

@@ -11,10 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from core.logfile import read_log
-from core.serialization import deserialize
-from platforms.nao import CROUCH, LolaProtocolError, crouch_pose, parse_sensors
-from representations.motion import JOINT_INDEX, BatteryData, FsrData, InertialSensorData, TouchSensorData
+from tafel.core.logfile import read_log
+from tafel.core.serialization import deserialize
+from tafel.platforms.nao import CROUCH, LolaProtocolError, crouch_pose, parse_sensors
+from tafel.representations.motion import JOINT_INDEX, BatteryData, FsrData, InertialSensorData, TouchSensorData
 from tests.support.fake_lola import PACKET_SIZE, FakeLola, sensor_packet
 from tests.test_cli_runtime import REPO
 
@@ -22,7 +22,7 @@ LOOK_LEFT = "tests.support.nao_support:LookLeft"
 
 
 def run_nao(socket_path: Path, *args: str, modules: str = f'["{LOOK_LEFT}"]') -> subprocess.CompletedProcess:
-    command = [sys.executable, "-m", "tools.cli", "run", "--platform", "nao", "--lola", str(socket_path), "--cameras", "off",
+    command = [sys.executable, "-m", "tafel.tools.cli", "run", "--platform", "nao", "--lola", str(socket_path), "--cameras", "off",
                "--no-debug", "--set", f"cognition.modules={modules}", *args]
     return subprocess.run(command, capture_output=True, text=True, timeout=120, cwd=REPO, env={**os.environ, "PYTHONPATH": str(REPO)})
 
@@ -109,7 +109,7 @@ def test_a_missing_socket_is_a_clear_error(tmp_path: Path) -> None:
 
 
 def test_missing_cameras_are_a_clear_error(lola: FakeLola) -> None:
-    command = [sys.executable, "-m", "tools.cli", "run", "--platform", "nao", "--lola", str(lola.path), "--no-debug",
+    command = [sys.executable, "-m", "tafel.tools.cli", "run", "--platform", "nao", "--lola", str(lola.path), "--no-debug",
                "--camera-top", "/dev/no-such-camera"]
     result = subprocess.run(command, capture_output=True, text=True, timeout=60, cwd=REPO, env={**os.environ, "PYTHONPATH": str(REPO)})
     assert result.returncode == 1 and "the top camera /dev/no-such-camera does not exist" in result.stderr

@@ -6,16 +6,16 @@ from typing import ClassVar
 
 import pytest
 
-from core import ConflictingProvidersError, MissingProviderError, Module, UnknownModuleError, provides, requires
-from core.config import ConfigError
-from core.platform import Platform
-from core.program import plan_program
-from core.runtime import Limits, LockstepRuntime
-from representations.behavior import HeadMotionRequest
-from representations.infrastructure import CognitionStatus, FrameInfo
-from representations.motion import JointCommand, JointSensorData
-from representations.perception import BallPercept
-from tools.cli import discover_modules
+from tafel.core import ConflictingProvidersError, MissingProviderError, Module, UnknownModuleError, provides, requires
+from tafel.core.config import ConfigError
+from tafel.core.platform import Platform
+from tafel.core.program import plan_program
+from tafel.core.runtime import Limits, LockstepRuntime
+from tafel.representations.behavior import HeadMotionRequest
+from tafel.representations.infrastructure import CognitionStatus, FrameInfo
+from tafel.representations.motion import JointCommand, JointSensorData
+from tafel.representations.perception import BallPercept
+from tafel.tools.cli import discover_modules
 
 discover_modules()
 
@@ -119,7 +119,7 @@ def test_lockstep_hands_over_the_newest_complete_value() -> None:
         def execute(self) -> None:
             seen.append((self.head_motion_request.yaw, self.head_motion_request.pitch))
 
-    from core.program import ContextPlan
+    from tafel.core.program import ContextPlan
 
     plans = {
         "cognition": ContextPlan("cognition", 30.0, [StampRequest], {}, [], {}, [FrameInfo], [], handover_out=[HeadMotionRequest]),

@@ -8,7 +8,7 @@ import enum
 import numpy as np
 import pytest
 
-from core import (
+from tafel.core import (
     RepresentationDefinitionError,
     array,
     fields_of,
@@ -18,7 +18,7 @@ from core import (
     representation,
     values_equal,
 )
-from core.representation import copy_into, reset
+from tafel.core.representation import copy_into, reset
 
 
 class Color(enum.Enum):

@@ -10,8 +10,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from core import array, registered_representations, representation, values_equal
-from core.serialization import (
+from tafel.core import array, registered_representations, representation, values_equal
+from tafel.core.serialization import (
     SerializationError,
     check_compatible,
     deserialize,
@@ -21,8 +21,8 @@ from core.serialization import (
     schema_of,
     serialize,
 )
-from core.testing import strategy_for
-from tools.cli import discover_modules
+from tafel.core.testing import strategy_for
+from tafel.tools.cli import discover_modules
 
 discover_modules()  # every representation of the project takes part in the round-trip property
 
@@ -164,8 +164,8 @@ def test_numpy_scalars_are_accepted_in_scalar_fields() -> None:
 
 
 def test_the_core_package_offers_serialization() -> None:
-    import core
-    from representations.modeling import BallModel
+    import tafel.core as core
+    from tafel.representations.modeling import BallModel
 
     model = BallModel(valid=True, x=1200.0, y=-40.0)
     assert core.deserialize(BallModel, core.serialize(model)) == model

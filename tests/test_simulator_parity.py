@@ -8,10 +8,10 @@ import numpy as np
 import pybullet
 import pytest
 
-from modules.perception.ball_detector import BallDetector
-from platforms.mujoco_sim import MujocoPlatform
-from platforms.pybullet_sim import PybulletPlatform
-from representations.nao import CAMERAS, JOINTS, TORSO_MASS, VERTICAL_FOV
+from tafel.modules.perception.ball_detector import BallDetector
+from tafel.platforms.mujoco_sim import MujocoPlatform
+from tafel.platforms.pybullet_sim import PybulletPlatform
+from tafel.representations.nao import CAMERAS, JOINTS, TORSO_MASS, VERTICAL_FOV
 
 
 @pytest.fixture(scope="module")

@@ -15,13 +15,13 @@ import sys
 import numpy as np
 import pytest
 
-from core.testing import ModuleHarness
-from modules.motion.camera_matrix_provider import CameraMatrixProvider
-from modules.perception.ball_detector import BallDetector
-from modules.perception.ball_locator import BallLocator
-from representations.modeling import BallModel
-from representations.motion import HEAD_YAW, CameraMatrixBottom, CameraMatrixTop, InertialModel, InertialSensorData, JointSensorData
-from representations.perception import BallCandidate, BallImagePercept, BallPercept, CameraImageBottom, CameraImageTop
+from tafel.core.testing import ModuleHarness
+from tafel.modules.motion.camera_matrix_provider import CameraMatrixProvider
+from tafel.modules.perception.ball_detector import BallDetector
+from tafel.modules.perception.ball_locator import BallLocator
+from tafel.representations.modeling import BallModel
+from tafel.representations.motion import HEAD_YAW, CameraMatrixBottom, CameraMatrixTop, InertialModel, InertialSensorData, JointSensorData
+from tafel.representations.perception import BallCandidate, BallImagePercept, BallPercept, CameraImageBottom, CameraImageTop
 from tests.support.simulation import Simulation
 from tests.test_cli_runtime import REPO, frames, tafel
 
@@ -160,7 +160,7 @@ def test_sensors_have_the_projects_units(sim: Simulation) -> None:
     sim.run(2.0)
     motion = sim.blackboard("motion")
     assert motion[InertialSensorData].accelerometer[2] == pytest.approx(9.81, abs=0.5)  # upright
-    from representations.motion import FsrData
+    from tafel.representations.motion import FsrData
 
     total_kg = motion[FsrData].pressure.sum()
     assert total_kg == pytest.approx(5.36, rel=0.15)  # the robot's weight on its soles
@@ -189,7 +189,7 @@ def test_runs_are_deterministic(engine: str) -> None:
 
 
 def test_tafel_run_without_arguments_runs_the_simulator_with_the_debug_server() -> None:
-    process = subprocess.Popen([sys.executable, "-m", "tools.cli", "run", "--seconds", "3", "--status-interval", "1"],
+    process = subprocess.Popen([sys.executable, "-m", "tafel.tools.cli", "run", "--seconds", "3", "--status-interval", "1"],
                                cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                env={**os.environ, "PYTHONPATH": str(REPO)})
     out, err = process.communicate(timeout=120)
@@ -201,7 +201,7 @@ def test_tafel_run_without_arguments_runs_the_simulator_with_the_debug_server() 
 
 def test_viewer_without_a_display_says_so_and_runs_headless(engine: str) -> None:
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
-    result = subprocess.run([sys.executable, "-m", "tools.cli", "run", "--platform", engine, "--viewer", "--frames", "20", "--speed", "max", "--no-debug"],
+    result = subprocess.run([sys.executable, "-m", "tafel.tools.cli", "run", "--platform", engine, "--viewer", "--frames", "20", "--speed", "max", "--no-debug"],
                             cwd=REPO, capture_output=True, text=True, timeout=120, env={**env, "PYTHONPATH": str(REPO)})
     assert result.returncode == 0, result.stderr
     assert "--viewer needs a display" in result.stderr

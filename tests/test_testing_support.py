@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 
-from core import Module, array, provides, representation, requires, uses, values_equal
-from core.testing import ModuleHarness, strategy_for
+from tafel.core import Module, array, provides, representation, requires, uses, values_equal
+from tafel.core.testing import ModuleHarness, strategy_for
 
 
 class TsMode(enum.Enum):

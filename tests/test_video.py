@@ -8,10 +8,10 @@ import cv2
 import numpy as np
 import pytest
 
-from core.logfile import read_log
-from core.serialization import deserialize
-from representations.infrastructure import FrameInfo
-from representations.perception import BallImagePercept
+from tafel.core.logfile import read_log
+from tafel.core.serialization import deserialize
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.perception import BallImagePercept
 from tests.test_cli_runtime import tafel
 
 FRAMES = 60

@@ -13,15 +13,15 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
-from core.config import load_config
-from core.dot import contexts_dot
-from core.errors import TafelError
-from core.platform import Platform, PlatformError, PlatformOptionError, available_platforms, load_platform
-from core.program import ContextPlan, plan_program
-from core.recording import Recorder, select
-from core.runtime import ConcurrentRuntime, ContextStats, Limits, LockstepRuntime, install_signal_handlers
-from representations.modeling import BallModel
-from tools.debugging import (
+from tafel.core.config import load_config
+from tafel.core.dot import contexts_dot
+from tafel.core.errors import TafelError
+from tafel.core.platform import Platform, PlatformError, PlatformOptionError, available_platforms, load_platform
+from tafel.core.program import ContextPlan, plan_program
+from tafel.core.recording import Recorder, select
+from tafel.core.runtime import ConcurrentRuntime, ContextStats, Limits, LockstepRuntime, install_signal_handlers
+from tafel.representations.modeling import BallModel
+from tafel.tools.debugging import (
     DEBUG_REPRESENTATIONS,
     LocalExecutor,
     ProgramDebug,
@@ -32,8 +32,8 @@ from tools.debugging import (
     worker_debug_setup,
 )
 
-REPO_ROOT = Path(__file__).resolve().parent.parent
-DEFAULT_CONFIG = REPO_ROOT / "config"
+#: the default configuration, shipped inside the package (the repository's config/ folder)
+DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "config"
 FALLBACK_PLATFORM = "dummy"
 DEFAULT_DEBUG_PORT = 5401
 
@@ -44,11 +44,11 @@ class UsageError(Exception):
 
 def discover_modules() -> None:
     """Import every file under ``representations/`` and ``modules/`` so configuration and logs can name them."""
-    import modules
-    from representations import load_all
+    import tafel.modules as modules
+    from tafel.representations import load_all
 
     load_all()
-    for info in pkgutil.walk_packages(modules.__path__, prefix="modules."):
+    for info in pkgutil.walk_packages(modules.__path__, prefix="tafel.modules."):
         importlib.import_module(info.name)
 
 
@@ -79,7 +79,9 @@ def positive(kind: type) -> Any:
 
 def add_program_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--platform", help="where to run (see 'tafel platforms'); default from configuration")
-    parser.add_argument("--config", type=Path, default=DEFAULT_CONFIG, help="configuration folder (default: %(default)s)")
+    parser.add_argument("--config", type=Path, metavar="DIR",
+                        help="a configuration folder whose layers go on top of the shipped defaults; "
+                             "parameter:store and modules:store write into DIR/private/private.toml")
     parser.add_argument("--robot", help="robot layer config/robot/NAME.toml")
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                         help="override a configuration value, e.g. runtime.cognition_hz=15 (repeatable)")
@@ -110,10 +112,10 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--debug-token", metavar="T", help="clients must send 'auth T' first")
     run.add_argument("--no-debug", action="store_true", help="run without the debug server")
 
-    from tools.log_tools import add_log_commands
+    from tafel.tools.log_tools import add_log_commands
 
     add_log_commands(commands)
-    from tools.console import add_console_command
+    from tafel.tools.console import add_console_command
 
     add_console_command(commands)
 
@@ -130,22 +132,28 @@ def fail(message: str) -> NoReturn:
     raise UsageError(message)
 
 
-def resolve_platform(args: argparse.Namespace, config_dir: Path) -> type[Platform]:
+def config_dirs(args: argparse.Namespace) -> list[Path]:
+    """The shipped defaults, then ``--config DIR`` on top."""
+    return [DEFAULT_CONFIG] + ([args.config] if args.config is not None else [])
+
+
+def store_dir(args: argparse.Namespace) -> Path:
+    """Where ``*:store`` writes its private layer: the user's folder, else the shipped one."""
+    return args.config if args.config is not None else DEFAULT_CONFIG
+
+
+def resolve_platform(args: argparse.Namespace) -> type[Platform]:
     name = args.platform
     if name is None:
-        general = config_dir / "general.toml"
-        name = FALLBACK_PLATFORM
-        if general.is_file():
-            from core.config import read_toml
-
-            name = read_toml(general).get("runtime", {}).get("default_platform", FALLBACK_PLATFORM)
+        general = load_config(config_dirs(args), "", None, args.overrides)
+        name = general.get("runtime", {}).get("default_platform", FALLBACK_PLATFORM)
         args.platform = name
     return load_platform(name)
 
 
 def prepare(args: argparse.Namespace, extra: Sequence[str]) -> tuple[Platform, dict[str, Any], dict[str, ContextPlan], dict[str, Any]]:
     """Platform, platform options, context plans and configuration for ``run`` and ``modules``."""
-    platform_class = resolve_platform(args, args.config)
+    platform_class = resolve_platform(args)
     platform_parser = argparse.ArgumentParser(prog=f"tafel {args.command} --platform {platform_class.name}", add_help=False)
     platform_class.add_arguments(platform_parser)
     options, unknown = platform_parser.parse_known_args(list(extra))
@@ -156,7 +164,7 @@ def prepare(args: argparse.Namespace, extra: Sequence[str]) -> tuple[Platform, d
     discover_modules()
     platform = platform_class(vars(options))
     overrides = [f"runtime.{context}_hz={hz}" for context, hz in (platform.rates() or {}).items()]
-    config = load_config(args.config, platform_class.name, args.robot, [*overrides, *args.overrides])
+    config = load_config(config_dirs(args), platform_class.name, args.robot, [*overrides, *args.overrides])
     plans = plan_program(config, platform, strict=args.strict)
     return platform, vars(options), plans, config
 
@@ -209,7 +217,7 @@ def start_debug(args: argparse.Namespace, recorder: Recorder | None, plans: dict
     if args.no_debug:
         return None
     port = DEFAULT_DEBUG_PORT if args.debug_port is None else args.debug_port
-    debug = ProgramDebug(host=args.debug_host, port=port, token=args.debug_token, config_dir=args.config, recorder=recorder)
+    debug = ProgramDebug(host=args.debug_host, port=port, token=args.debug_token, config_dir=store_dir(args), recorder=recorder)
     debug.handovers = handovers_of(plans)
     return debug
 
@@ -433,7 +441,7 @@ def command_modules(args: argparse.Namespace, extra: Sequence[str]) -> int:
 
 
 def command_log(args: argparse.Namespace, extra: Sequence[str]) -> int:
-    from tools.log_tools import run_log_command
+    from tafel.tools.log_tools import run_log_command
 
     if extra:
         fail(f"unrecognized arguments: {' '.join(extra)}")
@@ -441,7 +449,7 @@ def command_log(args: argparse.Namespace, extra: Sequence[str]) -> int:
 
 
 def command_console(args: argparse.Namespace, extra: Sequence[str]) -> int:
-    from tools.console import run_console
+    from tafel.tools.console import run_console
 
     if extra:
         fail(f"unrecognized arguments: {' '.join(extra)}")

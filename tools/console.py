@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from debug.client import DebugClient
+from tafel.debug.client import DebugClient
 
 HISTORY = Path.home() / ".tafel_history"
 

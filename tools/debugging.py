@@ -16,17 +16,17 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from core.config import store_private
-from core.dot import contexts_dot
-from core.errors import TafelError
-from core.manager import ModuleManager
-from core.program import ContextPlan
-from core.recording import Recorder
-from core.runtime import ContextRunner
-from debug.commands import CommandError, ContextDebug, argument
-from debug.concepts import STATE, DebugDrawings, DebugPlots, frame_debug_data
-from debug.protocol import Command
-from debug.server import DebugRouter, DebugServer, Executor
+from tafel.core.config import store_private
+from tafel.core.dot import contexts_dot
+from tafel.core.errors import TafelError
+from tafel.core.manager import ModuleManager
+from tafel.core.program import ContextPlan
+from tafel.core.recording import Recorder
+from tafel.core.runtime import ContextRunner
+from tafel.debug.commands import CommandError, ContextDebug, argument
+from tafel.debug.concepts import STATE, DebugDrawings, DebugPlots, frame_debug_data
+from tafel.debug.protocol import Command
+from tafel.debug.server import DebugRouter, DebugServer, Executor
 
 DEBUG_REPRESENTATIONS = (DebugDrawings, DebugPlots)
 #: s before a context's next frame when command work stops, so the frame starts on time

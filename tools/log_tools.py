@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 from google.protobuf import descriptor_pool, message_factory
 
-from core.logfile import LogContents, LogError, as_dict, read_log
-from core.naming import did_you_mean
+from tafel.core.logfile import LogContents, LogError, as_dict, read_log
+from tafel.core.naming import did_you_mean
 
 
 def add_log_commands(commands: Any) -> None:

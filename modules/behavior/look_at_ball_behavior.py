@@ -5,10 +5,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from core import Module, provides, requires
-from representations.behavior import HeadMotionRequest
-from representations.infrastructure import FrameInfo
-from representations.modeling import BallModel
+from tafel.core import Module, provides, requires
+from tafel.representations.behavior import HeadMotionRequest
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.modeling import BallModel
 
 
 def sweep(start: float, direction: float, distance: float, amplitude: float) -> float:

@@ -5,10 +5,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from core import Module, provides, requires
-from representations.infrastructure import FrameInfo
-from representations.modeling import BallModel
-from representations.perception import BallPercept
+from tafel.core import Module, provides, requires
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.modeling import BallModel
+from tafel.representations.perception import BallPercept
 
 
 @dataclass

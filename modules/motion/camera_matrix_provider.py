@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from core import Module, provides, requires
-from modules.motion.kinematics import CAMERA_LINKS, angles_by_name, camera_pose_in_torso, link_poses, robot_frame_from_torso
-from representations.motion import CameraMatrixBottom, CameraMatrixTop, InertialModel, JointSensorData, TorsoPose
-from representations.nao import BOTTOM_CAMERA, TOP_CAMERA
+from tafel.core import Module, provides, requires
+from tafel.modules.motion.kinematics import CAMERA_LINKS, angles_by_name, camera_pose_in_torso, link_poses, robot_frame_from_torso
+from tafel.representations.motion import CameraMatrixBottom, CameraMatrixTop, InertialModel, JointSensorData, TorsoPose
+from tafel.representations.nao import BOTTOM_CAMERA, TOP_CAMERA
 
 
 @requires(JointSensorData, InertialModel)

@@ -5,10 +5,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from core import Module, provides, requires
-from representations.behavior import HeadMotionRequest
-from representations.infrastructure import CognitionStatus, FrameInfo
-from representations.motion import HEAD_PITCH, HEAD_YAW, HeadJointTargets, JointSensorData
+from tafel.core import Module, provides, requires
+from tafel.representations.behavior import HeadMotionRequest
+from tafel.representations.infrastructure import CognitionStatus, FrameInfo
+from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, HeadJointTargets, JointSensorData
 
 
 @requires(HeadMotionRequest, JointSensorData, FrameInfo, CognitionStatus)

@@ -6,8 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core import Module, provides, requires
-from representations.motion import InertialModel, InertialSensorData
+from tafel.core import Module, provides, requires
+from tafel.representations.motion import InertialModel, InertialSensorData
 
 
 @requires(InertialSensorData)

@@ -13,8 +13,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from representations.motion import JOINT_INDEX
-from representations.nao import COUPLED_JOINTS, FOOT_HEIGHT, JOINTS, CameraMount, Joint
+from tafel.representations.motion import JOINT_INDEX
+from tafel.representations.nao import COUPLED_JOINTS, FOOT_HEIGHT, JOINTS, CameraMount, Joint
 
 
 def rotation(axis: tuple[float, float, float] | np.ndarray, angle: float) -> np.ndarray:

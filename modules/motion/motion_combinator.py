@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from core import Module, provides, requires
-from representations.motion import HEAD_PITCH, HEAD_YAW, BodyJointTargets, HeadJointTargets, JointCommand
+from tafel.core import Module, provides, requires
+from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, BodyJointTargets, HeadJointTargets, JointCommand
 
 
 @requires(BodyJointTargets, HeadJointTargets)

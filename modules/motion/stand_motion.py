@@ -7,9 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core import Module, provides, requires
-from representations.infrastructure import FrameInfo
-from representations.motion import JOINT_COUNT, JOINT_INDEX, BodyJointTargets, JointSensorData
+from tafel.core import Module, provides, requires
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.motion import JOINT_COUNT, JOINT_INDEX, BodyJointTargets, JointSensorData
 
 #: the stand pose (rad): slightly bent knees keep the centre of mass over the feet
 STAND_POSE: dict[str, float] = {

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from core import Module, provides, requires
-from representations.infrastructure import CognitionStatus
-from representations.motion import LedRequest
+from tafel.core import Module, provides, requires
+from tafel.representations.infrastructure import CognitionStatus
+from tafel.representations.motion import LedRequest
 
 GREEN, RED = np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0])
 BLUE_EYE = np.concatenate([np.zeros(16), np.ones(8)])  # 8 red, 8 green, 8 blue segments

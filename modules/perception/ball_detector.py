@@ -8,9 +8,9 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from core import Module, provides, requires
-from debug import drawing, request, stopwatch
-from representations.perception import BallCandidate, BallImagePercept, CameraImageBottom, CameraImageTop
+from tafel.core import Module, provides, requires
+from tafel.debug import drawing, request, stopwatch
+from tafel.representations.perception import BallCandidate, BallImagePercept, CameraImageBottom, CameraImageTop
 
 DRAW_CANDIDATES = request("BallDetector:draw_candidates", "circle around every ball candidate in the images")
 

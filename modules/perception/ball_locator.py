@@ -7,11 +7,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core import Module, provides, requires
-from debug import drawing, plot, request
-from representations.field import BALL_RADIUS
-from representations.motion import CameraMatrixBottom, CameraMatrixTop
-from representations.perception import BallCandidate, BallImagePercept, BallPercept
+from tafel.core import Module, provides, requires
+from tafel.debug import drawing, plot, request
+from tafel.representations.field import BALL_RADIUS
+from tafel.representations.motion import CameraMatrixBottom, CameraMatrixTop
+from tafel.representations.perception import BallCandidate, BallImagePercept, BallPercept
 
 DRAW_PERCEPT = request("BallLocator:draw_percept", "the located ball in its image and on the field")
 

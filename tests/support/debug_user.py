@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from core import Module, provides, representation, requires
-from debug import drawing, modify, plot, request, stopwatch
-from representations.infrastructure import FrameInfo
+from tafel.core import Module, provides, representation, requires
+from tafel.debug import drawing, modify, plot, request, stopwatch
+from tafel.representations.infrastructure import FrameInfo
 
 DRAW = request("DebugUser:draw", "a circle on the field every frame")
 

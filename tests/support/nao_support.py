@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from core import Module, provides, requires
-from representations.behavior import HeadMotionRequest
-from representations.infrastructure import FrameInfo
+from tafel.core import Module, provides, requires
+from tafel.representations.behavior import HeadMotionRequest
+from tafel.representations.infrastructure import FrameInfo
 
 
 @requires(FrameInfo)

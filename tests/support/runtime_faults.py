@@ -9,8 +9,8 @@ import os
 import time
 from dataclasses import dataclass
 
-from core import Module, requires
-from representations.infrastructure import FrameInfo
+from tafel.core import Module, requires
+from tafel.representations.infrastructure import FrameInfo
 
 
 @requires(FrameInfo)

@@ -5,11 +5,11 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from core.config import load_config
-from core.platform import load_platform
-from core.program import plan_program
-from core.runtime import LockstepRuntime
-from tools.cli import DEFAULT_CONFIG, discover_modules
+from tafel.core.config import load_config
+from tafel.core.platform import load_platform
+from tafel.core.program import plan_program
+from tafel.core.runtime import LockstepRuntime
+from tafel.tools.cli import DEFAULT_CONFIG, discover_modules
 
 
 class Simulation:
