@@ -43,11 +43,17 @@ def config_folders(config_dirs: Path | Sequence[Path]) -> list[Path]:
     return [Path(config_dirs)] if isinstance(config_dirs, (str, Path)) else [Path(d) for d in config_dirs]
 
 
-def layer_paths(config_dirs: Path | Sequence[Path], platform: str, robot: str | None) -> list[Path]:
-    """The layer files in override order (only those that exist are read)."""
+def layer_paths(config_dirs: Path | Sequence[Path], platform: str | Sequence[str], robot: str | None) -> list[Path]:
+    """The layer files in override order (only those that exist are read).
+
+    ``platform`` may name several platform layers, read in order (a log replays with the layer of
+    the platform it was recorded on, then its own).
+    """
+    platforms = [platform] if isinstance(platform, str) else list(platform)
     paths = []
     for config_dir in config_folders(config_dirs):
-        paths += [config_dir / "general.toml", config_dir / "platform" / f"{platform}.toml"]
+        paths.append(config_dir / "general.toml")
+        paths += [config_dir / "platform" / f"{name}.toml" for name in platforms if name]
         if robot:
             paths.append(config_dir / "robot" / f"{robot}.toml")
         paths.append(config_dir / PRIVATE_FILE)
@@ -104,7 +110,7 @@ def apply_overrides(config: dict[str, Any], overrides: Iterable[str]) -> dict[st
 
 
 def load_config(
-    config_dirs: Path | Sequence[Path], platform: str, robot: str | None = None, overrides: Iterable[str] = ()
+    config_dirs: Path | Sequence[Path], platform: str | Sequence[str], robot: str | None = None, overrides: Iterable[str] = ()
 ) -> dict[str, Any]:
     """The merged configuration for a platform (and robot), with ``--set`` overrides applied last.
 

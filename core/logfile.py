@@ -14,23 +14,32 @@ at least every ``flush_interval`` seconds, so a process killed with SIGKILL lose
 from __future__ import annotations
 
 import io
+import logging
+import os
 import queue
 import threading
 import time
-from collections.abc import Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from google.protobuf import descriptor_pb2
-from mcap.records import Channel, Message, Metadata, Schema
-from mcap.stream_reader import StreamReader
+from mcap.data_stream import ReadDataStream
+from mcap.opcode import Opcode
+from mcap.reader import SeekingReader
+from mcap.records import Channel, Chunk, Message, Metadata, Schema
+from mcap.stream_reader import breakup_chunk
 from mcap.writer import CompressionType, Writer
 
 from tafel.core.errors import TafelError
 from tafel.core.serialization import file_descriptor_set, message_name
 
 PROFILE = "tafel"
+MAGIC = b"\x89MCAP0\r\n"
+#: ns of log time one chunk holds at the most, so a cut-off file loses at most this much
+CHUNK_SPAN_NS = 1_000_000_000
+log = logging.getLogger("tafel.log")
 
 
 class LogError(TafelError, RuntimeError):
@@ -108,6 +117,7 @@ class LogWriter:
 
     def _run(self) -> None:
         last_flush = time.monotonic()
+        chunk_start_ns: int | None = None  # log time of the first message in the open chunk
         while True:
             try:
                 item = self._queue.get(timeout=self.flush_interval)
@@ -116,11 +126,17 @@ class LogWriter:
             if item is None:
                 return
             try:
+                # a chunk holds at most CHUNK_SPAN_NS of log time, at any speed, and at most
+                # flush_interval of wall time: a cut-off file loses only its last chunk
+                if item.topic and chunk_start_ns is not None and abs(item.time_ns - chunk_start_ns) >= CHUNK_SPAN_NS:
+                    self._writer.flush()
+                    last_flush, chunk_start_ns = time.monotonic(), None
                 if item.topic:
                     self._add(item)
+                    chunk_start_ns = item.time_ns if chunk_start_ns is None else chunk_start_ns
                 if time.monotonic() - last_flush >= self.flush_interval:
                     self._writer.flush()
-                    last_flush = time.monotonic()
+                    last_flush, chunk_start_ns = time.monotonic(), None
             except Exception as exc:  # noqa: BLE001 - a full disk must not kill the program
                 self.error = f"{type(exc).__name__}: {exc}"
                 self.dropped += 1
@@ -167,16 +183,219 @@ class LogChannel:
         return self.topic.split("/", 1)[-1]
 
 
+@dataclass(frozen=True)
+class ChunkInfo:
+    """Where one chunk of messages lies in the file, and the log times it covers."""
+
+    offset: int
+    start_ns: int
+    end_ns: int
+
+
+class LogReader:
+    """Reads an MCAP log chunk by chunk, never the whole file at once.
+
+    An intact file is read through its summary (channels, metadata and the chunk index); a file
+    without one (the recording was cut off) is walked record by record once to find its chunks.
+    A damaged chunk is skipped with a warning and reading goes on with the next one; a file cut off
+    in the middle yields everything before the cut. ``problems`` lists what was skipped and why.
+    """
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        try:
+            self._file = open(self.path, "rb")  # noqa: SIM115 - closed by close()
+            self.size = os.fstat(self._file.fileno()).st_size
+        except OSError as exc:
+            raise LogError(f"cannot read log {self.path}: {exc.strerror or exc}") from None
+        if self._file.read(len(MAGIC)) != MAGIC:
+            self.close()
+            raise LogError(f"{self.path} is not an MCAP log (it does not start with the MCAP magic bytes)")
+        self.channels: dict[str, LogChannel] = {}
+        self.metadata: dict[str, str] = {}
+        self.chunks: list[ChunkInfo] = []
+        self.complete = True
+        self.problems: list[str] = []
+        self._schemas: dict[int, Schema] = {}
+        self._topics: dict[int, str] = {}
+        self._warned: set[int] = set()
+        if not self._read_summary():
+            self._walk()
+            for _ in self.iter_chunks():  # channels are defined inside the chunks: find them all once
+                pass
+            if not self.chunks and not self.complete:
+                self.close()
+                raise LogError(f"{self.path}: nothing can be read: {self.problems[0]}")
+
+    # ------------------------------------------------------------------------------- opening
+    def _read_summary(self) -> bool:
+        """Channels, metadata and chunks from the summary section; False when there is none."""
+        try:
+            reader = SeekingReader(self._file, record_size_limit=self.size)
+            summary = reader.get_summary()
+        except Exception:  # noqa: BLE001 - no intact summary: walk the file instead
+            return False
+        if summary is None:
+            return False
+        for schema in summary.schemas.values():
+            self._schemas[schema.id] = schema
+        for channel in summary.channels.values():
+            self._add_channel(channel)
+        try:
+            for record in reader.iter_metadata():
+                if record.name == PROFILE:
+                    self.metadata.update(record.metadata)
+        except Exception as exc:  # noqa: BLE001 - metadata is a convenience; the messages matter
+            self._problem(f"{self.path}: the run's metadata cannot be read: {exc}")
+        self.chunks = sorted((ChunkInfo(c.chunk_start_offset, c.message_start_time, c.message_end_time)
+                              for c in summary.chunk_indexes), key=lambda c: c.offset)
+        return True
+
+    def _walk(self) -> None:
+        """Find chunks, schemas, channels and metadata by walking the records from the start."""
+        position = len(MAGIC)
+        while True:
+            self._file.seek(position)
+            head = self._file.read(9)
+            if len(head) < 9:
+                self.complete = False
+                self._problem(f"{self.path}: the file ends at byte {self.size} without the MCAP footer (the recording was cut off)")
+                return
+            opcode, length = head[0], int.from_bytes(head[1:], "little")
+            if position + 9 + length > self.size:
+                self.complete = False
+                self._problem(f"{self.path}: the record at byte {position} runs past the end of the file "
+                              f"(byte {self.size}): the recording was cut off")
+                return
+            if opcode == Opcode.CHUNK:
+                times = self._file.read(16)
+                self.chunks.append(ChunkInfo(position, int.from_bytes(times[:8], "little"), int.from_bytes(times[8:], "little")))
+            elif opcode in (Opcode.SCHEMA, Opcode.CHANNEL, Opcode.METADATA):
+                try:
+                    self._register(_RECORD_TYPES[opcode].read(ReadDataStream(io.BytesIO(self._file.read(length)))))
+                except Exception as exc:  # noqa: BLE001 - a damaged record is skipped, the rest read
+                    self._problem(f"{self.path}: damaged record at byte {position} skipped ({type(exc).__name__}: {exc})")
+            elif opcode in (Opcode.DATA_END, Opcode.FOOTER):
+                return
+            elif opcode not in _KNOWN_OPCODES:
+                self.complete = False
+                self._problem(f"{self.path}: unknown record (opcode {opcode:#x}) at byte {position}: the file is damaged from here on")
+                return
+            position += 9 + length
+
+    def _register(self, record: Any) -> None:
+        if isinstance(record, Schema):
+            self._schemas[record.id] = record
+        elif isinstance(record, Channel):
+            self._add_channel(record)
+        elif isinstance(record, Metadata) and record.name == PROFILE:
+            self.metadata.update(record.metadata)
+
+    def _add_channel(self, record: Channel) -> None:
+        self._topics[record.id] = record.topic
+        if record.topic not in self.channels:
+            schema = self._schemas.get(record.schema_id)
+            self.channels[record.topic] = LogChannel(record.topic, schema.name if schema else "", _file_of(schema), dict(record.metadata))
+
+    def _problem(self, text: str) -> None:
+        self.problems.append(text)
+        log.warning("%s", text)
+
+    # ------------------------------------------------------------------------------- reading
+    def iter_chunks(self, start_ns: int | None = None) -> Iterator[tuple[int, list[LogMessage]]]:
+        """(chunk number, its messages in file order) for every readable chunk ending at or after ``start_ns``."""
+        for number, chunk in enumerate(self.chunks):
+            if start_ns is not None and chunk.end_ns < start_ns:
+                continue
+            messages = self.read_chunk(number)
+            if messages is not None:
+                yield number, messages
+
+    def read_chunk(self, number: int) -> list[LogMessage] | None:
+        """The messages of one chunk; None (and a warning, once) when the chunk is damaged."""
+        chunk = self.chunks[number]
+        try:
+            self._file.seek(chunk.offset)
+            head = self._file.read(9)
+            if len(head) < 9 or head[0] != Opcode.CHUNK:
+                raise LogError("no chunk record there")
+            records = breakup_chunk(Chunk.read(ReadDataStream(io.BytesIO(self._file.read(int.from_bytes(head[1:], "little"))))),
+                                    validate_crc=True)
+        except Exception as exc:  # noqa: BLE001 - whatever the damage, skip this chunk and go on
+            if number not in self._warned:
+                self._warned.add(number)
+                self._problem(f"{self.path}: the chunk at byte {chunk.offset} is damaged ({type(exc).__name__}: {exc}); "
+                              "skipped, reading on with the next chunk")
+            return None
+        messages = []
+        for record in records:
+            if isinstance(record, Message):
+                topic = self._topics.get(record.channel_id)
+                if topic is not None:
+                    messages.append(LogMessage(topic, record.log_time, record.sequence, record.data))
+            else:
+                self._register(record)
+        return messages
+
+    def messages(self, topics: Iterable[str] | None = None, start_ns: int | None = None) -> Iterator[LogMessage]:
+        """Every readable message (of ``topics``, from ``start_ns`` on), chunk by chunk in file order."""
+        wanted = None if topics is None else set(topics)
+        for _number, messages in self.iter_chunks(start_ns):
+            for message in messages:
+                if (wanted is None or message.topic in wanted) and (start_ns is None or message.time_ns >= start_ns):
+                    yield message
+
+    def summary(self) -> dict[str, Any]:
+        """Duration, frames per context and channels with counts and sizes, from one pass (``tafel log info``)."""
+        for channel in self.channels.values():
+            channel.messages = channel.bytes = 0
+        first, last = None, None
+        frames: dict[str, set[int]] = {}
+        for message in self.messages():
+            channel = self.channels[message.topic]
+            channel.messages += 1
+            channel.bytes += len(message.data)
+            first = message.time_ns if first is None else min(first, message.time_ns)
+            last = message.time_ns if last is None else max(last, message.time_ns)
+            frames.setdefault(channel.context, set()).add(message.sequence)
+        return {
+            "file": str(self.path),
+            "bytes": self.size,
+            "complete": self.complete and not self.problems,
+            "problem": "; ".join(self.problems),
+            "duration_s": (last - first) * 1e-9 if first is not None and last is not None else 0.0,
+            "frames": {context: len(numbers) for context, numbers in sorted(frames.items())},
+            "channels": {
+                topic: {"messages": c.messages, "bytes": c.bytes, "schema": c.schema_name, **c.metadata}
+                for topic, c in sorted(self.channels.items())
+            },
+            "metadata": dict(self.metadata),
+        }
+
+    def close(self) -> None:
+        self._file.close()
+
+    def __enter__(self) -> LogReader:
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self.close()
+
+
+_RECORD_TYPES: dict[int, Any] = {Opcode.SCHEMA: Schema, Opcode.CHANNEL: Channel, Opcode.METADATA: Metadata}
+_KNOWN_OPCODES = {int(op) for op in Opcode}
+
+
 @dataclass
 class LogContents:
-    """Everything read from a log file (messages in file order)."""
+    """A whole log in memory, messages in file order: for tests and small logs (tools stream instead)."""
 
     path: Path
     channels: dict[str, LogChannel] = field(default_factory=dict)
     messages: list[LogMessage] = field(default_factory=list)
     metadata: dict[str, str] = field(default_factory=dict)
     complete: bool = True
-    #: why reading stopped early (a truncated or damaged file), with the byte position
+    #: why reading stopped early or skipped something (a truncated or damaged file), with the byte position
     problem: str = ""
 
     def frames(self, context: str) -> dict[int, dict[str, LogMessage]]:
@@ -190,50 +409,19 @@ class LogContents:
 
 
 def read_log(path: str | Path) -> LogContents:
-    """Read a whole MCAP log; a truncated file yields what was complete and says where it stopped.
+    """Read a whole MCAP log into memory; a truncated file yields what was complete and says where it stopped.
 
-    Raises ``LogError`` naming the file for files that are missing, unreadable or not MCAP at all.
+    Raises ``LogError`` naming the file for files that are missing, unreadable, not MCAP at all, or
+    hold nothing readable. Programs that handle long logs use ``LogReader``, which streams.
     """
-    path = Path(path)
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise LogError(f"cannot read log {path}: {exc.strerror or exc}") from None
-    if not data.startswith(b"\x89MCAP0\r\n"):
-        raise LogError(f"{path} is not an MCAP log (it does not start with the MCAP magic bytes)")
-    contents = LogContents(path=path)
-    stream = io.BytesIO(data)
-    reader = StreamReader(stream, skip_magic=False, validate_crcs=True)
-    schemas: dict[int, Schema] = {}
-    channel_ids: dict[int, str] = {}
-    try:
-        for record in reader.records:
-            if isinstance(record, Schema):
-                schemas[record.id] = record
-            elif isinstance(record, Channel):
-                if record.topic not in contents.channels:
-                    schema = schemas.get(record.schema_id)
-                    contents.channels[record.topic] = LogChannel(
-                        record.topic, schema.name if schema else "", _file_of(schema), dict(record.metadata)
-                    )
-                channel_ids[record.id] = record.topic
-            elif isinstance(record, Message):
-                topic = channel_ids.get(record.channel_id)
-                if topic is None:
-                    continue
-                contents.messages.append(LogMessage(topic, record.log_time, record.sequence, record.data))
-                channel = contents.channels[topic]
-                channel.messages += 1
-                channel.bytes += len(record.data)
-            elif isinstance(record, Metadata) and record.name == "tafel":
-                contents.metadata.update(record.metadata)
-    except Exception as exc:  # noqa: BLE001 - any damage ends reading, whatever the reader raises
-        contents.complete = False
-        contents.problem = f"{path}: stopped reading at byte {stream.tell()} of {len(data)}: {type(exc).__name__}: {exc}"
-    if contents.complete and not data.endswith(b"\x89MCAP0\r\n"):
-        contents.complete = False
-        contents.problem = f"{path}: the file ends at byte {len(data)} without the MCAP footer (the recording was cut off)"
-    return contents
+    with LogReader(path) as reader:
+        messages = list(reader.messages())
+        for message in messages:
+            channel = reader.channels[message.topic]
+            channel.messages += 1
+            channel.bytes += len(message.data)
+        return LogContents(path=reader.path, channels=reader.channels, messages=messages, metadata=reader.metadata,
+                           complete=reader.complete and not reader.problems, problem="; ".join(reader.problems))
 
 
 def _file_of(schema: Schema | None) -> descriptor_pb2.FileDescriptorProto | None:
@@ -245,23 +433,3 @@ def _file_of(schema: Schema | None) -> descriptor_pb2.FileDescriptorProto | None
         if any(m.name == wanted for m in file.message_type):
             return file
     return fds.file[0] if fds.file else None
-
-
-def as_dict(contents: LogContents) -> dict[str, Any]:
-    """A summary of the log as plain data (for ``tafel log info``)."""
-    times = [m.time_ns for m in contents.messages]
-    per_context: dict[str, set[int]] = {}
-    for message in contents.messages:
-        per_context.setdefault(contents.channels[message.topic].context, set()).add(message.sequence)
-    return {
-        "file": str(contents.path),
-        "complete": contents.complete,
-        "problem": contents.problem,
-        "duration_s": (max(times) - min(times)) * 1e-9 if times else 0.0,
-        "frames": {context: len(frames) for context, frames in sorted(per_context.items())},
-        "channels": {
-            topic: {"messages": c.messages, "bytes": c.bytes, "schema": c.schema_name, **c.metadata}
-            for topic, c in sorted(contents.channels.items())
-        },
-        "metadata": contents.metadata,
-    }

@@ -66,6 +66,10 @@ class Platform:
     def add_arguments(cls, parser: argparse.ArgumentParser) -> None:
         """Command-line options of this platform (for ``tafel run``); values arrive in ``options``."""
 
+    def config_layers(self) -> list[str]:
+        """The platform layers of the configuration, in order (``config/platform/NAME.toml``)."""
+        return [self.name]
+
     def rates(self) -> Mapping[str, float] | None:
         """Frame rates (Hz) the platform imposes per context, or None to use the configured ones."""
         return None

@@ -1,7 +1,8 @@
 """Recording representations while a program runs, switchable at run time.
 
-Which representations: per context, those the platform provides (sensor data) plus the names chosen in
-configuration (``[recording] representations``) or with ``--record-reps`` (which replaces both). Each is
+Which representations: per context, always those the platform provides (sensor data, which replay
+needs), plus the names chosen in configuration (``[recording] representations``) or with
+``--record-reps`` (which replaces the configured names; ``all`` records every representation). Each is
 recorded in the context that owns it (the platform's or the provider module's), not where it was
 handed over to. Serialization happens in the loop (a few microseconds a message); writing happens in
 the background.
@@ -20,6 +21,10 @@ from tafel.core.manager import Blackboard
 from tafel.core.naming import did_you_mean
 from tafel.core.program import ContextPlan
 from tafel.core.serialization import SerializationError, serialize
+
+
+#: the name that selects every representation of the program
+ALL = "all"
 
 
 class Sink(Protocol):
@@ -67,8 +72,10 @@ def select(plans: Mapping[str, ContextPlan], names: Iterable[str] | None, *, inc
             provider = chosen or module.__name__
             owners.setdefault(rep.__name__, []).append(Selection(context, rep, "module", provider))
     chosen_names = list(dict.fromkeys(names or []))
+    if ALL in chosen_names:  # every representation of the program; debug data only when named
+        chosen_names = [n for n, owned in owners.items() if any(o.source != "debug" for o in owned)] + chosen_names
     for name in chosen_names:
-        if name not in owners and strict:
+        if name not in owners and name != ALL and strict:
             raise UnknownModuleError(f"cannot record {name!r}: no context has it; {did_you_mean(name, owners)}")
     result: list[Selection] = []
     for name, selections in owners.items():

@@ -34,6 +34,7 @@ from tafel.core.manager import ModuleManager
 from tafel.core.platform import EndOfData, Platform, PlatformError
 from tafel.core.program import ContextPlan
 from tafel.core.recording import QueueSink, Recorder
+from tafel.core.serialization import SerializationError, serialize
 from tafel.core.status import CognitionStatus
 
 log = logging.getLogger("tafel.runtime")
@@ -93,11 +94,33 @@ def recorder_hook(recorder: Recorder) -> Callable[[ContextRunner], None]:
 
 
 def state_digest(manager: ModuleManager) -> str:
-    """A short fingerprint of every representation on a blackboard (equal states, equal digests)."""
+    """A short fingerprint of every representation on a blackboard (equal states, equal digests).
+
+    Each is hashed in its serialized form, the form logs hold, so a value read back from a log
+    (a Python float where a module wrote a numpy float) counts as the same state.
+    """
     digest = hashlib.blake2b(digest_size=8)
     for name in manager.blackboard.names():
         digest.update(name.encode())
-        digest.update(pickle.dumps(manager.blackboard.get(name).__dict__, protocol=5))
+        instance = manager.blackboard.get(name)
+        try:
+            digest.update(serialize(instance))
+        except SerializationError:
+            digest.update(pickle.dumps(instance.__dict__, protocol=5))
+    return digest.hexdigest()
+
+
+def program_fingerprint(stats: Mapping[str, ContextStats]) -> str:
+    """One fingerprint of a whole program's state: every representation on every blackboard.
+
+    Equal in a live run and in its replay when the replay reproduces it (``tafel log compare`` says
+    where it does not); empty when a context could not report its state.
+    """
+    if not stats or any(not s.digest for s in stats.values()):
+        return ""
+    digest = hashlib.blake2b(digest_size=8)
+    for name in sorted(stats):
+        digest.update(f"{name}={stats[name].digest};".encode())
     return digest.hexdigest()
 
 
@@ -261,10 +284,7 @@ class LockstepRuntime:
         self.time_ns = time_ns
         self.platform.advance(time_ns)
         cognition = self.runners.get("cognition") if self.main == "motion" else None
-        if self._motion_status is not None and cognition is not None:
-            self._motion_status.alive = True
-            self._motion_status.frame_number = cognition.frames
-            self._motion_status.age = (time_ns - cognition.time_ns) * 1e-9 if cognition.frames else 0.0
+        self._update_cognition_status(time_ns)
         self.runners[self.main].step(time_ns)
         # cognition tick k is due at k / cognition_rate seconds: compare exactly
         if cognition is not None and self.ticks * self._cognition_rate >= cognition.frames * self._main_rate:
@@ -340,6 +360,8 @@ class LockstepRuntime:
                 if delay > 0:
                     self.idle(delay)
             self.time_ns = time_ns
+            if "motion" in contexts:
+                self._update_cognition_status(time_ns)
             for name in MAIN_CONTEXT_ORDER:
                 if name in contexts and name in self.runners:
                     self.runners[name].step(time_ns)
@@ -347,6 +369,14 @@ class LockstepRuntime:
                 hook(self)
         if first_ns is not None:
             self.time_ns -= first_ns
+
+    def _update_cognition_status(self, time_ns: int) -> None:
+        """In lockstep cognition is alive by construction; motion sees its last frame and age."""
+        cognition = self.runners.get("cognition") if self.main == "motion" else None
+        if self._motion_status is not None and cognition is not None:
+            self._motion_status.alive = True
+            self._motion_status.frame_number = cognition.frames
+            self._motion_status.age = (time_ns - cognition.time_ns) * 1e-9 if cognition.frames else 0.0
 
     def _cognition_status(self) -> CognitionStatus | None:
         runner = self.runners.get("motion")

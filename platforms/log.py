@@ -12,12 +12,14 @@ from __future__ import annotations
 import argparse
 import logging
 import threading
+from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
 from tafel.core.errors import TafelError
-from tafel.core.logfile import LogContents, read_log
+from tafel.core.logfile import LogReader
+from tafel.core.naming import did_you_mean
 from tafel.core.manager import Blackboard
 from tafel.core.platform import EndOfData, Platform, PlatformError, PlatformOptionError
 from tafel.core.representation import get_representation
@@ -26,14 +28,18 @@ from tafel.representations import load_all
 
 log = logging.getLogger("tafel.platform.log")
 CONTEXT_ORDER = ("motion", "cognition")
+#: decoded chunks kept for replay (a frame's messages may straddle two chunks; stepping back reuses them)
+CHUNK_CACHE = 4
 
 
-@dataclass
+@dataclass(frozen=True)
 class _Frame:
+    """One recorded frame of one context: where its fed messages are, not the messages themselves."""
+
     context: str
     number: int
     time_ns: int
-    messages: dict[str, bytes]
+    chunks: tuple[int, ...]
 
 
 class LogPlatform(Platform):
@@ -48,25 +54,26 @@ class LogPlatform(Platform):
         if not path:
             raise PlatformOptionError("the log platform needs a recording: tafel run --platform log --log FILE.mcap")
         try:
-            contents = read_log(path)
+            self.reader = LogReader(path)
         except TafelError as exc:
             raise PlatformError(str(exc)) from None
-        if not contents.messages:
-            raise PlatformError(f"{path} holds no messages to replay" + (f" ({contents.problem})" if contents.problem else ""))
-        if contents.problem:
-            log.warning("replaying what could be recovered: %s", contents.problem)
-        self.contents = contents
         load_all()
         self.loop = bool(self.options.get("loop", False))
-        replace = [n for n in str(self.options.get("replace") or "").split(",") if n.strip()]
-        self.classes = self._resolve_classes(contents, [n.strip() for n in replace])
+        replace = [n.strip() for n in str(self.options.get("replace") or "").split(",") if n.strip()]
+        classes = self._resolve_classes(self.reader, replace)
+        topics = self._fed_topics(self.reader, replace)
+        #: topic -> class of exactly what replay writes onto the blackboards: sensor data and --replace
+        self.classes = {topic: cls for topic, cls in classes.items() if any(topic in t for t in topics.values())}
         self.decoders = {topic: codec(cls).decode for topic, cls in self.classes.items()}
         self.provides = {  # type: ignore[misc] - depends on the file, so per instance
-            context: tuple(self.classes[topic] for topic in topics if topic in self.classes)
-            for context, topics in self._provided_topics(contents, replace).items()
+            context: tuple(self.classes[topic] for topic in names if topic in self.classes)
+            for context, names in topics.items()
         }
         self.consumes = {}  # type: ignore[misc]
-        self.timeline = self._timeline(contents)
+        self.timeline = self._timeline()
+        if not self.timeline:
+            raise PlatformError(f"{path} holds no sensor data to replay"
+                                + (f" ({'; '.join(self.reader.problems)})" if self.reader.problems else ""))
         self.position = 0  # index into the timeline of the next step
         self.paused = False
         self.steps_left: int | None = None  # frames to run before pausing again (stepping)
@@ -74,6 +81,11 @@ class LogPlatform(Platform):
         self._lock = threading.Lock()
         self._by_context = {c: [f for step in self.timeline for f in step if f.context == c] for c in self.provides}
         self._cursors: dict[str, int] = {}
+        self._cache: OrderedDict[int, dict[tuple[str, int], dict[str, bytes]]] = OrderedDict()
+
+    @property
+    def path(self) -> str:
+        return str(self.reader.path)
 
     @classmethod
     def add_arguments(cls, parser: argparse.ArgumentParser) -> None:
@@ -84,64 +96,71 @@ class LogPlatform(Platform):
 
     # -------------------------------------------------------------------------------- set-up
     @staticmethod
-    def _provided_topics(contents: LogContents, replace: list[str]) -> dict[str, list[str]]:
-        recorded = {c.representation for c in contents.channels.values()}
+    def _fed_topics(reader: LogReader, replace: list[str]) -> dict[str, list[str]]:
+        """Per context, the recorded topics replay feeds: what the recording platform provided, and
+        what ``--replace`` names. Recorded module outputs are only there to compare against."""
+        recorded = {c.representation for c in reader.channels.values()}
         unknown = [name for name in replace if name not in recorded]
         if unknown:
-            from tafel.core.naming import did_you_mean
-
             raise PlatformOptionError(
                 f"--replace names {', '.join(unknown)}, which the log does not hold; "
                 + did_you_mean(unknown[0], sorted(recorded))
             )
         topics: dict[str, list[str]] = {}
-        for topic, channel in contents.channels.items():
+        for topic, channel in reader.channels.items():
             if channel.metadata.get("source") == "platform" or channel.representation in replace:
                 topics.setdefault(channel.context, []).append(topic)
         return topics
 
     @staticmethod
-    def _resolve_classes(contents: LogContents, replace: list[str]) -> dict[str, type]:
+    def _resolve_classes(reader: LogReader, replace: list[str]) -> dict[str, type]:
         classes = {}
-        for topic, channel in contents.channels.items():
+        for topic, channel in reader.channels.items():
             try:
                 cls = get_representation(channel.representation)
             except KeyError:
-                log.warning("%s: no representation class %s in this program; not replayed", contents.path, channel.representation)
+                log.warning("%s: no representation class %s in this program; not replayed", reader.path, channel.representation)
                 continue
             if channel.schema is not None:
                 try:
                     check_compatible(cls, channel.schema)
                 except SerializationError as exc:
-                    raise PlatformError(f"{contents.path}, channel {topic}: {exc}") from None
+                    raise PlatformError(f"{reader.path}, channel {topic}: {exc}") from None
             classes[topic] = cls
         return classes
 
-    def _timeline(self, contents: LogContents) -> list[list[_Frame]]:
-        """Steps in recorded order: the frames of all contexts that share one time."""
-        frames: dict[tuple[str, int], _Frame] = {}
-        for message in contents.messages:
-            channel = contents.channels[message.topic]
-            if message.topic not in self.classes:
-                continue
-            key = (channel.context, message.sequence)
-            frame = frames.get(key)
-            if frame is None:
-                frame = frames[key] = _Frame(channel.context, message.sequence, message.time_ns, {})
-            frame.messages[message.topic] = message.data
-        ordered = sorted(frames.values(), key=lambda f: (f.time_ns, CONTEXT_ORDER.index(f.context) if f.context in CONTEXT_ORDER else 9, f.number))
+    def _timeline(self) -> list[list[_Frame]]:
+        """Steps in recorded order: the frames of all contexts that share one time.
+
+        One pass over the file; only frame numbers, times and chunk numbers are kept, so memory does
+        not grow with the size of what was recorded.
+        """
+        found: dict[tuple[str, int], tuple[int, set[int]]] = {}
+        for number, messages in self.reader.iter_chunks():
+            for message in messages:
+                if message.topic in self.classes:
+                    key = (self.reader.channels[message.topic].context, message.sequence)
+                    time_ns, chunks = found.setdefault(key, (message.time_ns, set()))
+                    chunks.add(number)
+        frames = [_Frame(context, sequence, time_ns, tuple(sorted(chunks))) for (context, sequence), (time_ns, chunks) in found.items()]
+        frames.sort(key=lambda f: (f.time_ns, CONTEXT_ORDER.index(f.context) if f.context in CONTEXT_ORDER else 9, f.number))
         steps: list[list[_Frame]] = []
-        for frame in ordered:
+        for frame in frames:
             if steps and steps[-1][0].time_ns == frame.time_ns and all(f.context != frame.context for f in steps[-1]):
                 steps[-1].append(frame)
             else:
                 steps.append([frame])
         return steps
 
+    def config_layers(self) -> list[str]:
+        """The recording platform's layer first, so that replay runs the program that was recorded."""
+        recorded = self.reader.metadata.get("platform", "")
+        return [recorded, self.name] if recorded and recorded != self.name else [self.name]
+
     def rates(self) -> Mapping[str, float] | None:
         rates = {}
         for context in ("cognition", "motion"):
-            value = self.contents.metadata.get(f"{context}_hz")
+            value = self.reader.metadata.get(f"{context}_hz")
             if value:
                 rates[context] = float(value)
         return rates or None
@@ -153,7 +172,7 @@ class LogPlatform(Platform):
                 return None
             if self.position >= len(self.timeline):
                 if not self.loop:
-                    raise EndOfData(f"end of log {self.contents.path}")
+                    raise EndOfData(f"end of log {self.path}")
                 self.position = 0
             step = self.timeline[self.position]
             self.position += 1
@@ -168,19 +187,40 @@ class LogPlatform(Platform):
         frame = self._pending.pop(context, None)
         if frame is None:  # concurrent runtime: no schedule, serve this context's frames in order
             frame = self._next_frame_of(context)
-        for topic, data in frame.messages.items():
+        for topic, data in self._messages_of(frame).items():
             try:
                 # each channel's schema was checked against its class when the log was opened
                 blackboard.set(self.decoders[topic](data))
             except Exception as exc:  # noqa: BLE001 - a damaged message is reported, the replay goes on
-                log.error("%s frame %d of %s: cannot decode: %s", self.contents.path, frame.number, topic, exc)
+                log.error("%s frame %d of %s: cannot decode: %s", self.path, frame.number, topic, exc)
+
+    def _messages_of(self, frame: _Frame) -> dict[str, bytes]:
+        messages: dict[str, bytes] = {}
+        for number in frame.chunks:
+            messages.update(self._chunk(number).get((frame.context, frame.number), {}))
+        return messages
+
+    def _chunk(self, number: int) -> dict[tuple[str, int], dict[str, bytes]]:
+        """The fed messages of one chunk by frame, decoded from the file on first use."""
+        cached = self._cache.get(number)
+        if cached is not None:
+            self._cache.move_to_end(number)
+            return cached
+        frames: dict[tuple[str, int], dict[str, bytes]] = {}
+        for message in self.reader.read_chunk(number) or []:
+            if message.topic in self.classes:
+                frames.setdefault((self.reader.channels[message.topic].context, message.sequence), {})[message.topic] = message.data
+        self._cache[number] = frames
+        while len(self._cache) > CHUNK_CACHE:
+            self._cache.popitem(last=False)
+        return frames
 
     def _next_frame_of(self, context: str) -> _Frame:
         frames = self._by_context.get(context, [])
         index = self._cursors.get(context, 0)
         if index >= len(frames):
             if not self.loop or not frames:
-                raise EndOfData(f"end of log {self.contents.path}")
+                raise EndOfData(f"end of log {self.path}")
             index = 0
         self._cursors[context] = index + 1
         return frames[index]
@@ -220,10 +260,12 @@ class LogPlatform(Platform):
         with self._lock:
             current = self.timeline[min(self.position, len(self.timeline)) - 1] if self.position else []
         return {
-            "file": str(self.contents.path),
+            "file": self.path,
             "paused": self.paused,
             "step": self.position,
             "steps": len(self.timeline),
             "frames": {f.context: f.number for f in current},
         }
 
+    def stop(self) -> None:
+        self.reader.close()

@@ -19,7 +19,14 @@ from tafel.core.errors import TafelError
 from tafel.core.platform import Platform, PlatformError, PlatformOptionError, available_platforms, load_platform
 from tafel.core.program import ContextPlan, plan_program
 from tafel.core.recording import Recorder, select
-from tafel.core.runtime import ConcurrentRuntime, ContextStats, Limits, LockstepRuntime, install_signal_handlers
+from tafel.core.runtime import (
+    ConcurrentRuntime,
+    ContextStats,
+    Limits,
+    LockstepRuntime,
+    install_signal_handlers,
+    program_fingerprint,
+)
 from tafel.representations.modeling import BallModel
 from tafel.tools.debugging import (
     DEBUG_REPRESENTATIONS,
@@ -106,7 +113,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="seconds between status lines (default: %(default)s)")
     run.add_argument("-v", "--verbose", action="store_true", help="log informational messages")
     run.add_argument("--record", type=Path, metavar="FILE.mcap", help="record representations into an MCAP log")
-    run.add_argument("--record-reps", metavar="A,B", help="what to record (default: sensor data and [recording] representations)")
+    run.add_argument("--record-reps", metavar="A,B",
+                     help="what to record besides the sensor data (default: [recording] representations; 'all': everything)")
     run.add_argument("--debug-port", type=int, default=None, metavar="P", help=f"debug server port (default {DEFAULT_DEBUG_PORT}; 0 takes a free one)")
     run.add_argument("--debug-host", default="127.0.0.1", metavar="H", help="debug server address (default: %(default)s)")
     run.add_argument("--debug-token", metavar="T", help="clients must send 'auth T' first")
@@ -164,7 +172,7 @@ def prepare(args: argparse.Namespace, extra: Sequence[str]) -> tuple[Platform, d
     discover_modules()
     platform = platform_class(vars(options))
     overrides = [f"runtime.{context}_hz={hz}" for context, hz in (platform.rates() or {}).items()]
-    config = load_config(config_dirs(args), platform_class.name, args.robot, [*overrides, *args.overrides])
+    config = load_config(config_dirs(args), platform.config_layers(), args.robot, [*overrides, *args.overrides])
     plans = plan_program(config, platform, strict=args.strict)
     return platform, vars(options), plans, config
 
@@ -186,8 +194,6 @@ def print_summary(platform: str, mode: str, stats: dict[str, ContextStats], wall
     for name, s in stats.items():
         errors = ", ".join(f"{m} {n}" for m, n in sorted(s.errors_by_module.items())) or "none"
         line = f"  {name}: {s.frames} frames, module errors: {errors}"
-        if s.digest:
-            line += f", state {s.digest}"
         if s.failure:
             line += f", FAILED: {s.failure}"
         print(line)
@@ -196,6 +202,9 @@ def print_summary(platform: str, mode: str, stats: dict[str, ContextStats], wall
             print(f"    timing: period error p50 {timing['p50_ms']:.2f} ms, p99 {timing['p99_ms']:.2f} ms, "
                   f"max {timing['max_ms']:.2f} ms, missed_periods={s.missed_periods}"
                   + (f", frames_without_cognition={s.frames_without_cognition}" if name == "motion" else ""))
+    fingerprint = program_fingerprint(stats)
+    if fingerprint:
+        print(f"fingerprint {fingerprint} (the state of every representation; equal runs and faithful replays print the same)")
     rates = ", ".join(f"{n} {s.rate_hz:.1f} Hz" for n, s in stats.items())
     sys.stdout.flush()
     print(f"wall time {wall_s:.2f} s ({rates})", file=sys.stderr)
@@ -346,7 +355,7 @@ def make_recorder(args: argparse.Namespace, plans: dict[str, ContextPlan], confi
         [n.strip() for n in args.record_reps.split(",") if n.strip()] if args.record_reps
         else list(config.get("recording", {}).get("representations", []))
     )
-    selections = select(plans, names, include_sensors=not args.record_reps, extra=DEBUG_REPRESENTATIONS,
+    selections = select(plans, names, extra=DEBUG_REPRESENTATIONS,
                         strict=bool(args.record_reps))
     metadata = {"platform": platform, **{f"{c}_hz": str(p.rate_hz) for c, p in plans.items()}}
     recorder = Recorder(selections, metadata)

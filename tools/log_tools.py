@@ -1,6 +1,7 @@
-"""``tafel log info`` and ``tafel log export``: look into recorded MCAP logs.
+"""``tafel log info``, ``export`` and ``compare``: look into recorded MCAP logs.
 
-Export decodes with the schemas stored in the log itself, so it works for logs written by older
+All of them stream through the file chunk by chunk, so logs of any length can be read. Export and
+compare decode with the schemas stored in the log itself, so they work for logs written by older
 versions of the code too.
 """
 
@@ -9,6 +10,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import logging
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -17,7 +19,7 @@ from typing import Any
 import numpy as np
 from google.protobuf import descriptor_pool, message_factory
 
-from tafel.core.logfile import LogContents, LogError, as_dict, read_log
+from tafel.core.logfile import LogError, LogReader
 from tafel.core.naming import did_you_mean
 
 
@@ -34,21 +36,34 @@ def add_log_commands(commands: Any) -> None:
     export.add_argument("--context", choices=["cognition", "motion"], help="only this context's channel")
     export.add_argument("--format", required=True, choices=["csv", "jsonl", "png"])
     export.add_argument("--out", required=True, type=Path, help="output file (csv, jsonl) or folder (png)")
+    compare = actions.add_parser("compare", help="where two logs differ: per channel, the first differing frame and field",
+                                 description="Compare two logs frame by frame, per context and representation; "
+                                             "exit status 1 when they differ.")
+    compare.add_argument("first", type=Path, metavar="A.mcap")
+    compare.add_argument("second", type=Path, metavar="B.mcap")
+    compare.add_argument("--rep", metavar="A,B", help="only these representations")
+    compare.add_argument("--json", action="store_true", help="print the report as JSON")
 
 
 def run_log_command(args: argparse.Namespace) -> int:
+    if args.log_command == "compare":
+        from tafel.tools.log_compare import run_compare
+
+        return run_compare(args)
+    logging.getLogger("tafel.log").setLevel(logging.ERROR)  # the commands print the problems themselves
     try:
-        contents = read_log(args.file)
+        reader = LogReader(args.file)
     except LogError as exc:
         print(f"tafel log: error: {exc}", file=sys.stderr)
         return 1
-    if args.log_command == "info":
-        return print_info(contents, args.json)
-    return export(contents, args)
+    with reader:
+        if args.log_command == "info":
+            return print_info(reader, args.json)
+        return export(reader, args)
 
 
-def print_info(contents: LogContents, as_json: bool) -> int:
-    info = as_dict(contents)
+def print_info(reader: LogReader, as_json: bool) -> int:
+    info = reader.summary()
     if as_json:
         print(json.dumps(info, indent=2))
         return 0
@@ -76,28 +91,35 @@ def _size(n: int) -> str:
 
 
 # ----------------------------------------------------------------------------------------- export
-def decoded_messages(contents: LogContents, rep: str, context: str | None) -> Iterator[tuple[str, int, int, dict[str, Any]]]:
-    """(context, frame, time_ns, fields) for every message of ``rep``, decoded with the log's schema."""
-    topics = [t for t, c in contents.channels.items() if c.representation == rep and (context is None or c.context == context)]
+def message_class(reader: LogReader, topic: str) -> Any:
+    """The protobuf class of a channel, built from the schema stored in the log."""
+    channel = reader.channels[topic]
+    if channel.schema is None:
+        raise LogError(f"{reader.path}: channel {topic} has no protobuf schema")
+    pool = descriptor_pool.DescriptorPool()
+    pool.Add(channel.schema)
+    return message_factory.GetMessageClass(pool.FindMessageTypeByName(channel.schema_name))
+
+
+def topics_of(reader: LogReader, rep: str, context: str | None = None) -> list[str]:
+    """The channels holding ``rep`` (in ``context``); ``LogError`` with the closest names otherwise."""
+    topics = [t for t, c in reader.channels.items() if c.representation == rep and (context is None or c.context == context)]
     if not topics:
-        names = sorted({c.representation for c in contents.channels.values()})
-        raise LogError(f"{contents.path} holds no representation {rep!r}" + (f" in {context}" if context else "") + f"; {did_you_mean(rep, names)}")
-    classes = {}
-    for topic in topics:
-        channel = contents.channels[topic]
-        if channel.schema is None:
-            raise LogError(f"{contents.path}: channel {topic} has no protobuf schema")
-        pool = descriptor_pool.DescriptorPool()
-        pool.Add(channel.schema)
-        classes[topic] = message_factory.GetMessageClass(pool.FindMessageTypeByName(channel.schema_name))
-    for message in contents.messages:
-        if message.topic in classes:
-            try:
-                decoded = classes[message.topic].FromString(message.data)
-            except Exception as exc:  # noqa: BLE001 - a damaged message is skipped, named
-                print(f"\nskipping {message.topic} frame {message.sequence}: {exc}", file=sys.stderr)
-                continue
-            yield contents.channels[message.topic].context, message.sequence, message.time_ns, to_python(decoded)
+        names = sorted({c.representation for c in reader.channels.values()})
+        raise LogError(f"{reader.path} holds no representation {rep!r}" + (f" in {context}" if context else "") + f"; {did_you_mean(rep, names)}")
+    return topics
+
+
+def decoded_messages(reader: LogReader, rep: str, context: str | None) -> Iterator[tuple[str, int, int, dict[str, Any]]]:
+    """(context, frame, time_ns, fields) for every message of ``rep``, decoded with the log's schema."""
+    classes = {topic: message_class(reader, topic) for topic in topics_of(reader, rep, context)}
+    for message in reader.messages(classes):
+        try:
+            decoded = classes[message.topic].FromString(message.data)
+        except Exception as exc:  # noqa: BLE001 - a damaged message is skipped, named
+            print(f"\nskipping {message.topic} frame {message.sequence}: {exc}", file=sys.stderr)
+            continue
+        yield reader.channels[message.topic].context, message.sequence, message.time_ns, to_python(decoded)
 
 
 def to_python(message: Any) -> dict[str, Any]:
@@ -167,11 +189,10 @@ class Progress:
             print(file=sys.stderr)
 
 
-def export(contents: LogContents, args: argparse.Namespace) -> int:
+def export(reader: LogReader, args: argparse.Namespace) -> int:
     try:
-        rows = decoded_messages(contents, args.rep, args.context)
-        total = sum(c.messages for c in contents.channels.values()
-                    if c.representation == args.rep and (args.context is None or c.context == args.context))
+        total = _message_count(reader, topics_of(reader, args.rep, args.context))
+        rows = decoded_messages(reader, args.rep, args.context)
         progress = Progress(f"exporting {args.rep}", total)
         written = _write(rows, args, progress)
         progress.close()
@@ -182,8 +203,23 @@ def export(contents: LogContents, args: argparse.Namespace) -> int:
         print(f"tafel log: error: cannot write {args.out}: {exc.strerror}", file=sys.stderr)
         return 1
     print(f"exported {written} {args.rep} {'images' if args.format == 'png' else 'rows'} to {args.out}")
-    if contents.problem:
-        print(f"note: {contents.problem}", file=sys.stderr)
+    for problem in reader.problems:
+        print(f"note: {problem}", file=sys.stderr)
+    return 0
+
+
+def _message_count(reader: LogReader, topics: list[str]) -> int:
+    """How many messages the topics hold, from the summary's statistics where the file has them."""
+    try:
+        from mcap.reader import SeekingReader
+
+        with open(reader.path, "rb") as handle:
+            summary = SeekingReader(handle).get_summary()
+        if summary is not None and summary.statistics is not None:
+            ids = {c.id for c in summary.channels.values() if c.topic in topics}
+            return sum(n for channel_id, n in summary.statistics.channel_message_counts.items() if channel_id in ids)
+    except Exception:  # noqa: BLE001 - without statistics the progress bar is simply not shown
+        pass
     return 0
 
 
