@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
 
+from tafel.core import clock
 from tafel.core.handover import Bundle, LocalChannel, SharedChannel, apply_bundle, make_bundle
 from tafel.core.manager import ModuleManager
 from tafel.core.platform import EndOfData, Platform, PlatformError
@@ -414,6 +415,8 @@ class WorkerSpec:
     record_switch: Any = None
     #: (function, arguments) run in the context process once its runner exists (debug server wiring)
     setup: tuple[Callable[[ContextRunner, Any], None], Any] | None = None
+    #: the program's time 0 on the monotonic clock, shared by every process (``core.clock``)
+    clock_origin_ns: int = 0
 
 
 def try_realtime(priority: int) -> str:
@@ -473,7 +476,7 @@ def run_context_loop(
                 status.alive, status.frame_number, status.age = alive, frame_number, age
                 if not alive:
                     stats.frames_without_cognition += 1
-            runner.step(now - start_ns)
+            runner.step(clock.from_monotonic_ns(now))  # one time base for both contexts
             if now - last_report >= 1e9:
                 last_report = now
                 report(_snapshot_stats(runner, stats, start_ns))
@@ -505,6 +508,7 @@ def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
     """Entry point of a context process."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the supervisor decides when to stop
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    clock.set_origin(spec.clock_origin_ns)
     logging.basicConfig(level=logging.WARNING, format=f"[{spec.plan.name}] %(levelname)s %(message)s")
     realtime = try_realtime(spec.realtime_priority) if spec.plan.name == "motion" else ""
     inbox = SharedChannel.attach(spec.inbox_name) if spec.inbox_name else None
@@ -619,7 +623,7 @@ class ConcurrentRuntime:
                     inbox_name=channels[other].name if (plan.handover_in or watch_cognition) and other in channels else None,
                     outbox_name=channels[name].name, stall_timeout_s=self.stall_timeout_s,
                     record=self.recorder.by_context.get(name, []) if self.recorder else [], record_queue=record_queue,
-                    record_switch=self.record_switch, setup=self.worker_setup,
+                    record_switch=self.record_switch, setup=self.worker_setup, clock_origin_ns=clock.origin_ns(),
                 )
                 receiver, sender = self._mp.Pipe(duplex=False)
                 process = self._mp.Process(target=_worker_main, args=(spec, self.stop, sender), name=f"tafel-{name}", daemon=True)

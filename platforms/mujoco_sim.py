@@ -124,6 +124,21 @@ class MujocoPlatform(SimulatedRobotPlatform):
         renderer.update_scene(self.data, camera=f"{camera}_camera")
         return renderer.render().copy()
 
+    def world_state(self) -> np.ndarray:
+        return self.data.qpos.copy()
+
+    def render_state(self, state: np.ndarray, cameras: tuple[str, ...]) -> dict[str, np.ndarray]:
+        now = self.data.qpos.copy()
+        self.data.qpos[:] = state
+        mujoco.mj_kinematics(self.model, self.data)
+        mujoco.mj_camlight(self.model, self.data)
+        images = {camera: self.render(camera) for camera in cameras}
+        # back to the present; the next step recomputes everything else from qpos and qvel
+        self.data.qpos[:] = now
+        mujoco.mj_kinematics(self.model, self.data)
+        mujoco.mj_camlight(self.model, self.data)
+        return images
+
     def drive(self, targets: np.ndarray, stiffness: np.ndarray) -> None:
         if not np.array_equal(stiffness, self._gains_for):
             self.set_gains(stiffness)

@@ -27,8 +27,10 @@ import cv2
 import msgpack
 import numpy as np
 
+from tafel.core import clock
 from tafel.core.manager import Blackboard
 from tafel.core.platform import Platform, PlatformError
+from tafel.platforms.v4l2 import image_time_ns
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import (
     JOINT_COUNT,
@@ -108,7 +110,6 @@ class NaoPlatform(Platform):
         self.captures: dict[str, Any] = {}
         self.measured = np.zeros(JOINT_COUNT)
         self.commanded_stiffness = np.zeros(JOINT_COUNT)
-        self.started_ns = time.monotonic_ns()
         self.time_ns = 0
         self.packets = 0
         self.pending_answer = False
@@ -233,7 +234,7 @@ class NaoPlatform(Platform):
     def sense(self, context: str, blackboard: Blackboard, frame_number: int, time_ns: int) -> None:
         if context == "motion":
             values = self.receive()
-            self.time_ns = time.monotonic_ns() - self.started_ns
+            self.time_ns = clock.now_ns()
             blackboard.set(FrameInfo(frame_number=frame_number, time_ns=self.time_ns))
             self.measured = values["Position"]
             blackboard.set(JointSensorData(position=values["Position"], stiffness=values["Stiffness"],
@@ -249,7 +250,7 @@ class NaoPlatform(Platform):
             blackboard.set(BatteryData(charge=float(battery[0]), status=float(battery[1]), current=float(battery[2]),
                                        temperature=float(battery[3])))
         elif context == "cognition":
-            self.time_ns = time.monotonic_ns() - self.started_ns
+            self.time_ns = clock.now_ns()
             blackboard.set(FrameInfo(frame_number=frame_number, time_ns=self.time_ns))
             if not self.captures:
                 time.sleep(1.0 / 30.0)  # no cameras: keep cognition at its usual pace
@@ -261,6 +262,7 @@ class NaoPlatform(Platform):
                 if camera == "top":
                     frame = cv2.rotate(frame, cv2.ROTATE_180)  # mounted upside down
                 image = blackboard[rep]
+                image.time_ns = image_time_ns(self.captures[camera], self.camera_devices[camera])
                 image.image = cv2.cvtColor(frame, cv2.COLOR_BGR2RGB)
                 image.horizontal_fov, image.vertical_fov = HORIZONTAL_FOV, VERTICAL_FOV
 

@@ -190,6 +190,21 @@ class PybulletPlatform(SimulatedRobotPlatform):
                                                    lightDirection=[0.3, 0.2, 1.0], physicsClientId=self.client)
         return np.asarray(rgba, dtype=np.uint8).reshape(self.height, self.width, 4)[:, :, :3].copy()
 
+    def world_state(self) -> int:
+        return pybullet.saveState(physicsClientId=self.client)
+
+    def forget_state(self, state: int) -> None:
+        pybullet.removeState(state, physicsClientId=self.client)
+
+    def render_state(self, state: int, cameras: tuple[str, ...]) -> dict[str, np.ndarray]:
+        now = pybullet.saveState(physicsClientId=self.client)
+        try:
+            pybullet.restoreState(stateId=state, physicsClientId=self.client)
+            return {camera: self.render(camera) for camera in cameras}
+        finally:
+            pybullet.restoreState(stateId=now, physicsClientId=self.client)
+            pybullet.removeState(now, physicsClientId=self.client)
+
     def drive(self, targets: np.ndarray, stiffness: np.ndarray) -> None:
         joints = list(self.joint_ids) + [follower for follower, _ in self.follower_ids]
         goals = list(targets) + [targets[leader] for _, leader in self.follower_ids]

@@ -11,6 +11,7 @@ import argparse
 import math
 import os
 import sys
+from collections import deque
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
@@ -83,6 +84,12 @@ class SimulatedRobotPlatform(Platform):
         self.paused = False
         self.time_ns = 0
         self.last_steps = 0  # physics steps of the last advance (benchmarks read it)
+        latency = float(self.options.get("camera_latency_ms") or 0.0)
+        if not (math.isfinite(latency) and 0.0 <= latency <= 1000.0):
+            raise PlatformOptionError(f"--camera-latency-ms takes 0 to 1000 ms, got {self.options.get('camera_latency_ms')!r}")
+        self.camera_latency_ns = int(round(latency * 1e6))
+        #: (time_ns, engine state) of the recent physics steps, while images arrive late
+        self.history: deque[tuple[int, Any]] = deque()
 
     @classmethod
     def add_arguments(cls, parser: argparse.ArgumentParser) -> None:
@@ -92,6 +99,8 @@ class SimulatedRobotPlatform(Platform):
         parser.add_argument("--resolution", default="320x240", help=f"{name}: camera image size WIDTHxHEIGHT")
         parser.add_argument("--ball", default="1000,300", help=f"{name}: ball start X,Y in mm on the field")
         parser.add_argument("--viewer", action="store_true", help=f"{name}: open the {cls.engine} viewer (needs a display)")
+        parser.add_argument("--camera-latency-ms", type=float, default=0.0, metavar="MS",
+                            help=f"{name}: images are rendered at time t and delivered MS later, as on the NAO (30 to 40)")
 
     # ------------------------------------------------------------------ what an engine implements
     def build(self, contexts: frozenset[str], viewer: bool) -> None:
@@ -121,6 +130,17 @@ class SimulatedRobotPlatform(Platform):
         """The image of ``top`` or ``bottom`` (height x width x 3 RGB uint8)."""
         raise NotImplementedError
 
+    def world_state(self) -> Any:
+        """The world as it is now, to render it later (only used with a camera latency)."""
+        raise NotImplementedError
+
+    def forget_state(self, state: Any) -> None:
+        """Release a state from ``world_state`` that is no longer needed."""
+
+    def render_state(self, state: Any, cameras: tuple[str, ...]) -> dict[str, np.ndarray]:
+        """The cameras' images of the world as it was in ``state``; the world itself stays as it is now."""
+        raise NotImplementedError
+
     def drive(self, targets: np.ndarray, stiffness: np.ndarray) -> None:
         """Position targets (rad) with stiffness 0..1 per joint in ``JOINT_NAMES`` order."""
         raise NotImplementedError
@@ -148,10 +168,18 @@ class SimulatedRobotPlatform(Platform):
 
     def advance(self, time_ns: int) -> None:
         steps = int(round((time_ns - self.time_ns) * 1e-9 / TIMESTEP))
-        self.time_ns = time_ns
+        start_ns, self.time_ns = self.time_ns, time_ns
         self.last_steps = 0 if self.paused else max(steps, 0)
-        if self.last_steps:
+        if not self.last_steps:
+            return
+        if not (self.camera_latency_ns and self.cameras):
             self.step_physics(self.last_steps)
+            return
+        for step in range(1, self.last_steps + 1):  # keep each step's world: images show the past
+            self.step_physics(1)
+            self.history.append((start_ns + int(round(step * TIMESTEP * 1e9)), self.world_state()))
+        while len(self.history) > 1 and self.history[1][0] <= time_ns - self.camera_latency_ns:
+            self.forget_state(self.history.popleft()[1])
 
     def sense(self, context: str, blackboard: Blackboard, frame_number: int, time_ns: int) -> None:
         blackboard.set(FrameInfo(frame_number=frame_number, time_ns=time_ns))
@@ -168,10 +196,25 @@ class SimulatedRobotPlatform(Platform):
             inertial.angles = np.array(self.torso_angles())
             blackboard[FsrData].pressure = self.foot_forces() / GRAVITY
         elif context == "cognition" and self.cameras:
+            taken_ns, images = self.images(time_ns)
             for camera, rep in (("top", CameraImageTop), ("bottom", CameraImageBottom)):
                 image = blackboard[rep]
-                image.image = self.render(camera)
+                image.image = images[camera]
+                image.time_ns = taken_ns
                 image.horizontal_fov, image.vertical_fov = self.fov()
+
+    def images(self, time_ns: int) -> tuple[int, dict[str, np.ndarray]]:
+        """(when taken, images) delivered at ``time_ns``: rendered ``camera_latency_ns`` earlier."""
+        cameras = ("top", "bottom")
+        if not (self.camera_latency_ns and self.history):
+            return time_ns, {camera: self.render(camera) for camera in cameras}
+        due = time_ns - self.camera_latency_ns
+        taken_ns, state = self.history[0]
+        for entry_ns, entry in self.history:
+            if entry_ns > due:
+                break
+            taken_ns, state = entry_ns, entry
+        return taken_ns, self.render_state(state, cameras)
 
     def act(self, context: str, blackboard: Blackboard) -> None:
         if context != "motion":

@@ -18,8 +18,10 @@ from typing import Any, ClassVar
 import cv2
 import numpy as np
 
+from tafel.core import clock
 from tafel.core.manager import Blackboard
 from tafel.core.platform import EndOfData, Platform, PlatformError, PlatformOptionError
+from tafel.platforms.v4l2 import image_time_ns
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.perception import CameraImageBottom, CameraImageTop
 
@@ -107,11 +109,14 @@ class VideoPlatform(Platform):
             if delay > 0:
                 time.sleep(delay * 1e-9)
             self.time_ns = self.frame_index * self.period_ns
+            taken_ns = self.time_ns
         else:
-            self.time_ns = time.monotonic_ns() - self.started_ns
+            self.time_ns = clock.now_ns()
+            taken_ns = image_time_ns(self.capture, str(self.device))
         self.frame_index += 1
         blackboard.set(FrameInfo(frame_number=frame_number, time_ns=self.time_ns))
         image = blackboard[CameraImageTop]
+        image.time_ns = taken_ns
         image.image = cv2.cvtColor(frame, cv2.COLOR_BGR2RGB)
         height, width = image.image.shape[:2]
         image.horizontal_fov = self.horizontal_fov

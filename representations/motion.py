@@ -110,6 +110,84 @@ class CameraMatrixBottom(CameraMatrix):
     """The bottom camera's pose in the robot frame."""
 
 
+#: camera matrices the buffer holds: 400 ms at 100 Hz (NaoTH's CameraMatrixBuffer holds about 300 ms)
+CAMERA_MATRIX_HISTORY = 40
+
+
+@representation
+class CameraMatrixBuffer:
+    """The camera matrices of the last motion frames with their times, oldest first, so that cognition
+    can use the pose a camera had when an image was taken (images arrive 30 to 40 ms after that on
+    the NAO). ``count`` entries are filled; ``time_ns`` is on the program's clock, like ``FrameInfo``.
+    """
+
+    count: int = 0
+    time_ns: np.ndarray = array((CAMERA_MATRIX_HISTORY,), np.int64)
+    top_rotation: np.ndarray = array((CAMERA_MATRIX_HISTORY, 3, 3))
+    top_translation: np.ndarray = array((CAMERA_MATRIX_HISTORY, 3))
+    bottom_rotation: np.ndarray = array((CAMERA_MATRIX_HISTORY, 3, 3))
+    bottom_translation: np.ndarray = array((CAMERA_MATRIX_HISTORY, 3))
+
+    @classmethod
+    def of(cls, top: CameraMatrix, bottom: CameraMatrix, time_ns: int = 0) -> CameraMatrixBuffer:
+        """A buffer holding one pair of matrices (tests, and programs without a history)."""
+        buffer = cls(count=1)
+        buffer.time_ns[0] = time_ns
+        buffer.top_rotation[0], buffer.top_translation[0] = top.rotation, top.translation
+        buffer.bottom_rotation[0], buffer.bottom_translation[0] = bottom.rotation, bottom.translation
+        return buffer
+
+    def newest(self, camera: str) -> CameraMatrix:
+        """The latest matrix of ``camera`` ("top" or "bottom"); invalid while the buffer is empty."""
+        if self.count == 0:
+            return CameraMatrix()
+        rotation, translation = self._arrays(camera)
+        return CameraMatrix(rotation[self.count - 1].copy(), translation[self.count - 1].copy(), True)
+
+    def at(self, camera: str, time_ns: int) -> CameraMatrix:
+        """The matrix of ``camera`` at ``time_ns``, interpolated between the two nearest entries.
+
+        Rotation is interpolated on the shortest arc between the two, translation linearly. Before
+        the oldest or after the newest entry the nearest one is used. Invalid while empty.
+        """
+        n = self.count
+        if n == 0:
+            return CameraMatrix()
+        rotation, translation = self._arrays(camera)
+        times = self.time_ns[:n]
+        after = int(np.searchsorted(times, time_ns, side="left"))
+        if after == 0 or after >= n:
+            index = 0 if after == 0 else n - 1
+            return CameraMatrix(rotation[index].copy(), translation[index].copy(), True)
+        before = after - 1
+        span = float(times[after] - times[before])
+        share = (time_ns - float(times[before])) / span if span > 0 else 1.0
+        relative = rotation[before].T @ rotation[after]
+        blended = rotation[before] @ _rotation_power(relative, share)
+        return CameraMatrix(blended, translation[before] + share * (translation[after] - translation[before]), True)
+
+    def _arrays(self, camera: str) -> tuple[np.ndarray, np.ndarray]:
+        if camera == "top":
+            return self.top_rotation, self.top_translation
+        if camera == "bottom":
+            return self.bottom_rotation, self.bottom_translation
+        raise ValueError(f"camera is 'top' or 'bottom', not {camera!r}")
+
+
+def _rotation_power(rotation: np.ndarray, share: float) -> np.ndarray:
+    """``rotation`` raised to ``share`` (0: identity, 1: itself), through its axis and angle."""
+    cosine = max(-1.0, min(1.0, (float(np.trace(rotation)) - 1.0) / 2.0))
+    angle = float(np.arccos(cosine))
+    if angle < 1e-9:
+        return np.eye(3)
+    axis = np.array([rotation[2, 1] - rotation[1, 2], rotation[0, 2] - rotation[2, 0], rotation[1, 0] - rotation[0, 1]])
+    axis /= 2.0 * np.sin(angle)
+    x, y, z = axis
+    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    theta = share * angle
+    return np.eye(3) + np.sin(theta) * k + (1.0 - np.cos(theta)) * (k @ k)
+
+
 @representation
 class TorsoPose:
     """The torso's pose in the robot frame: ``rotation`` (3x3) and ``translation`` (mm); the

@@ -34,6 +34,8 @@ class CameraImage:
     image: np.ndarray = array((240, 320, 3), np.uint8)
     horizontal_fov: float = 0.0
     vertical_fov: float = 0.0
+    #: when the image was taken, on the program's clock (ns); later than that it reaches cognition
+    time_ns: int = 0
 
 
 @representation
@@ -49,7 +51,7 @@ class CameraImageBottom(CameraImage):
 @dataclass
 class BallCandidate:
     """A round orange blob in one image: centre and radius (px), and the share of its enclosing circle
-    that is orange; with the image's size (px) and field of view (rad) to turn it into a ray."""
+    that is orange; with the image's size (px), field of view (rad) and time to turn it into a ray."""
 
     camera: str = ""
     x: float = 0.0
@@ -60,6 +62,8 @@ class BallCandidate:
     image_height: int = 0
     horizontal_fov: float = 0.0
     vertical_fov: float = 0.0
+    #: when the image was taken (ns, program clock): the camera matrix of that instant places it
+    time_ns: int = 0
 
 
 @representation

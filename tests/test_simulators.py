@@ -20,7 +20,7 @@ from tafel.modules.motion.camera_matrix_provider import CameraMatrixProvider
 from tafel.modules.perception.ball_detector import BallDetector
 from tafel.modules.perception.ball_locator import BallLocator
 from tafel.representations.modeling import BallModel
-from tafel.representations.motion import HEAD_YAW, CameraMatrixBottom, CameraMatrixTop, InertialModel, InertialSensorData, JointSensorData
+from tafel.representations.motion import HEAD_YAW, CameraMatrixBottom, CameraMatrixBuffer, CameraMatrixTop, InertialModel, InertialSensorData, JointSensorData
 from tafel.representations.perception import BallCandidate, BallImagePercept, BallPercept, CameraImageBottom, CameraImageTop
 from tests.support.simulation import Simulation
 from tests.test_cli_runtime import REPO, frames, tafel
@@ -112,7 +112,8 @@ def test_detector_finds_the_ball_in_rendered_images(engine: str, ball: tuple[flo
         matrices = ModuleHarness(CameraMatrixProvider, motion[JointSensorData], InertialModel(roll=motion[InertialSensorData].angles[0],
                                                                                                  pitch=motion[InertialSensorData].angles[1])).execute()
         candidates = ModuleHarness(BallDetector, cognition[CameraImageTop], cognition[CameraImageBottom]).execute()[BallImagePercept]
-        percept = ModuleHarness(BallLocator, candidates, matrices[CameraMatrixTop], matrices[CameraMatrixBottom]).execute()[BallPercept]
+        buffer = CameraMatrixBuffer.of(matrices[CameraMatrixTop], matrices[CameraMatrixBottom])
+        percept = ModuleHarness(BallLocator, candidates, buffer).execute()[BallPercept]
         truth = sim.platform.ball_in_robot_frame()
         assert percept.seen and percept.camera == camera
         distance = math.hypot(*truth)
@@ -142,9 +143,9 @@ def test_locator_rejects_a_ball_whose_size_does_not_fit_its_distance() -> None:
     matrix.rotation = np.array([[math.cos(0.3), 0, math.sin(0.3)], [0, 1, 0], [-math.sin(0.3), 0, math.cos(0.3)]])
     fov = (math.radians(56.3), math.radians(43.7))
     huge = BallCandidate("top", 160.0, 150.0, 60.0, 0.9, 320, 240, *fov)  # at about 1.4 m a ball is ~17 px
-    assert not ModuleHarness(BallLocator, BallImagePercept([huge]), matrix).execute()[BallPercept].seen
+    assert not ModuleHarness(BallLocator, BallImagePercept([huge]), CameraMatrixBuffer.of(matrix, matrix)).execute()[BallPercept].seen
     fitting = BallCandidate("top", 160.0, 150.0, 17.0, 0.9, 320, 240, *fov)
-    assert ModuleHarness(BallLocator, BallImagePercept([fitting]), matrix).execute()[BallPercept].seen
+    assert ModuleHarness(BallLocator, BallImagePercept([fitting]), CameraMatrixBuffer.of(matrix, matrix)).execute()[BallPercept].seen
 
 
 def test_images_have_the_published_field_of_view(sim: Simulation) -> None:

@@ -59,7 +59,7 @@ def test_modules_that_need_more_than_an_image_are_pruned_with_a_report(video: Pa
     result = tafel("run", "--platform", "video", "--source", str(video), "--fps", "200", "--no-debug")
     assert result.returncode == 0, result.stderr
     assert "motion: not running: the platform provides nothing to it" in result.stderr
-    assert "cognition: BallLocator disabled: nothing provides CameraMatrixTop, CameraMatrixBottom" in result.stderr
+    assert "cognition: BallLocator disabled: nothing provides CameraMatrixBuffer" in result.stderr
     assert "cognition: KalmanBallModeler disabled: nothing provides BallPercept" in result.stderr
     assert "Traceback" not in result.stderr
     strict = tafel("run", "--platform", "video", "--source", str(video), "--strict", "--no-debug")

@@ -45,6 +45,7 @@ class BallDetector(Module):
                 candidates = self.candidates(camera, pixels)
             for candidate in candidates:
                 candidate.horizontal_fov, candidate.vertical_fov = image.horizontal_fov, image.vertical_fov
+                candidate.time_ns = image.time_ns
                 if DRAW_CANDIDATES:
                     drawing(f"image:{camera}").circle(candidate.x, candidate.y, candidate.radius, color="orange")
             found += candidates
