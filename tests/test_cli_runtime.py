@@ -95,7 +95,7 @@ def test_modules_shows_order_providers_and_hand_overs() -> None:
     result = tafel("modules", "--platform", "dummy")
     assert result.returncode == 0, result.stderr
     out = result.stdout
-    assert "order: InertialFilter -> CameraMatrixProvider -> StandMotion -> HeadMotion -> MotionCombinator" in out
+    assert "order: InertialFilter -> CameraMatrixProvider -> CameraMatrixBufferProvider -> StandMotion -> HeadMotion -> MotionCombinator" in out
     assert "provider BallModel: KalmanBallModeler (alternatives: SimpleBallModeler)" in out
     assert "hand-over in: HeadMotionRequest from cognition" in out
     assert "hand-over out: HeadMotionRequest to motion" in out
@@ -117,6 +117,7 @@ def test_module_exceptions_are_counted_and_the_loop_goes_on() -> None:
     assert "deliberate failure in frame 1" in result.stderr and "Traceback" in result.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("concurrent", [False, True])
 def test_sigint_and_sigterm_shut_down_cleanly(concurrent: bool) -> None:
     args = [*TAFEL, "run", "--platform", "dummy", "--no-debug", "--status-interval", "0.3"] + (["--concurrent"] if concurrent else [])
@@ -155,6 +156,7 @@ def summary_value(output: str, name: str) -> int:
     return int(match.group(1))
 
 
+@pytest.mark.slow
 def test_motion_keeps_running_when_cognition_crashes() -> None:
     result = run_concurrent_fault("CrashCognitionProcess", "0", 400)
     assert result.returncode == 0, result.stderr
@@ -163,6 +165,7 @@ def test_motion_keeps_running_when_cognition_crashes() -> None:
     assert summary_value(result.stdout, "frames_without_cognition") > 0
 
 
+@pytest.mark.slow
 def test_motion_sees_a_stalled_cognition_and_its_return() -> None:
     result = run_concurrent_fault("StallCognition", "2.0", 500)
     assert result.returncode == 0, result.stderr
@@ -173,6 +176,7 @@ def test_motion_sees_a_stalled_cognition_and_its_return() -> None:
     assert frames(result.stdout)["cognition"] > 20
 
 
+@pytest.mark.slow
 def test_a_stuck_module_cannot_keep_the_program_from_stopping() -> None:
     process = subprocess.Popen(
         [*TAFEL, "run", "--platform", "dummy", "--no-debug", "--set", "runtime.shutdown_grace_s=1",

@@ -96,6 +96,7 @@ def test_the_provider_waits_for_valid_matrices_and_starts_over_when_time_goes_ba
     assert buffer.count == 1 and buffer.time_ns[0] == 5
 
 
+@pytest.mark.slow
 def test_simulated_images_are_taken_camera_latency_before_they_arrive() -> None:
     sim = Simulation("mujoco", camera_latency_ms=40, cameras="on")
     try:
@@ -121,6 +122,7 @@ def test_camera_latency_option_is_checked() -> None:
     assert bad.returncode == 2 and "--camera-latency-ms takes 0 to 1000 ms" in bad.stderr
 
 
+@pytest.mark.slow
 def test_every_process_of_a_concurrent_program_shares_one_origin(tmp_path: Path) -> None:
     """Processes adopt the supervisor's origin: with it set 1000 s back, every frame time is past 1000 s."""
     from tafel.core.config import load_config

@@ -149,6 +149,7 @@ def test_truncated_files_yield_what_was_complete_and_name_the_position(recorded:
     assert "Traceback" not in result.stderr + result.stdout
 
 
+@pytest.mark.slow
 def test_sigkill_while_recording_loses_at_most_the_last_second(tmp_path: Path) -> None:
     path = tmp_path / "killed.mcap"
     process = subprocess.Popen([sys.executable, "-m", "tafel.tools.cli", "run", "--platform", "dummy", "--no-debug", "--record", str(path), "--status-interval", "0.5"],
@@ -242,6 +243,7 @@ def test_stepping_the_replay(recorded: Path) -> None:
         LogPlatform({})
 
 
+@pytest.mark.slow
 def test_concurrent_runs_record_into_one_file(tmp_path: Path) -> None:
     path = tmp_path / "concurrent.mcap"
     result = dummy("--concurrent", "--frames", "150", "--record", str(path))
@@ -249,3 +251,46 @@ def test_concurrent_runs_record_into_one_file(tmp_path: Path) -> None:
     contents = read_log(path)
     assert contents.complete
     assert len(contents.frames("motion")) == 150 and len(contents.frames("cognition")) >= 30
+
+
+def test_good_magic_and_garbage_after_is_an_error_naming_file_and_byte(tmp_path: Path) -> None:
+    garbage = tmp_path / "garbage.mcap"
+    garbage.write_bytes(b"\x89MCAP0\r\n" + bytes(range(200, 256)) * 40)
+    for command in (("log", "info", str(garbage)), ("log", "export", str(garbage), "--rep", "BallModel", "--format", "csv",
+                                                     "--out", str(tmp_path / "x.csv"))):
+        result = tafel(*command)
+        assert result.returncode == 1, result.stdout
+        assert "garbage.mcap" in result.stderr and re.search(r"at byte \d+", result.stderr), result.stderr
+        assert "Traceback" not in result.stderr
+    replay = tafel("run", "--platform", "log", "--log", str(garbage), "--no-debug")
+    assert replay.returncode != 0 and "garbage.mcap" in replay.stderr and "Traceback" not in replay.stderr
+
+
+def test_a_damaged_chunk_in_the_middle_is_skipped_and_the_rest_is_read(recorded: Path, tmp_path: Path) -> None:
+    from tafel.core.logfile import LogReader
+
+    with LogReader(recorded) as reader:
+        chunks = list(reader.chunks)
+        total = sum(1 for _ in reader.messages())
+    assert len(chunks) >= 4, "the recording should have several chunks (at most 1 s of log time each)"
+    victim = chunks[len(chunks) // 2]
+    data = bytearray(recorded.read_bytes())
+    data[victim.offset + 60] ^= 0x10  # one flipped bit inside the compressed records
+    damaged = tmp_path / "damaged.mcap"
+    damaged.write_bytes(bytes(data))
+    with LogReader(damaged) as reader:
+        survived = sum(1 for _ in reader.messages())
+        assert reader.problems and f"chunk at byte {victim.offset} is damaged" in reader.problems[0]
+    assert total * 0.6 < survived < total
+    info = tafel("log", "info", str(damaged))
+    assert info.returncode == 0 and "damaged" in info.stdout
+    replay = tafel("run", "--platform", "log", "--log", str(damaged), "--no-debug", "--speed", "max")
+    assert replay.returncode == 0, replay.stderr
+
+
+def test_chunks_hold_at_most_one_second_of_log_time_at_any_speed(recorded: Path) -> None:
+    from tafel.core.logfile import CHUNK_SPAN_NS, LogReader
+
+    with LogReader(recorded) as reader:  # recorded at --speed max: 6 s of log time in well under a second
+        spans = [c.end_ns - c.start_ns for c in reader.chunks]
+    assert len(spans) >= 6 and max(spans) < CHUNK_SPAN_NS

@@ -39,6 +39,7 @@ def finished(fake: FakeLola) -> None:
     fake.close()
 
 
+@pytest.mark.slow
 def test_every_packet_gets_exactly_one_well_formed_answer(lola: FakeLola, tmp_path: Path) -> None:
     log = tmp_path / "nao.mcap"
     result = run_nao(lola.path, "--frames", "200", "--record", str(log),
@@ -63,6 +64,7 @@ def test_every_packet_gets_exactly_one_well_formed_answer(lola: FakeLola, tmp_pa
     assert battery.charge == pytest.approx(0.9) and battery.current == pytest.approx(-1.2)
 
 
+@pytest.mark.slow
 def test_motion_falls_back_to_a_safe_motion_when_cognition_dies(lola: FakeLola) -> None:
     result = run_nao(lola.path, "--frames", "400", "--set", "parameters.CrashCognitionProcess.after_frames=60",
                      modules=f'["{LOOK_LEFT}", "tests.support.runtime_faults:CrashCognitionProcess"]')
@@ -77,6 +79,7 @@ def test_motion_falls_back_to_a_safe_motion_when_cognition_dies(lola: FakeLola) 
     assert lola.sent - len(lola.answers) in (0, 1)
 
 
+@pytest.mark.slow
 def test_the_program_ends_with_a_crouch_that_goes_limp(lola: FakeLola) -> None:
     result = run_nao(lola.path, "--frames", "100")
     finished(lola)
@@ -89,6 +92,7 @@ def test_the_program_ends_with_a_crouch_that_goes_limp(lola: FakeLola) -> None:
     assert stiffness[0] > 0.5 and all(a >= b - 1e-6 for a, b in zip(stiffness[len(stiffness) // 2 :], stiffness[len(stiffness) // 2 + 1 :]))
 
 
+@pytest.mark.slow
 def test_malformed_packets_give_a_clear_error_and_a_safe_stop(tmp_path: Path) -> None:
     fake = FakeLola(tmp_path / "robocup", garbage_after=50)
     try:
@@ -108,6 +112,7 @@ def test_a_missing_socket_is_a_clear_error(tmp_path: Path) -> None:
     assert "Traceback" not in result.stderr
 
 
+@pytest.mark.slow
 def test_missing_cameras_are_a_clear_error(lola: FakeLola) -> None:
     command = [sys.executable, "-m", "tafel.tools.cli", "run", "--platform", "nao", "--lola", str(lola.path), "--no-debug",
                "--camera-top", "/dev/no-such-camera"]

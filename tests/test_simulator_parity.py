@@ -30,6 +30,7 @@ def bullet_joints(platform: PybulletPlatform) -> dict[str, tuple]:
     return {info[1].decode(): info for info in infos}
 
 
+@pytest.mark.slow
 def test_joint_names_and_limits_agree(engines) -> None:
     mujoco_platform, bullet_platform = engines
     model = mujoco_platform.model
@@ -40,6 +41,7 @@ def test_joint_names_and_limits_agree(engines) -> None:
         assert bullet[name] == pytest.approx((low, high), abs=1e-5), name
 
 
+@pytest.mark.slow
 def test_link_masses_agree(engines) -> None:
     mujoco_platform, bullet_platform = engines
     joints = bullet_joints(bullet_platform)
@@ -51,6 +53,7 @@ def test_link_masses_agree(engines) -> None:
     assert mujoco_platform.model.body("torso").mass[0] == pytest.approx(TORSO_MASS)
 
 
+@pytest.mark.slow
 def test_camera_poses_and_field_of_view_agree(engines) -> None:
     mujoco_platform, bullet_platform = engines
     import mujoco
@@ -72,6 +75,7 @@ def test_camera_poses_and_field_of_view_agree(engines) -> None:
     assert mujoco_platform.fov() == bullet_platform.fov()
 
 
+@pytest.mark.slow
 def test_both_renderings_show_the_ball_at_the_same_pixel(engines) -> None:
     images = [platform.render("top") for platform in engines]
     detector = BallDetector.__new__(BallDetector)

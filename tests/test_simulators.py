@@ -46,6 +46,7 @@ def simulation(engine: str, **options: str) -> Simulation:
     return Simulation(engine, **options)
 
 
+@pytest.mark.slow
 def test_the_robot_stands_for_20_seconds(engine: str) -> None:
     sim = simulation(engine, cameras="off")
     try:
@@ -77,6 +78,7 @@ def model_distance_error(sim: Simulation) -> float:
     return abs(math.hypot(model.x, model.y) - math.hypot(x, y)) / math.hypot(x, y)
 
 
+@pytest.mark.slow
 def test_the_head_tracks_the_ball_and_follows_when_it_moves(engine: str) -> None:
     sim = simulation(engine, ball="1500,500")
     try:
@@ -101,6 +103,7 @@ def _tracks(sim: Simulation) -> None:
     ("ball", "camera"),
     [((700.0, 0.0), "top"), ((1500.0, 400.0), "top"), ((2500.0, -500.0), "top"), ((250.0, 60.0), "bottom")],
 )
+@pytest.mark.slow
 def test_detector_finds_the_ball_in_rendered_images(engine: str, ball: tuple[float, float], camera: str) -> None:
     sim = simulation(engine, ball=f"{ball[0]},{ball[1]}")
     try:
@@ -123,6 +126,7 @@ def test_detector_finds_the_ball_in_rendered_images(engine: str, ball: tuple[flo
         sim.close()
 
 
+@pytest.mark.slow
 def test_no_ball_in_view_no_percept(sim: Simulation) -> None:
     sim.platform.move_ball(-2000, 0)  # behind the robot
     sim.run(0.5)
@@ -148,6 +152,7 @@ def test_locator_rejects_a_ball_whose_size_does_not_fit_its_distance() -> None:
     assert ModuleHarness(BallLocator, BallImagePercept([fitting]), CameraMatrixBuffer.of(matrix, matrix)).execute()[BallPercept].seen
 
 
+@pytest.mark.slow
 def test_images_have_the_published_field_of_view(sim: Simulation) -> None:
     sim.run(0.1)
     image = sim.blackboard("cognition")[CameraImageTop]
@@ -157,6 +162,7 @@ def test_images_have_the_published_field_of_view(sim: Simulation) -> None:
     assert image.image.std() > 5  # something was rendered
 
 
+@pytest.mark.slow
 def test_sensors_have_the_projects_units(sim: Simulation) -> None:
     sim.run(2.0)
     motion = sim.blackboard("motion")
@@ -167,6 +173,7 @@ def test_sensors_have_the_projects_units(sim: Simulation) -> None:
     assert total_kg == pytest.approx(5.36, rel=0.15)  # the robot's weight on its soles
 
 
+@pytest.mark.slow
 def test_debug_commands_move_things_and_pause_physics(sim: Simulation) -> None:
     commands = sim.platform.commands()
     assert commands["sim:move_ball"][1]({"x": "2000", "y": "-300"}) == "ball at x=2000 y=-300 mm"
@@ -182,6 +189,7 @@ def test_debug_commands_move_things_and_pause_physics(sim: Simulation) -> None:
     assert "ball x=2000" in commands["sim:status"][1]({})
 
 
+@pytest.mark.slow
 def test_runs_are_deterministic(engine: str) -> None:
     runs = [tafel("run", "--platform", engine, "--no-debug", "--frames", "150", "--speed", "max") for _ in range(2)]
     assert runs[0].returncode == 0, runs[0].stderr
@@ -189,6 +197,7 @@ def test_runs_are_deterministic(engine: str) -> None:
     assert frames(runs[0].stdout) == {"cognition": 45, "motion": 150}
 
 
+@pytest.mark.slow
 def test_tafel_run_without_arguments_runs_the_simulator_with_the_debug_server() -> None:
     process = subprocess.Popen([sys.executable, "-m", "tafel.tools.cli", "run", "--seconds", "3", "--status-interval", "1"],
                                cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
@@ -200,6 +209,7 @@ def test_tafel_run_without_arguments_runs_the_simulator_with_the_debug_server() 
     assert re.search(r"ball seen at x=\d+ y=\d+ mm", err), err
 
 
+@pytest.mark.slow
 def test_viewer_without_a_display_says_so_and_runs_headless(engine: str) -> None:
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
     result = subprocess.run([sys.executable, "-m", "tafel.tools.cli", "run", "--platform", engine, "--viewer", "--frames", "20", "--speed", "max", "--no-debug"],
@@ -213,6 +223,7 @@ def test_concurrent_is_refused_with_a_reason(engine: str) -> None:
     assert result.returncode == 1 and "run it without --concurrent" in result.stderr
 
 
+@pytest.mark.slow
 def test_debug_commands_reach_the_platform_through_the_server(engine: str) -> None:
     from tests.test_debug_server import Program
 

@@ -66,6 +66,7 @@ def test_modules_that_need_more_than_an_image_are_pruned_with_a_report(video: Pa
     assert strict.returncode == 2 and "cannot feed these modules (--strict)" in strict.stderr
 
 
+@pytest.mark.slow
 def test_the_file_plays_at_its_own_rate_and_loops(video: Path) -> None:
     modules = tafel("modules", "--platform", "video", "--source", str(video))
     assert "cognition (25 Hz)" in modules.stdout  # the file's frame rate
