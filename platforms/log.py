@@ -12,10 +12,13 @@ from __future__ import annotations
 import argparse
 import logging
 import threading
+from array import array
 from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
 
 from tafel.core.errors import TafelError
 from tafel.core.logfile import LogReader
@@ -70,16 +73,17 @@ class LogPlatform(Platform):
             for context, names in topics.items()
         }
         self.consumes = {}  # type: ignore[misc]
-        self.timeline = self._timeline()
-        if not self.timeline:
+        self._index()
+        if not self.steps:
             raise PlatformError(f"{path} holds no sensor data to replay"
                                 + (f" ({'; '.join(self.reader.problems)})" if self.reader.problems else ""))
-        self.position = 0  # index into the timeline of the next step
+        self.position = 0  # the next step
         self.paused = False
         self.steps_left: int | None = None  # frames to run before pausing again (stepping)
         self._pending: dict[str, _Frame] = {}
         self._lock = threading.Lock()
-        self._by_context = {c: [f for step in self.timeline for f in step if f.context == c] for c in self.provides}
+        codes = {name: code for code, name in self._context_names.items()}
+        self._by_context = {c: np.flatnonzero(self.frame_context == codes[c]) for c in self.provides}
         self._cursors: dict[str, int] = {}
         self._cache: OrderedDict[int, dict[tuple[str, int], dict[str, bytes]]] = OrderedDict()
 
@@ -129,28 +133,50 @@ class LogPlatform(Platform):
             classes[topic] = cls
         return classes
 
-    def _timeline(self) -> list[list[_Frame]]:
-        """Steps in recorded order: the frames of all contexts that share one time.
+    def _index(self) -> None:
+        """Index the frames in one pass over the file: per frame its context, number, time and chunks.
 
-        One pass over the file; only frame numbers, times and chunk numbers are kept, so memory does
-        not grow with the size of what was recorded.
+        The index is a handful of numpy arrays (about 30 bytes a frame), never the messages, so replay
+        memory stays small however long the log is. Frames are ordered by time, motion before
+        cognition at equal times, and grouped into steps: the frames of all contexts that share a time.
         """
-        found: dict[tuple[str, int], tuple[int, set[int]]] = {}
+        contexts, numbers, times, chunks = array("b"), array("q"), array("q"), array("i")
+        codes = {name: CONTEXT_ORDER.index(name) if name in CONTEXT_ORDER else len(CONTEXT_ORDER) for name in self.provides}
+        self._context_names = {code: name for name, code in codes.items()}
+        topic_codes = {topic: codes[self.reader.channels[topic].context] for topic in self.classes}
         for number, messages in self.reader.iter_chunks():
             for message in messages:
-                if message.topic in self.classes:
-                    key = (self.reader.channels[message.topic].context, message.sequence)
-                    time_ns, chunks = found.setdefault(key, (message.time_ns, set()))
-                    chunks.add(number)
-        frames = [_Frame(context, sequence, time_ns, tuple(sorted(chunks))) for (context, sequence), (time_ns, chunks) in found.items()]
-        frames.sort(key=lambda f: (f.time_ns, CONTEXT_ORDER.index(f.context) if f.context in CONTEXT_ORDER else 9, f.number))
-        steps: list[list[_Frame]] = []
-        for frame in frames:
-            if steps and steps[-1][0].time_ns == frame.time_ns and all(f.context != frame.context for f in steps[-1]):
-                steps[-1].append(frame)
-            else:
-                steps.append([frame])
-        return steps
+                code = topic_codes.get(message.topic)
+                if code is not None:
+                    contexts.append(code)
+                    numbers.append(message.sequence)
+                    times.append(message.time_ns)
+                    chunks.append(number)
+        context, number, time_ns, chunk = (np.frombuffer(a, dtype=d) if len(a) else np.zeros(0, d)
+                                           for a, d in ((contexts, np.int8), (numbers, np.int64), (times, np.int64), (chunks, np.int32)))
+        by_frame = np.lexsort((chunk, number, context))  # messages of one frame next to each other
+        context, number, time_ns, chunk = context[by_frame], number[by_frame], time_ns[by_frame], chunk[by_frame]
+        first = np.flatnonzero(np.r_[True, (context[1:] != context[:-1]) | (number[1:] != number[:-1])]) if len(context) else np.zeros(0, np.int64)
+        last_chunk = np.maximum.reduceat(chunk, first) if len(first) else np.zeros(0, np.int32)
+        order = np.lexsort((number[first], context[first], time_ns[first]))
+        self.frame_context = context[first][order]
+        self.frame_number = number[first][order]
+        self.frame_time = time_ns[first][order]
+        self.frame_chunks = np.stack([chunk[first][order], last_chunk[order]], axis=1) if len(first) else np.zeros((0, 2), np.int32)
+        boundary = np.r_[True, (self.frame_time[1:] != self.frame_time[:-1]) | (self.frame_context[1:] == self.frame_context[:-1])]
+        self.step_starts = np.r_[np.flatnonzero(boundary), len(self.frame_time)] if len(self.frame_time) else np.zeros(1, np.int64)
+
+    @property
+    def steps(self) -> int:
+        return len(self.step_starts) - 1
+
+    def _frame(self, index: int) -> _Frame:
+        first, last = (int(c) for c in self.frame_chunks[index])
+        return _Frame(self._context_names[int(self.frame_context[index])], int(self.frame_number[index]),
+                      int(self.frame_time[index]), tuple(range(first, last + 1)))
+
+    def _step_frames(self, step: int) -> list[_Frame]:
+        return [self._frame(i) for i in range(int(self.step_starts[step]), int(self.step_starts[step + 1]))]
 
     def config_layers(self) -> list[str]:
         """The recording platform's layer first, so that replay runs the program that was recorded."""
@@ -170,11 +196,11 @@ class LogPlatform(Platform):
         with self._lock:
             if self.paused:
                 return None
-            if self.position >= len(self.timeline):
+            if self.position >= self.steps:
                 if not self.loop:
                     raise EndOfData(f"end of log {self.path}")
                 self.position = 0
-            step = self.timeline[self.position]
+            step = self._step_frames(self.position)
             self.position += 1
             self._pending = {frame.context: frame for frame in step}
             if self.steps_left is not None:
@@ -216,14 +242,14 @@ class LogPlatform(Platform):
         return frames
 
     def _next_frame_of(self, context: str) -> _Frame:
-        frames = self._by_context.get(context, [])
+        frames = self._by_context.get(context, np.zeros(0, np.int64))
         index = self._cursors.get(context, 0)
         if index >= len(frames):
-            if not self.loop or not frames:
+            if not self.loop or not len(frames):
                 raise EndOfData(f"end of log {self.path}")
             index = 0
         self._cursors[context] = index + 1
-        return frames[index]
+        return self._frame(int(frames[index]))
 
     # ------------------------------------------------------------------------------ stepping
     def play(self) -> None:
@@ -244,26 +270,27 @@ class LogPlatform(Platform):
 
     def goto(self, frame_number: int, context: str = "") -> None:
         """Pause at the step holding ``frame_number`` of the main context (or of ``context``)."""
-        context = context or ("motion" if any(f.context == "motion" for s in self.timeline for f in s) else "cognition")
-        for index, step in enumerate(self.timeline):
-            if any(f.context == context and f.number == frame_number for f in step):
-                with self._lock:
-                    self.position, self.paused, self.steps_left = index, True, None
-                return
-        numbers = [f.number for s in self.timeline for f in s if f.context == context]
-        raise PlatformError(
-            f"the log has no {context} frame {frame_number}; its {context} frames are {min(numbers)}..{max(numbers)}"
-            if numbers else f"the log has no {context} frames"
-        )
+        context = context or ("motion" if "motion" in self._by_context else "cognition")
+        frames = self._by_context.get(context, np.zeros(0, np.int64))
+        numbers = self.frame_number[frames]
+        found = frames[numbers == frame_number]
+        if not len(found):
+            raise PlatformError(
+                f"the log has no {context} frame {frame_number}; its {context} frames are {numbers.min()}..{numbers.max()}"
+                if len(numbers) else f"the log has no {context} frames"
+            )
+        step = int(np.searchsorted(self.step_starts, found[0], side="right")) - 1
+        with self._lock:
+            self.position, self.paused, self.steps_left = step, True, None
 
     def status(self) -> dict[str, Any]:
         with self._lock:
-            current = self.timeline[min(self.position, len(self.timeline)) - 1] if self.position else []
+            current = self._step_frames(min(self.position, self.steps) - 1) if self.position else []
         return {
             "file": self.path,
             "paused": self.paused,
             "step": self.position,
-            "steps": len(self.timeline),
+            "steps": self.steps,
             "frames": {f.context: f.number for f in current},
         }
 
