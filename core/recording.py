@@ -22,7 +22,6 @@ from tafel.core.naming import did_you_mean
 from tafel.core.program import ContextPlan
 from tafel.core.serialization import SerializationError, serialize
 
-
 #: the name that selects every representation of the program
 ALL = "all"
 

@@ -22,8 +22,8 @@ import numpy as np
 
 from tafel.core.errors import TafelError
 from tafel.core.logfile import LogReader
-from tafel.core.naming import did_you_mean
 from tafel.core.manager import Blackboard
+from tafel.core.naming import did_you_mean
 from tafel.core.platform import EndOfData, Platform, PlatformError, PlatformOptionError
 from tafel.core.representation import get_representation
 from tafel.core.serialization import SerializationError, check_compatible, codec

@@ -71,6 +71,21 @@ def crouch_pose() -> np.ndarray:
     return pose
 
 
+def convert_inertial(accelerometer: np.ndarray, gyroscope: np.ndarray, angles: np.ndarray) -> InertialSensorData:
+    """LoLA's IMU values in the project's frame (x forward, y left, z up).
+
+    LoLA's axes are the robot's, but its accelerometer reports the opposite of what an accelerometer
+    measures (gravity itself, -9.81 on z when upright), so all three axes are negated, as B-Human and
+    HULKs do. Two real packets settle it: only with all three negated does the roll computed from the
+    accelerometer have the sign of LoLA's own ``Angles[0]`` (tests/test_nao.py). The gyroscope shares
+    those axes and measures angular velocity with the right-hand rule, so it is taken as it is: a robot
+    turning left (counter-clockwise seen from above) has a positive rate about z, and LoLA's roll and
+    pitch rates match the derivatives of its own ``Angles``. NaoTH negates z for an older convention.
+    """
+    return InertialSensorData(accelerometer=-np.asarray(accelerometer, dtype=float),
+                              gyroscope=np.asarray(gyroscope, dtype=float).copy(), angles=np.asarray(angles, dtype=float).copy())
+
+
 def parse_sensors(packet: Any) -> dict[str, np.ndarray]:
     """The sensor arrays of one LoLA packet, checked: a clear error for anything malformed."""
     if not isinstance(packet, dict):
@@ -239,11 +254,8 @@ class NaoPlatform(Platform):
             self.measured = values["Position"]
             blackboard.set(JointSensorData(position=values["Position"], stiffness=values["Stiffness"],
                                            current=values["Current"], temperature=values["Temperature"]))
-            acc, gyro = values["Accelerometer"], values["Gyroscope"]
-            # LoLA's axes are not right-handed with z up: x and z of the accelerometer and z of the
-            # gyroscope are negated (upright, the accelerometer then reads +9.81 on z, as in the simulators).
-            blackboard.set(InertialSensorData(accelerometer=np.array([-acc[0], acc[1], -acc[2]]),
-                                              gyroscope=np.array([gyro[0], gyro[1], -gyro[2]]), angles=values["Angles"].copy()))
+            inertial = convert_inertial(values["Accelerometer"], values["Gyroscope"], values["Angles"])
+            blackboard.set(inertial)
             blackboard.set(FsrData(pressure=values["FSR"]))
             blackboard.set(TouchSensorData(pressed=values["Touch"]))
             battery = values["Battery"]
@@ -281,6 +293,7 @@ class NaoPlatform(Platform):
                 "Chest": leds.chest.tolist(), "LFoot": leds.left_foot.tolist(), "RFoot": leds.right_foot.tolist(),
                 "LEye": leds.left_eye.tolist(), "REye": leds.right_eye.tolist(),
                 "LEar": leds.left_ear.tolist(), "REar": leds.right_ear.tolist(), "Skull": leds.skull.tolist(),
+                "Sonar": [True, True],  # as most teams send: keeps the sonars measuring
             })
         except OSError as exc:
             if exc.errno in (errno.EPIPE, errno.ECONNRESET):

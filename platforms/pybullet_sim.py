@@ -18,7 +18,7 @@ from tafel.core.platform import PlatformError
 from tafel.platforms.robot_model import BALL_FRICTION, SERVO_TORQUE, STANDING_HEIGHT, FieldPart, field_parts, fsr_sites, urdf
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.motion import JOINT_NAMES
-from tafel.representations.nao import CAMERAS, COUPLED_JOINTS, SOLE_BACK, SOLE_FRONT, VERTICAL_FOV
+from tafel.representations.nao import ACCELEROMETER_POSITION, CAMERAS, COUPLED_JOINTS, SOLE_BACK, SOLE_FRONT, VERTICAL_FOV
 
 POSITION_GAIN = 0.1  # PyBullet's position motors: share of the position error corrected per step
 ROBOT_RGBA = (0.87, 0.87, 0.9, 1.0)
@@ -141,7 +141,11 @@ class PybulletPlatform(SimulatedRobotPlatform):
         self.acceleration = (after - before) / (steps * TIMESTEP)
 
     def _base_velocity(self) -> np.ndarray:
-        return np.array(pybullet.getBaseVelocity(self.robot, physicsClientId=self.client)[0])
+        """Velocity (m/s) of the accelerometer's point: the base's centre of mass plus the turn's share."""
+        linear, angular = pybullet.getBaseVelocity(self.robot, physicsClientId=self.client)
+        _, rotation = self.torso_pose()
+        lever = rotation @ (np.array(ACCELEROMETER_POSITION) * M - self.base_inertial)
+        return np.array(linear) + np.cross(np.array(angular), lever)
 
     def joint_angles(self) -> np.ndarray:
         states = pybullet.getJointStates(self.robot, self.joint_ids, physicsClientId=self.client)

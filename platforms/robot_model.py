@@ -16,14 +16,15 @@ import numpy as np
 
 from tafel.representations import field
 from tafel.representations.nao import (
+    ACCELEROMETER_POSITION,
     CAMERAS,
     COUPLED_JOINTS,
     ELBOW_OFFSET_Y,
     FOOT_HEIGHT,
+    GYROSCOPE_POSITION,
     HAND_OFFSET_X,
     HAND_OFFSET_Z,
     HIP_OFFSET_Z,
-    IMU_POSITION,
     JOINTS,
     LOWER_ARM_LENGTH,
     SOLE_BACK,
@@ -269,7 +270,8 @@ def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002) ->
         '  <freejoint name="root"/>',
         f'  <inertial pos="{_vec(center)}" mass="{TORSO_MASS}" diaginertia="{_vec(diagonal)}"/>',
         "  " + _geom_xml(torso_shapes[0], "torso_geom0"),
-        f'  <site name="imu" pos="{_vec(np.array(IMU_POSITION) * M)}" size="0.005"/>',
+        f'  <site name="accelerometer" pos="{_vec(np.array(ACCELEROMETER_POSITION) * M)}" size="0.005"/>',
+        f'  <site name="gyroscope" pos="{_vec(np.array(GYROSCOPE_POSITION) * M)}" size="0.005"/>',
         *_body_xml("torso", children, "  "),
         "</body>",
     ]
@@ -277,7 +279,7 @@ def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002) ->
     actuators = [f'<position name="{j.name}" joint="{j.name}" kp="{SERVO_GAIN}" kv="0" ctrlrange="{j.limits[0]:.6g} {j.limits[1]:.6g}" '
                  f'forcerange="{-SERVO_TORQUE} {SERVO_TORQUE}"/>' for j in actuated]
     equalities = [f'<joint joint1="{follower}" joint2="{leader}" polycoef="0 1 0 0 0"/>' for follower, leader in COUPLED_JOINTS.items()]
-    sensors = ['<accelerometer name="accelerometer" site="imu"/>', '<gyro name="gyroscope" site="imu"/>']
+    sensors = ['<accelerometer name="accelerometer" site="accelerometer"/>', '<gyro name="gyroscope" site="gyroscope"/>']
     sensors += [f'<touch name="{name}" site="{name}"/>' for side in "LR" for name, _ in fsr_sites(side)]
     width, height = offscreen
     return "\n".join([

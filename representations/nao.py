@@ -28,7 +28,9 @@ FOOT_HEIGHT = 45.19
 
 #: sole outline relative to the ankle (mm): forward, back, inside, outside
 SOLE_FRONT, SOLE_BACK, SOLE_INSIDE, SOLE_OUTSIDE = 100.0, 50.0, 38.77, 50.02
-IMU_POSITION = (-8.0, 6.06, 112.0)
+#: the IMU in the torso frame (mm), as B-Human's NaoV6H25 scene has it (their 112 mm is from the hip)
+ACCELEROMETER_POSITION = (-8.0, 6.06, 27.0)
+GYROSCOPE_POSITION = (-8.0, 6.0, 29.0)
 
 
 @dataclass(frozen=True)
@@ -89,7 +91,7 @@ def _leg(side: str) -> list[Joint]:
     else:
         hip_roll, knee, ankle_pitch, ankle_roll = _deg(-45.29, 21.74), _deg(-5.90, 121.47), _deg(-67.97, 53.40), _deg(-44.06, 22.80)
     return [
-        Joint(f"{side}HipYawPitch", "torso", f"{side}Pelvis", (0.0, s * HIP_OFFSET_Y, -HIP_OFFSET_Z), (0, -_S, -s * _S), _deg(-65.62, 42.44), 0.06981),
+        Joint(f"{side}HipYawPitch", "torso", f"{side}Pelvis", (0.0, s * HIP_OFFSET_Y, -HIP_OFFSET_Z), (0, _S, -s * _S), _deg(-65.62, 42.44), 0.06981),
         Joint(f"{side}HipRoll", f"{side}Pelvis", f"{side}Hip", (0.0, 0.0, 0.0), (1, 0, 0), hip_roll, 0.14053),
         Joint(f"{side}HipPitch", f"{side}Hip", f"{side}Thigh", (0.0, 0.0, 0.0), (0, 1, 0), _deg(-88, 27.73), 0.38968),
         Joint(f"{side}KneePitch", f"{side}Thigh", f"{side}Tibia", (0.0, 0.0, -THIGH_LENGTH), (0, 1, 0), knee, 0.30142),

@@ -16,7 +16,7 @@ from tafel.core.logfile import read_log
 from tafel.core.testing import ModuleHarness
 from tafel.modules.motion.camera_matrix_buffer_provider import CameraMatrixBufferProvider
 from tafel.representations.infrastructure import FrameInfo
-from tafel.representations.motion import CAMERA_MATRIX_HISTORY, CameraMatrix, CameraMatrixBottom, CameraMatrixBuffer, CameraMatrixTop
+from tafel.representations.motion import CAMERA_MATRIX_HISTORY, CameraMatrixBottom, CameraMatrixBuffer, CameraMatrixTop
 from tafel.representations.perception import CameraImageTop
 from tests.support.head_sweep import summary, sweep_errors
 from tests.support.simulation import Simulation

@@ -17,8 +17,16 @@ from tafel.modules.motion.kinematics import (
     rotation,
     sole_in_torso,
 )
+from tafel.platforms.robot_model import mjcf
 from tafel.representations.motion import JOINT_INDEX, CameraMatrixBottom, CameraMatrixTop, InertialModel, JointSensorData, TorsoPose
-from tafel.representations.nao import BOTTOM_CAMERA, TOP_CAMERA, total_mass
+from tafel.representations.nao import (
+    ACCELEROMETER_POSITION,
+    BOTTOM_CAMERA,
+    GYROSCOPE_POSITION,
+    JOINTS_BY_NAME,
+    TOP_CAMERA,
+    total_mass,
+)
 
 LEG = 85.0 + 100.0 + 102.9 + 45.19  # hip offset, thigh, tibia, foot height (mm)
 
@@ -110,3 +118,24 @@ def test_camera_matrix_provider_on_the_mocked_blackboard() -> None:
     assert top.translation[2] == pytest.approx(LEG + 126.5 + 63.64)
     assert math.atan2(top.rotation[1, 0], top.rotation[0, 0]) == pytest.approx(0.2)
     assert bb[TorsoPose].translation[2] == pytest.approx(LEG)
+
+
+@pytest.mark.parametrize(("angle", "left"), [(0.3, (-51.84, 55.54, -327.55)), (-0.5, (84.10, 65.19, -317.90))])
+def test_hip_yaw_pitch_axes_are_the_real_robots(angle: float, left: tuple[float, float, float]) -> None:
+    """Only HipYawPitch turned: the soles where B-Human's, NaoTH's and HULKs' models put them."""
+    poses = link_poses({"LHipYawPitch": angle, "RHipYawPitch": angle})
+    np.testing.assert_allclose(sole_in_torso(poses, "L"), left, atol=0.5)
+    np.testing.assert_allclose(sole_in_torso(poses, "R"), (left[0], -left[1], left[2]), atol=0.5)
+
+
+def test_hip_yaw_pitch_axes_in_the_torso_frame() -> None:
+    s = math.sqrt(0.5)
+    assert JOINTS_BY_NAME["LHipYawPitch"].axis == pytest.approx((0.0, s, -s))
+    assert JOINTS_BY_NAME["RHipYawPitch"].axis == pytest.approx((0.0, s, s))
+
+
+def test_imu_sits_where_the_real_one_does() -> None:
+    assert ACCELEROMETER_POSITION == (-8.0, 6.06, 27.0) and GYROSCOPE_POSITION == (-8.0, 6.0, 29.0)
+    xml = mjcf()
+    assert '<site name="accelerometer" pos="-0.008 0.00606 0.027"' in xml
+    assert '<site name="gyroscope" pos="-0.008 0.006 0.029"' in xml

@@ -15,7 +15,15 @@ from tafel.modules.motion.stand_motion import StandMotion, stand_pose
 from tafel.representations.behavior import HeadMotionRequest
 from tafel.representations.infrastructure import CognitionStatus, FrameInfo
 from tafel.representations.modeling import BallModel
-from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, JOINT_COUNT, BodyJointTargets, HeadJointTargets, JointCommand, JointSensorData
+from tafel.representations.motion import (
+    HEAD_PITCH,
+    HEAD_YAW,
+    JOINT_COUNT,
+    BodyJointTargets,
+    HeadJointTargets,
+    JointCommand,
+    JointSensorData,
+)
 
 TICK_NS = 10_000_000
 

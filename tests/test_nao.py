@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import subprocess
 import sys
@@ -13,9 +14,9 @@ import pytest
 
 from tafel.core.logfile import read_log
 from tafel.core.serialization import deserialize
-from tafel.platforms.nao import CROUCH, LolaProtocolError, crouch_pose, parse_sensors
+from tafel.platforms.nao import CROUCH, LolaProtocolError, convert_inertial, crouch_pose, parse_sensors
 from tafel.representations.motion import JOINT_INDEX, BatteryData, FsrData, InertialSensorData, TouchSensorData
-from tests.support.fake_lola import PACKET_SIZE, FakeLola, sensor_packet
+from tests.support.fake_lola import KEY_ORDER, PACKET_SIZE, FakeLola, sensor_packet
 from tests.test_cli_runtime import REPO
 
 LOOK_LEFT = "tests.support.nao_support:LookLeft"
@@ -57,7 +58,7 @@ def test_every_packet_gets_exactly_one_well_formed_answer(lola: FakeLola, tmp_pa
     contents = read_log(log)
     inertial = deserialize(InertialSensorData, next(m.data for m in contents.messages if m.topic == "motion/InertialSensorData"))
     assert inertial.accelerometer.tolist() == pytest.approx([-0.1, 0.0, 9.81], abs=1e-5)  # upright: +9.81 on z
-    assert inertial.gyroscope[2] == pytest.approx(-0.01, abs=1e-6)
+    assert inertial.gyroscope[2] == pytest.approx(0.01, abs=1e-6)  # LoLA's sign kept
     assert deserialize(FsrData, next(m.data for m in contents.messages if m.topic == "motion/FsrData")).pressure.tolist() == pytest.approx([0.6] * 8)
     assert deserialize(TouchSensorData, next(m.data for m in contents.messages if m.topic == "motion/TouchSensorData")).pressed.shape == (14,)
     battery = deserialize(BatteryData, next(m.data for m in contents.messages if m.topic == "motion/BatteryData"))
@@ -133,3 +134,44 @@ def test_sensor_packets_are_checked() -> None:
     with pytest.raises(LolaProtocolError, match="FSR holds something that is not a number"):
         parse_sensors(dict(good, FSR=["x"] * 8))
     assert set(CROUCH) <= set(JOINT_INDEX)
+
+
+# Two real LoLA packets (shared/reference/robocup.md): nao_lola's parser test, and NaoTH's LolaData.h
+# (a robot sitting and leaning forward). Accelerometer as LoLA sends it, and LoLA's own Angles.
+REAL_PACKETS = [((-3.0656, -0.3928, -9.3214), (0.03758, -0.35991)), ((8.66997, 0.287402, -5.48939), (-0.0239685, 0.990951))]
+
+
+@pytest.mark.parametrize(("accelerometer", "angles"), REAL_PACKETS)
+def test_accelerometer_roll_and_pitch_have_the_signs_of_lolas_own_angles(accelerometer, angles) -> None:
+    inertial = convert_inertial(np.array(accelerometer), np.zeros(3), np.array(angles))
+    ax, ay, az = inertial.accelerometer
+    roll, pitch = math.atan2(ay, az), math.atan2(-ax, math.hypot(ay, az))
+    assert math.copysign(1, roll) == math.copysign(1, angles[0])
+    assert math.copysign(1, pitch) == math.copysign(1, angles[1])
+    assert pitch == pytest.approx(angles[1], abs=0.1)
+
+
+def test_upright_reads_plus_g_on_z_and_the_gyroscope_keeps_lolas_signs() -> None:
+    inertial = convert_inertial(np.array([0.0, 0.0, -9.81]), np.array([0.1, -0.2, 0.3]), np.zeros(2))
+    assert inertial.accelerometer[2] == pytest.approx(9.81)
+    assert list(inertial.gyroscope) == pytest.approx([0.1, -0.2, 0.3])
+
+
+def test_the_fake_lola_sends_real_packets() -> None:
+    import msgpack
+
+    data = sensor_packet([0.0] * 25, [0.0] * 25, 3)
+    assert len(data) == 896
+    packet = msgpack.unpackb(data)
+    assert tuple(packet) == KEY_ORDER  # the real key order
+    assert [len(packet["RobotConfig"][0]), len(packet["RobotConfig"][2])] == [20, 20]
+    assert parse_sensors(packet)["Accelerometer"][2] == pytest.approx(-9.81)
+
+
+@pytest.mark.slow
+def test_answers_carry_sonar_on_and_every_led(lola: FakeLola) -> None:
+    result = run_nao(lola.path, "--frames", "50")
+    finished(lola)
+    assert result.returncode == 0, result.stderr
+    normal = [a for a in lola.answers if "LEye" in a]
+    assert normal and all(a["Sonar"] == [True, True] for a in normal)

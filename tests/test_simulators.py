@@ -20,7 +20,15 @@ from tafel.modules.motion.camera_matrix_provider import CameraMatrixProvider
 from tafel.modules.perception.ball_detector import BallDetector
 from tafel.modules.perception.ball_locator import BallLocator
 from tafel.representations.modeling import BallModel
-from tafel.representations.motion import HEAD_YAW, CameraMatrixBottom, CameraMatrixBuffer, CameraMatrixTop, InertialModel, InertialSensorData, JointSensorData
+from tafel.representations.motion import (
+    HEAD_YAW,
+    CameraMatrixBottom,
+    CameraMatrixBuffer,
+    CameraMatrixTop,
+    InertialModel,
+    InertialSensorData,
+    JointSensorData,
+)
 from tafel.representations.perception import BallCandidate, BallImagePercept, BallPercept, CameraImageBottom, CameraImageTop
 from tests.support.simulation import Simulation
 from tests.test_cli_runtime import REPO, frames, tafel

@@ -15,22 +15,29 @@ PERIOD = 0.012
 PACKET_SIZE = 896
 
 
-def sensor_packet(positions: list[float], stiffness: list[float], index: int) -> bytes:
-    """One well-formed packet of exactly 896 bytes, values as LoLA sends them (float32)."""
-    packet: dict[str, Any] = {
-        "Stiffness": stiffness, "Position": positions, "Temperature": [35.0] * 25, "Current": [0.1] * 25,
-        "Battery": [0.9, 0.0, -1.2, 30.0], "Accelerometer": [0.1, 0.0, -9.81], "Gyroscope": [0.0, 0.0, 0.01],
-        "Angles": [0.0, 0.01], "Sonar": [2.0, 2.0], "FSR": [0.6] * 8, "Touch": [0.0] * 14, "Status": [0] * 25,
-        "RobotConfig": ["", "6.0.0", f"P{index % 10}", "6.0.0"],
+#: the keys of a real read packet, in LoLA's order (NaoTH's LolaData.h)
+KEY_ORDER = ("RobotConfig", "Accelerometer", "Angles", "Battery", "Current", "FSR", "Gyroscope", "Position", "Sonar",
+             "Stiffness", "Temperature", "Touch", "Status")
+BODY_ID, HEAD_ID = "P0000073A07S94700014", "P0000074A05S93J00024"  # 20 characters each, as on a robot
+
+
+def sensor_packet(positions: list[float], stiffness: list[float], index: int, *,
+                  accelerometer: tuple[float, float, float] = (0.1, 0.0, -9.81),
+                  gyroscope: tuple[float, float, float] = (0.0, 0.0, 0.01),
+                  angles: tuple[float, float] = (0.0, 0.01)) -> bytes:
+    """One packet as LoLA sends it: its key order, 20-character IDs, float32 values, exactly 896 bytes.
+
+    The accelerometer is in LoLA's convention (-9.81 on z when upright).
+    """
+    values: dict[str, Any] = {
+        "RobotConfig": [BODY_ID, "6.0.0", HEAD_ID, "6.0.0"],
+        "Accelerometer": list(accelerometer), "Angles": list(angles), "Battery": [0.9, 0.0, -1.2, 30.0],
+        "Current": [0.1] * 25, "FSR": [0.6] * 8, "Gyroscope": list(gyroscope), "Position": list(positions),
+        "Sonar": [2.0, 2.0], "Stiffness": list(stiffness), "Temperature": [35.0] * 25, "Touch": [0.0] * 14,
+        "Status": [index % 2] * 25,
     }
-    packer = msgpack.Packer(use_single_float=True)
-    data = packer.pack(packet)
-    padding = PACKET_SIZE - len(data)
-    packet["RobotConfig"][0] = "B" * padding  # grow the body id until the packet is the real size
-    data = packer.pack(packet)
-    while len(data) != PACKET_SIZE:  # the string's own header grows with its length
-        packet["RobotConfig"][0] = packet["RobotConfig"][0][: len(packet["RobotConfig"][0]) - (len(data) - PACKET_SIZE)]
-        data = packer.pack(packet)
+    data = msgpack.Packer(use_single_float=True).pack({key: values[key] for key in KEY_ORDER})
+    assert len(data) == PACKET_SIZE, f"a LoLA packet is {PACKET_SIZE} bytes, this one {len(data)}"
     return data
 
 
