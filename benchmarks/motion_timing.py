@@ -97,7 +97,7 @@ def run_bare_floor(frames: int) -> dict:
         if now < deadline:
             time.sleep((deadline - now) * 1e-9)
             now = time.monotonic_ns()
-        stats.period_errors_ms.append((now - deadline) / 1e6)
+        stats.period_errors.add((now - deadline) / 1e6)
         stats.frames += 1
         deadline += period
         while deadline < now - period:

@@ -20,7 +20,6 @@ import multiprocessing
 import os
 import pickle
 import signal
-import statistics
 import sys
 import threading
 import time
@@ -36,6 +35,7 @@ from tafel.core.platform import EndOfData, Platform, PlatformError
 from tafel.core.program import ContextPlan
 from tafel.core.recording import QueueSink, Recorder
 from tafel.core.serialization import SerializationError, serialize
+from tafel.core.statistics import PeriodStatistics
 from tafel.core.status import CognitionStatus
 
 log = logging.getLogger("tafel.runtime")
@@ -63,7 +63,8 @@ class ContextStats:
     wall_s: float = 0.0
     module_errors: int = 0
     errors_by_module: dict[str, int] = field(default_factory=dict)
-    period_errors_ms: list[float] = field(default_factory=list)
+    #: period errors (ms) in bounded memory: reporting costs the same at any uptime
+    period_errors: PeriodStatistics = field(default_factory=PeriodStatistics)
     missed_periods: int = 0
     realtime: str = ""
     frames_without_cognition: int = 0
@@ -77,14 +78,7 @@ class ContextStats:
         return self.frames / self.wall_s if self.wall_s > 0 else 0.0
 
     def period_error_percentiles(self) -> dict[str, float]:
-        errors = sorted(self.period_errors_ms)
-        if not errors:
-            return {"p50_ms": 0.0, "p99_ms": 0.0, "max_ms": 0.0}
-        return {
-            "p50_ms": statistics.median(errors),
-            "p99_ms": errors[min(len(errors) - 1, int(round(0.99 * (len(errors) - 1))))],
-            "max_ms": errors[-1],
-        }
+        return self.period_errors.percentiles()
 
 
 def recorder_hook(recorder: Recorder) -> Callable[[ContextRunner], None]:
@@ -466,7 +460,7 @@ def run_context_loop(
                 if now < deadline:
                     runner.idle((deadline - now) * 1e-9)
                     now = time.monotonic_ns()
-                stats.period_errors_ms.append((now - deadline) / 1e6)
+                stats.period_errors.add((now - deadline) / 1e6)
                 deadline += period_ns
                 while deadline < now - period_ns:  # a whole period lost: skip it, keep the beat
                     deadline += period_ns
@@ -496,7 +490,7 @@ def run_context_loop(
 
 def _snapshot_stats(runner: ContextRunner, stats: ContextStats, start_ns: int) -> ContextStats:
     own = runner.stats((time.monotonic_ns() - start_ns) * 1e-9)
-    own.period_errors_ms = list(stats.period_errors_ms)
+    own.period_errors = stats.period_errors.copy()
     own.missed_periods = stats.missed_periods
     own.realtime = stats.realtime
     own.frames_without_cognition = stats.frames_without_cognition

@@ -197,7 +197,7 @@ def print_summary(platform: str, mode: str, stats: dict[str, ContextStats], wall
         if s.failure:
             line += f", FAILED: {s.failure}"
         print(line)
-        if s.period_errors_ms:
+        if s.period_errors:
             timing = s.period_error_percentiles()
             print(f"    timing: period error p50 {timing['p50_ms']:.2f} ms, p99 {timing['p99_ms']:.2f} ms, "
                   f"max {timing['max_ms']:.2f} ms, missed_periods={s.missed_periods}"
