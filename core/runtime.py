@@ -192,8 +192,11 @@ def install_signal_handlers(stop: Any, on_force: Callable[[], None] | None = Non
     dump says what held it.
     """
 
+    received: list[int] = []  # signals, counted on their own: a stop the program began itself is not one
+
     def handle(signum: int, _frame: Any) -> None:
-        if stop.is_set():
+        received.append(signum)
+        if len(received) > 1:
             if on_force is not None:
                 on_force()
             raise KeyboardInterrupt
@@ -498,10 +501,44 @@ def _snapshot_stats(runner: ContextRunner, stats: ContextStats, start_ns: int) -
     return own
 
 
+#: signal the supervisor sends a context process that does not stop in time: dump every stack
+DUMP_SIGNAL = signal.SIGUSR1
+
+
+def _watch_parent(stop: Any, parent: int) -> None:
+    """End this process when the supervisor is gone (killed with SIGKILL, say): first the clean stop,
+    then, if a module is stuck, for good. Linux also sends SIGTERM at once (PR_SET_PDEATHSIG)."""
+    _die_with_parent()
+    while os.getppid() == parent:
+        time.sleep(0.2)
+    stop.set()
+    time.sleep(PARENT_GONE_GRACE_S)
+    faulthandler.dump_traceback(all_threads=True)
+    os._exit(3)
+
+
+#: s a context process whose supervisor died gets for its clean stop before it ends itself
+PARENT_GONE_GRACE_S = 1.5
+
+
+def _die_with_parent() -> None:
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass  # not Linux: the polling in _watch_parent does the job
+
+
 def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
     """Entry point of a context process."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the supervisor decides when to stop
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    faulthandler.register(DUMP_SIGNAL, all_threads=True)
+    threading.Thread(target=_watch_parent, args=(stop, os.getppid()), name="tafel-parent-watch", daemon=True).start()
+    if spec.record_queue is not None:
+        spec.record_queue.cancel_join_thread()  # never wait at exit for a supervisor that no longer reads
     clock.set_origin(spec.clock_origin_ns)
     logging.basicConfig(level=logging.WARNING, format=f"[{spec.plan.name}] %(levelname)s %(message)s")
     realtime = try_realtime(spec.realtime_priority) if spec.plan.name == "motion" else ""
@@ -571,8 +608,11 @@ class ConcurrentRuntime:
     def __init__(self, plans: Mapping[str, ContextPlan], platform_class: type[Platform],
                  platform_options: Mapping[str, Any], *, strict: bool = False, stall_timeout_s: float = 1.0,
                  recorder: Recorder | None = None,
-                 worker_setup: tuple[Callable[[ContextRunner, Any], None], Any] | None = None) -> None:
+                 worker_setup: tuple[Callable[[ContextRunner, Any], None], Any] | None = None,
+                 grace_s: float = SHUTDOWN_GRACE_S) -> None:
         self.recorder = recorder
+        #: s the context processes get to stop once asked; then their stacks are dumped and they are ended
+        self.grace_s = grace_s
         self.worker_setup = worker_setup
         self.plans = {name: plan for name, plan in plans.items() if plan.runs}
         if not self.plans:
@@ -599,6 +639,7 @@ class ConcurrentRuntime:
             if recorder.recording:
                 self.record_switch.set()
         self.processes: dict[str, Any] = {}
+        self._stopping_since: float | None = None
 
     def run(self, limits: Limits) -> dict[str, ContextStats]:
         channels = {name: SharedChannel() for name in self.plans}
@@ -628,11 +669,8 @@ class ConcurrentRuntime:
             self._supervise(connections)
         finally:
             self.stop.set()
-            for process in self.processes.values():
-                process.join(timeout=5)
-                if process.is_alive():
-                    process.kill()
-                    process.join(timeout=2)
+            since = self._stopping_since
+            self._end_processes(self.grace_s if since is None else max(0.0, self.grace_s - (time.monotonic() - since)))
             for channel in channels.values():
                 channel.close()
             if drain is not None and record_queue is not None:
@@ -681,3 +719,31 @@ class ConcurrentRuntime:
                 break
             if not self.processes[self.main].is_alive() and self.main in reported_dead:
                 self.stop.set()
+            if self.stop.is_set():
+                self._stopping_since = self._stopping_since or time.monotonic()
+                if time.monotonic() - self._stopping_since > self.grace_s:
+                    break  # a context that does not stop in time: run() ends it
+
+    def _end_processes(self, grace_s: float) -> None:
+        """Every process this runtime started ends: asked to stop, given the grace period, then its
+        stacks are dumped (SIGUSR1) and it is terminated, and killed if even that does not help."""
+        deadline = time.monotonic() + grace_s
+        for process in self.processes.values():
+            process.join(timeout=max(0.0, deadline - time.monotonic()))
+        for name, process in self.processes.items():
+            if not process.is_alive():
+                continue
+            message = f"{name} process did not stop within {self.grace_s:g} s; its stacks follow, then it is ended"
+            self.notices.append(message)
+            self.stats[name].failure = self.stats[name].failure or f"did not stop within {self.grace_s:g} s (stuck?)"
+            print(f"tafel: {message}", file=sys.stderr, flush=True)
+            try:
+                os.kill(process.pid, DUMP_SIGNAL)
+                time.sleep(0.3)
+            except ProcessLookupError:
+                continue
+            process.terminate()
+            process.join(timeout=1.0)
+            if process.is_alive():
+                process.kill()
+                process.join(timeout=2.0)

@@ -189,3 +189,73 @@ def test_a_stuck_module_cannot_keep_the_program_from_stopping() -> None:
     assert process.returncode != 0
     assert "every thread's stack is dumped" in err
     assert "StuckForever" not in out and "runtime_faults.py" in err  # the dump shows where it was stuck
+
+
+def child_pids(pid: int) -> list[int]:
+    """Processes whose parent is ``pid`` (from /proc)."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if int(fields[1]) == pid:
+                found.append(int(entry.name))
+    return found
+
+
+def cmdline(pid: int) -> str:
+    try:
+        return Path(f"/proc/{pid}/cmdline").read_text()
+    except OSError:
+        return ""
+
+
+def alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+@pytest.mark.slow
+def test_concurrent_stop_with_a_stuck_cognition_ends_every_process_after_the_grace_period() -> None:
+    process = subprocess.Popen(
+        [*TAFEL, "run", "--platform", "dummy", "--concurrent", "--frames", "150", "--no-debug", "--set", "runtime.shutdown_grace_s=2",
+         "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "tests.support.runtime_faults:StuckForever"]'],
+        cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(REPO)},
+    )
+    time.sleep(1.0)
+    children = child_pids(process.pid)
+    out, err = process.communicate(timeout=40)  # before the fix: a hang until killed
+    assert process.returncode == 1, err
+    assert "cognition process did not stop within 2 s" in err
+    assert "runtime_faults.py" in err  # the stuck process's stacks were dumped
+    assert "motion: 150 frames" in out
+    assert children and not [pid for pid in children if alive(pid)]
+
+
+@pytest.mark.slow
+def test_context_processes_stop_when_the_supervisor_is_killed(tmp_path: Path) -> None:
+    process = subprocess.Popen(
+        [*TAFEL, "run", "--platform", "dummy", "--concurrent", "--no-debug", "--record", str(tmp_path / "orphan.mcap")],
+        cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(REPO)},
+    )
+    deadline = time.monotonic() + 20
+    children: list[int] = []
+    while time.monotonic() < deadline and len(children) < 2:
+        time.sleep(0.2)
+        children = [pid for pid in child_pids(process.pid) if "spawn_main" in cmdline(pid)]
+    assert len(children) == 2, children
+    time.sleep(1.0)  # recording under way
+    process.kill()
+    process.wait(timeout=5)
+    gone = time.monotonic() + 4.0  # they must stop within 2 s; a little slack for a loaded machine
+    while time.monotonic() < gone and any(alive(pid) for pid in children):
+        time.sleep(0.1)
+    left = [pid for pid in children if alive(pid)]
+    for pid in left:
+        os.kill(pid, signal.SIGKILL)
+    assert not left, "context processes outlived their supervisor"

@@ -296,7 +296,7 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
             debug.add_context(name, RemoteExecutor(name, ours[name]), plans[name])
     stall = float(config.get("runtime", {}).get("stall_timeout_s", 1.0))
     runtime = ConcurrentRuntime(plans, platform_class, options, strict=args.strict, stall_timeout_s=stall,
-                                recorder=recorder, worker_setup=setup)
+                                recorder=recorder, worker_setup=setup, grace_s=shutdown_grace(config))
     started = time.monotonic()
     last = [started]
 
