@@ -152,7 +152,8 @@ class ModuleManager:
             resolve_module(module_name, self._by_name)
         self._slots: list[_Slot] = []
         self._marks: list[AccessMark] = []
-        plan = build_plan(self._modules, external=self._external, providers=self._providers, disabled=self._disabled)
+        effective = {r: m for r, m in self._providers.items() if m not in self._disabled}
+        plan = build_plan(self._modules, external=self._external, providers=effective, disabled=self._disabled)
         self._plan = self._apply(plan, {})
 
     # ------------------------------------------------------------------ running
@@ -317,20 +318,25 @@ class ModuleManager:
 
     # ------------------------------------------------------------------ reconfiguration
     def set_provider(self, rep_name: str, module_name: str) -> None:
-        """Make ``module_name`` the provider of ``rep_name``; raises and changes nothing if invalid."""
-        providers = {**self._providers, rep_name: module_name}
-        plan = build_plan(self._modules, external=self._external, providers=providers, disabled=self._disabled)
-        self._plan = self._apply(plan, self._plan.provider)
-        self._providers = providers
+        """Make ``module_name`` the provider of ``rep_name`` (enabling it if it was disabled); raises
+        and changes nothing if invalid."""
+        name = resolve_module(module_name, self._by_name).__name__
+        self._reconfigure({**self._providers, rep_name: name}, self._disabled - {name})
 
     def set_enabled(self, module_name: str, enabled: bool) -> None:
-        """Enable or disable a module; raises and changes nothing if the graph would break."""
-        resolve_module(module_name, self._by_name)
-        disabled = self._disabled - {module_name} if enabled else self._disabled | {module_name}
-        providers = {r: m for r, m in self._providers.items() if m not in disabled}
-        plan = build_plan(self._modules, external=self._external, providers=providers, disabled=disabled)
+        """Enable or disable a module; raises and changes nothing if the graph would break.
+
+        Provider choices are kept while their module is disabled, and apply again once it is enabled,
+        so every sequence of switches can be undone.
+        """
+        name = resolve_module(module_name, self._by_name).__name__
+        self._reconfigure(self._providers, self._disabled - {name} if enabled else self._disabled | {name})
+
+    def _reconfigure(self, providers: Mapping[str, str], disabled: set[str]) -> None:
+        effective = {r: m for r, m in providers.items() if m not in disabled}
+        plan = build_plan(self._modules, external=self._external, providers=effective, disabled=disabled)
         self._plan = self._apply(plan, self._plan.provider)
-        self._disabled, self._providers = disabled, providers
+        self._providers, self._disabled = dict(providers), set(disabled)
 
     @property
     def providers(self) -> dict[str, str]:
