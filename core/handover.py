@@ -10,9 +10,11 @@ through a shared-memory seqlock with two slots, and a read that overlapped a wri
 from __future__ import annotations
 
 import copy
+import logging
 import pickle
 import struct
 import time
+import zlib
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from multiprocessing import shared_memory
@@ -22,6 +24,9 @@ import numpy as np
 
 from tafel.core.errors import TafelError
 from tafel.core.manager import Blackboard
+
+
+log = logging.getLogger("tafel.handover")
 
 
 class HandoverError(TafelError, RuntimeError):
@@ -85,16 +90,18 @@ class LocalChannel:
 
 
 _HEADER = struct.Struct("<Q")  # sequence number of the newest complete bundle
-_SLOT = struct.Struct("<Q")  # payload length
+_SLOT = struct.Struct("<QI")  # payload length, CRC-32 of the payload
 
 
 class SharedChannel:
     """Hand-over between processes through shared memory (single writer, any number of readers).
 
-    Layout: sequence number, then two slots of (length, payload). Bundle ``n`` goes into slot ``n % 2``
-    and becomes visible when the sequence number is set to ``n``. A reader copies the slot of the
-    sequence number it saw and accepts the copy only if the sequence number has not moved meanwhile
-    (the writer only touches that slot again after publishing the next bundle).
+    Layout: sequence number, then two slots of (length, CRC-32, payload). Bundle ``n`` goes into slot
+    ``n % 2`` and becomes visible when the sequence number is set to ``n``. A reader copies the slot of
+    the sequence number it saw and accepts the copy only if the sequence number has not moved meanwhile
+    (the writer only touches that slot again after publishing the next bundle) and the checksum holds.
+    A payload that is damaged or does not decode is skipped and counted (``skipped``); the reader keeps
+    the last good bundle, and no loop ever ends for it.
     """
 
     def __init__(self, name: str | None = None, capacity: int = 4 << 20, create: bool = True) -> None:
@@ -111,6 +118,10 @@ class SharedChannel:
         self.capacity = (self._shm.size - _HEADER.size) // 2 - _SLOT.size
         self._owner = create
         self._sequence = 0
+        self._last_good: Bundle | None = None
+        self._bad_sequence = 0
+        #: bundles skipped because their checksum failed or they did not decode
+        self.skipped = 0
 
     @classmethod
     def attach(cls, name: str) -> SharedChannel:
@@ -130,7 +141,7 @@ class SharedChannel:
         sequence = self._sequence + 1
         offset = self._slot_offset(sequence)
         buf = self._shm.buf
-        _SLOT.pack_into(buf, offset, len(payload))
+        _SLOT.pack_into(buf, offset, len(payload), zlib.crc32(payload))
         start = offset + _SLOT.size
         buf[start : start + len(payload)] = payload
         _HEADER.pack_into(buf, 0, sequence)
@@ -142,18 +153,35 @@ class SharedChannel:
             (sequence,) = _HEADER.unpack_from(buf, 0)
             if sequence == 0:
                 return None
+            if sequence == self._bad_sequence:
+                return self._last_good  # already found damaged: skipped once, counted once
             offset = self._slot_offset(sequence)
-            (length,) = _SLOT.unpack_from(buf, offset)
+            length, checksum = _SLOT.unpack_from(buf, offset)
             start = offset + _SLOT.size
             payload = bytes(buf[start : start + min(length, self.capacity)])
-            if _HEADER.unpack_from(buf, 0)[0] == sequence:
-                return pickle.loads(payload)
-        return None  # the writer kept overtaking; next frame will succeed
+            if _HEADER.unpack_from(buf, 0)[0] != sequence:
+                continue  # the writer overtook this read: try again
+            try:
+                if length > self.capacity or zlib.crc32(payload) != checksum:
+                    raise HandoverError(f"checksum of bundle {sequence} does not match")
+                self._last_good = pickle.loads(payload)
+            except Exception as exc:  # noqa: BLE001 - a damaged bundle never ends a loop
+                self._bad_sequence = sequence
+                self.skipped += 1
+                if self.skipped == 1 or self.skipped % 1000 == 0:
+                    log.warning("hand-over channel %s: bundle %d skipped (%s); %d skipped so far", self.name, sequence, exc, self.skipped)
+            return self._last_good
+        return self._last_good  # the writer kept overtaking; next frame will succeed
 
     def close(self) -> None:
+        """Release the mapping; the creator also removes the shared memory, even when closing fails."""
         try:
             self._shm.close()
+        except (BufferError, OSError) as exc:  # a view still open somewhere: unlinking still frees it
+            log.warning("hand-over channel %s: close failed (%s); removing it anyway", self.name, exc)
+        finally:
             if self._owner:
-                self._shm.unlink()
-        except (FileNotFoundError, BufferError):
-            pass
+                try:
+                    self._shm.unlink()
+                except FileNotFoundError:
+                    pass

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import multiprocessing
 import threading
+import time
+import zlib
+from multiprocessing import shared_memory
 
 import numpy as np
 import pytest
@@ -64,8 +67,10 @@ def test_shared_channel_never_shows_a_torn_value(sequence: list[int]) -> None:
     writer.start()
     observed = 0
     last_frame = 0
+    deadline = time.monotonic() + 60  # a writer that died must fail the test, not hang it
     try:
         while not done.is_set() or observed == 0:
+            assert time.monotonic() < deadline, f"the writer process stopped publishing (exit code {writer.exitcode})"
             bundle = channel.latest()
             if bundle is None:
                 continue
@@ -99,18 +104,20 @@ def test_local_channel_between_threads_never_shows_a_torn_value(sequence: list[i
 
     thread = threading.Thread(target=publish)
     thread.start()
-    consumer = HoConsistent()
     from tafel.core.manager import Blackboard
 
     board = Blackboard()
     board.ensure(HoConsistent)
+    deadline = time.monotonic() + 60
     while not done.is_set():
+        assert time.monotonic() < deadline, "the publishing thread stopped"
         bundle = channel.latest()
         if bundle is not None:
             apply_bundle(bundle, board, [HoConsistent])
             assert consistent(board[HoConsistent].__dict__)
     thread.join()
-    assert consumer == HoConsistent()
+    apply_bundle(channel.latest(), board, [HoConsistent])
+    assert board[HoConsistent].a == sequence[-1] and consistent(board[HoConsistent].__dict__)
 
 
 def test_snapshots_do_not_change_with_the_producer() -> None:
@@ -135,3 +142,53 @@ def test_oversized_bundles_are_refused_with_advice() -> None:
 def test_attaching_a_missing_channel_fails_clearly() -> None:
     with pytest.raises(HandoverError, match="cannot attach hand-over channel"):
         SharedChannel.attach("tafel-no-such-channel")
+
+
+def publish_one(channel: SharedChannel, value: int, frame: int) -> None:
+    manager = ModuleManager([HoWriter])
+    manager.module("HoWriter").value = value
+    manager.execute()
+    channel.publish(make_bundle(manager.blackboard, [HoConsistent], frame, frame))
+
+
+def test_a_damaged_bundle_is_skipped_and_counted_and_the_last_good_one_stays() -> None:
+    channel = SharedChannel(capacity=1 << 20)
+    try:
+        publish_one(channel, 7, 1)
+        assert channel.latest().values["HoConsistent"]["a"] == 7
+        publish_one(channel, 8, 2)
+        offset = channel._slot_offset(2) + 12 + 20  # inside bundle 2's payload
+        channel._shm.buf[offset] ^= 0xFF
+        for _ in range(3):  # read every frame: skipped once, counted once, never raising
+            assert channel.latest().values["HoConsistent"]["a"] == 7
+        assert channel.skipped == 1
+        publish_one(channel, 9, 3)
+        assert channel.latest().values["HoConsistent"]["a"] == 9
+    finally:
+        channel.close()
+
+
+def test_a_payload_that_does_not_decode_is_skipped() -> None:
+    channel = SharedChannel(capacity=4096)
+    try:
+        garbage = b"not a pickle at all"
+        offset = channel._slot_offset(1)
+        struct_slot = __import__("struct").Struct("<QI")
+        struct_slot.pack_into(channel._shm.buf, offset, len(garbage), zlib.crc32(garbage))
+        channel._shm.buf[offset + struct_slot.size : offset + struct_slot.size + len(garbage)] = garbage
+        __import__("struct").Struct("<Q").pack_into(channel._shm.buf, 0, 1)
+        assert channel.latest() is None and channel.skipped == 1
+    finally:
+        channel.close()
+
+
+def test_shared_memory_is_released_even_when_closing_raises() -> None:
+    channel = SharedChannel(capacity=1024)
+    name = channel.name
+    view = channel._shm.buf[0:8]  # an exported view makes SharedMemory.close raise BufferError
+    try:
+        channel.close()
+    finally:
+        view.release()
+    with pytest.raises(FileNotFoundError):
+        shared_memory.SharedMemory(name=name)
