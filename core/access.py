@@ -17,8 +17,18 @@ from typing import Any
 
 import numpy as np
 
-from tafel.core.errors import ReadOnlyRepresentationError
-from tafel.core.representation import fields_of
+from tafel.core.errors import ReadOnlyRepresentationError, TafelError
+from tafel.core.representation import ArraySpec, fields_of
+
+
+class ArrayFieldError(TafelError, ValueError):
+    """A module wrote an array of the wrong shape or dtype into a field that declares both."""
+
+    def __init__(self, owner: str, rep: str, field: str, spec: ArraySpec, value: np.ndarray) -> None:
+        expected = "(" + ", ".join("any" if n is None else str(n) for n in spec.shape) + ("," if len(spec.shape) == 1 else "") + ")"
+        who = f"module {owner}" if owner else "a module"
+        super().__init__(f"{who} wrote {rep}.{field} as an array of shape {value.shape} and dtype {value.dtype}; "
+                         f"the field declares shape {expected} and dtype {spec.dtype}")
 
 _SCALAR_KINDS = frozenset({"bool", "int", "float", "str", "bytes", "enum"})
 
@@ -192,9 +202,9 @@ class ReadOnlyView:
         return copy.deepcopy(self._t, memo)
 
 
-def _compile(source: str, name: str) -> Any:
+def _compile(source: str, name: str, globals_: dict[str, Any] | None = None) -> Any:
     """Compile a generated accessor; direct attribute access is three times faster than getattr()."""
-    namespace: dict[str, Any] = {}
+    namespace: dict[str, Any] = dict(globals_ or {})
     exec(source, namespace)  # noqa: S102 - generated from validated field identifiers
     return namespace[name]
 
@@ -260,16 +270,17 @@ class WriterView:
     reached through writer views too; in-place changes to arrays and lists are not noted.
     """
 
-    __slots__ = ("_t", "_mark", "_undo", "_cache")
+    __slots__ = ("_t", "_mark", "_undo", "_cache", "_owner")
 
-    def __init__(self, target: Any, mark: AccessMark, undo: list) -> None:
+    def __init__(self, target: Any, mark: AccessMark, undo: list, owner: str = "") -> None:
         object.__setattr__(self, "_t", target)
         object.__setattr__(self, "_mark", mark)
         object.__setattr__(self, "_undo", undo)
         object.__setattr__(self, "_cache", {})
+        object.__setattr__(self, "_owner", owner)
 
     def _nested(self, name: str, value: Any) -> Any:
-        view = writer_view(value, self._mark, self._undo)
+        view = writer_view(value, self._mark, self._undo, self._owner)
         self._cache[name] = (value, view)
         return view
 
@@ -294,14 +305,34 @@ def undo_writes(undo: list) -> None:
     undo.clear()
 
 
-def _write_property(name: str, kind: str) -> property:
+def check_array(value: Any, spec: ArraySpec, owner: str, rep: str, name: str) -> Any:
+    """``value`` as an array of the declared dtype and shape, or ``ArrayFieldError`` saying what is wrong.
+
+    Lists and numbers convert when they fit the dtype without loss (``[1, 2, 3]`` for a float array);
+    a wrong shape, or a dtype that would lose information, is refused.
+    """
+    array = value if isinstance(value, np.ndarray) else np.asarray(value)
+    if array.dtype != spec.dtype:
+        if not np.can_cast(array.dtype, spec.dtype, casting="same_kind") or (
+                array.dtype.kind == "f" and spec.dtype.kind in "iub"):
+            raise ArrayFieldError(owner, rep, name, spec, array)
+        array = array.astype(spec.dtype)
+    if len(array.shape) != len(spec.shape) or any(n is not None and n != m for n, m in zip(spec.shape, array.shape)):
+        raise ArrayFieldError(owner, rep, name, spec, array)
+    return array
+
+
+def _write_property(name: str, kind: str, spec: ArraySpec | None = None, rep: str = "") -> property:
+    check = (f"    value = _check(value, _spec, self._owner, {rep!r}, {name!r})\n" if kind == "ndarray" and spec is not None and spec.declared else "")
     setter = _compile(
         f"def set_(self, value):\n"
         f"    target = self._t\n"
         f"    self._mark.touched = True\n"
+        f"{check}"
         f"    self._undo.append((target, {name!r}, target.{name}))\n"
         f"    target.{name} = value\n",
         "set_",
+        {"_check": check_array, "_spec": spec},
     )
     if kind != "nested":
         return property(_compile(
@@ -322,15 +353,18 @@ def _write_property(name: str, kind: str) -> property:
 _WRITE_VIEWS: dict[type, type] = {}
 
 
-def writer_view(target: Any, mark: AccessMark, undo: list) -> WriterView:
-    """A writer view of a representation (or nested dataclass) for the module that provides it."""
+def writer_view(target: Any, mark: AccessMark, undo: list, owner: str = "") -> WriterView:
+    """A writer view of a representation (or nested dataclass) for the module ``owner`` that provides it.
+
+    Array fields with a declared dtype and shape (``core.array``) are checked on every assignment.
+    """
     cls = type(target)
     view_cls = _WRITE_VIEWS.get(cls)
     if view_cls is None:
         namespace: dict[str, Any] = {**_behaviour(cls), "__slots__": ()}
         for info in fields_of(cls):
-            namespace[info.name] = _write_property(info.name, info.kind)
+            namespace[info.name] = _write_property(info.name, info.kind, info.array, cls.__name__)
         view_cls = type(f"Writable{cls.__name__}", (WriterView,), namespace)
         _WRITE_VIEWS[cls] = view_cls
-    return view_cls(target, mark, undo)
+    return view_cls(target, mark, undo, owner)
 

@@ -25,7 +25,6 @@ import numpy as np
 from tafel.core.errors import TafelError
 from tafel.core.manager import Blackboard
 
-
 log = logging.getLogger("tafel.handover")
 
 

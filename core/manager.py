@@ -386,7 +386,7 @@ class ModuleManager:
             # A module running as provider of something else writes unchosen outputs to a private copy.
             target = self.blackboard[rep] if plan.provider.get(rep) is cls else rep()
             mark = AccessMark()
-            object.__setattr__(instance, snake_case(rep.__name__), writer_view(target, mark, slot.undo))
+            object.__setattr__(instance, snake_case(rep.__name__), writer_view(target, mark, slot.undo, cls.__name__))
             slot.write_marks.append((rep.__name__, mark))
         object.__setattr__(instance, "parameters", make_parameters(cls, self._parameters.get(cls.__name__)))
         try:

@@ -34,6 +34,8 @@ class ArraySpec:
 
     dtype: np.dtype
     shape: tuple[int | None, ...]
+    #: False for arrays declared without ``array(...)``: any float array goes, nothing is checked
+    declared: bool = True
 
 
 @dataclass(frozen=True)
@@ -246,7 +248,7 @@ def _describe(owner: str, field_name: str, hint: Any, field: dataclasses.Field |
         spec = None
         if field is not None:
             spec = field.metadata.get(_ARRAY_META)
-        return FieldInfo(field_name, "ndarray", np.ndarray, array=spec or ArraySpec(np.dtype(np.float64), (None,)))
+        return FieldInfo(field_name, "ndarray", np.ndarray, array=spec or ArraySpec(np.dtype(np.float64), (None,), declared=False))
     if origin is list or hint is list:
         (element_hint,) = typing.get_args(hint) or (None,)
         if element_hint is None:

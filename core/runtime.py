@@ -505,12 +505,14 @@ def _snapshot_stats(runner: ContextRunner, stats: ContextStats, start_ns: int) -
 DUMP_SIGNAL = signal.SIGUSR1
 
 
-def _watch_parent(stop: Any, parent: int) -> None:
+def _watch_parent(stop: Any, parent: int, record_queue: Any) -> None:
     """End this process when the supervisor is gone (killed with SIGKILL, say): first the clean stop,
     then, if a module is stuck, for good. Linux also sends SIGTERM at once (PR_SET_PDEATHSIG)."""
     _die_with_parent()
-    while os.getppid() == parent:
+    while os.getppid() == parent:  # also while stopping normally: the supervisor still reads the queue
         time.sleep(0.2)
+    if record_queue is not None:
+        record_queue.cancel_join_thread()  # nobody reads it any more: do not wait at exit to flush it
     stop.set()
     time.sleep(PARENT_GONE_GRACE_S)
     faulthandler.dump_traceback(all_threads=True)
@@ -536,9 +538,8 @@ def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the supervisor decides when to stop
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     faulthandler.register(DUMP_SIGNAL, all_threads=True)
-    threading.Thread(target=_watch_parent, args=(stop, os.getppid()), name="tafel-parent-watch", daemon=True).start()
-    if spec.record_queue is not None:
-        spec.record_queue.cancel_join_thread()  # never wait at exit for a supervisor that no longer reads
+    threading.Thread(target=_watch_parent, args=(stop, os.getppid(), spec.record_queue), name="tafel-parent-watch",
+                     daemon=True).start()
     clock.set_origin(spec.clock_origin_ns)
     logging.basicConfig(level=logging.WARNING, format=f"[{spec.plan.name}] %(levelname)s %(message)s")
     realtime = try_realtime(spec.realtime_priority) if spec.plan.name == "motion" else ""

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+from typing import Any
 
 import numpy as np
 import pytest
@@ -21,6 +22,7 @@ from tafel.core import (
     snake_case,
     uses,
 )
+from tafel.core.access import ArrayFieldError
 
 
 @dataclasses.dataclass
@@ -239,3 +241,56 @@ def test_module_may_keep_its_own_state() -> None:
     for _ in range(3):
         manager.execute()
     assert manager.blackboard[AccSink].value == 3 and manager.module("Counter").count == 3
+
+
+@representation
+class ShapedArrays:
+    joints: np.ndarray = array((25,))
+    image: np.ndarray = array((4, 6, 3), np.uint8)
+    free: np.ndarray = array((None, 2))
+
+
+@provides(ShapedArrays)
+class WritesShapes(Module):
+    value: Any = None
+    field_name = "joints"
+
+    def execute(self) -> None:
+        setattr(self.shaped_arrays, self.field_name, self.value)
+
+
+@pytest.mark.parametrize(("field_name", "value", "message"), [
+    ("joints", [1.0, 2.0, 3.0], r"module WritesShapes wrote ShapedArrays.joints as an array of shape \(3,\) and dtype float64; "
+                                r"the field declares shape \(25,\) and dtype float64"),
+    ("image", np.zeros((4, 6, 3), np.float32), r"ShapedArrays.image as an array of shape \(4, 6, 3\) and dtype float32; "
+                                               r"the field declares shape \(4, 6, 3\) and dtype uint8"),
+    ("free", np.zeros((3, 3)), r"declares shape \(any, 2\)"),
+])
+def test_declared_array_shapes_and_dtypes_are_enforced_on_write(field_name: str, value: Any, message: str) -> None:
+    manager = ModuleManager([WritesShapes], strict=True)
+    module = manager.module("WritesShapes")
+    module.field_name, module.value = field_name, value
+    with pytest.raises(ArrayFieldError, match=message):
+        manager.execute()
+
+
+def test_fitting_arrays_and_lists_are_accepted_and_converted() -> None:
+    manager = ModuleManager([WritesShapes], strict=True)
+    module = manager.module("WritesShapes")
+    module.field_name, module.value = "joints", list(range(25))  # ints fit a float array
+    manager.execute()
+    assert manager.blackboard[ShapedArrays].joints.dtype == np.float64
+    module.field_name, module.value = "free", np.ones((7, 2))
+    manager.execute()
+    assert manager.blackboard[ShapedArrays].free.shape == (7, 2)
+
+
+def test_a_wrong_array_is_a_module_error_and_the_previous_value_stays() -> None:
+    manager = ModuleManager([WritesShapes])
+    module = manager.module("WritesShapes")
+    module.field_name, module.value = "joints", np.ones(25)
+    manager.execute()
+    module.value = np.ones(24)
+    manager.execute()  # not strict: logged and counted, the frame goes on
+    assert manager.errors()["WritesShapes"][0] == 1
+    assert manager.blackboard[ShapedArrays].joints.shape == (25,) and manager.blackboard[ShapedArrays].joints[0] == 1.0
