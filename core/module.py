@@ -53,6 +53,13 @@ class Module:
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
+        previous = _KNOWN.get(cls.__name__)
+        if previous is not None and (previous.__module__, previous.__qualname__) != (cls.__module__, cls.__qualname__):
+            raise ModuleDefinitionError(
+                f"two module classes are named {cls.__name__!r}: {previous.__module__}.{previous.__qualname__} and "
+                f"{cls.__module__}.{cls.__qualname__}; module names must be unique because configuration, logs and "
+                "debug commands refer to modules by name. Rename one of them."
+            )
         _KNOWN[cls.__name__] = cls
 
     def execute(self) -> None:

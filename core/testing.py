@@ -11,7 +11,7 @@ in the module fails the test with its own traceback.
 
 from __future__ import annotations
 
-import dataclasses
+import copy
 from collections.abc import Mapping
 from typing import Any, TypeVar
 
@@ -64,7 +64,7 @@ class ModuleHarness:
                     f"{type(value).__name__}; it declares {names}"
                 )
             target = self.blackboard[type(value)]
-            target.__dict__.update(dataclasses.replace(value).__dict__)
+            target.__dict__.update(copy.deepcopy(value).__dict__)  # deep: arrays and lists too
         return self
 
     def execute(self, frames: int = 1) -> Blackboard:

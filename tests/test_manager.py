@@ -160,9 +160,8 @@ def test_providers_choosing_a_module_that_does_not_provide_it() -> None:
 
 
 def test_duplicate_module_names_and_non_modules_are_rejected() -> None:
-    other = type("MgrCamera", (Module,), {"__module__": "elsewhere"})
-    with pytest.raises(ModuleDefinitionError, match="two modules are named MgrCamera"):
-        ModuleManager([MgrCamera, other])
+    with pytest.raises(ModuleDefinitionError, match="two module classes are named 'MgrCamera'"):
+        type("MgrCamera", (Module,), {"__module__": "elsewhere"})  # fails where it is defined
     with pytest.raises(ModuleDefinitionError, match="take Module subclasses"):
         ModuleManager([object])
 

@@ -294,3 +294,44 @@ def test_a_wrong_array_is_a_module_error_and_the_previous_value_stays() -> None:
     manager.execute()  # not strict: logged and counted, the frame goes on
     assert manager.errors()["WritesShapes"][0] == 1
     assert manager.blackboard[ShapedArrays].joints.shape == (25,) and manager.blackboard[ShapedArrays].joints[0] == 1.0
+
+
+def test_two_module_classes_with_one_name_fail_at_definition_naming_both() -> None:
+    namespace: dict[str, Any] = {"__name__": "first_place"}
+    exec("from tafel.core import Module\nclass TwinModuleName(Module):\n    pass\n", namespace)  # noqa: S102
+    other: dict[str, Any] = {"__name__": "second_place"}
+    with pytest.raises(ModuleDefinitionError, match=r"two module classes are named 'TwinModuleName': "
+                                                     r"first_place.TwinModuleName and second_place.TwinModuleName"):
+        exec("from tafel.core import Module\nclass TwinModuleName(Module):\n    pass\n", other)  # noqa: S102
+
+
+@representation
+class HarnessCopied:
+    samples: np.ndarray = array((3,))
+    names: list[str]
+
+
+@requires(HarnessCopied)
+@provides(ShapedArrays)
+class ReadsCopied(Module):
+    def execute(self) -> None:
+        pass
+
+
+@provides(HarnessCopied)
+class ScribblesOnItsOutput(Module):
+    def execute(self) -> None:
+        self.harness_copied.samples[0] = 99.0  # in place
+        self.harness_copied.names.append("changed")
+
+
+def test_the_harness_never_changes_the_tests_own_objects() -> None:
+    from tafel.core.testing import ModuleHarness, run_module
+
+    mine = HarnessCopied(samples=np.array([1.0, 2.0, 3.0]), names=["a"])
+    harness = ModuleHarness(ScribblesOnItsOutput, mine)
+    harness.execute()
+    assert harness[HarnessCopied].samples[0] == 99.0
+    assert mine.samples.tolist() == [1.0, 2.0, 3.0] and mine.names == ["a"]
+    run_module(ReadsCopied, mine)
+    assert mine.samples.tolist() == [1.0, 2.0, 3.0]
