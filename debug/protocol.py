@@ -31,11 +31,33 @@ class ParseError(TafelError, ValueError):
     """A line that is not a well-formed command; the message says what was expected."""
 
 
+#: arguments that stay bytes when sent in base64 (binary data); every other one is text either way
+BINARY_ARGUMENTS = frozenset({"data"})
+
+
 @dataclass(frozen=True)
 class Command:
     name: str
     args: dict[str, str | bytes] = field(default_factory=dict)
     base64_answer: bool = False
+
+    def as_text(self) -> Command:
+        """The command with every base64 argument decoded to text (UTF-8), as if sent plainly.
+
+        Base64 is a way to send any value (spaces, quotes, line breaks), not another kind of value:
+        handlers see text, except for the binary arguments (``BINARY_ARGUMENTS``).
+        """
+        if not any(isinstance(v, bytes) for v in self.args.values()):
+            return self
+        args: dict[str, str | bytes] = {}
+        for name, value in self.args.items():
+            if isinstance(value, bytes) and name not in BINARY_ARGUMENTS:
+                try:
+                    value = value.decode("utf-8")
+                except UnicodeDecodeError as exc:
+                    raise ParseError(f"argument +{name} decodes to bytes that are not UTF-8 text (byte {exc.start})") from None
+            args[name] = value
+        return Command(self.name, args, self.base64_answer)
 
 
 def parse(line: str) -> Command:

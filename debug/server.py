@@ -69,6 +69,9 @@ class DebugRouter:
         self.register("help", "the commands, or one command's arguments", "help [NAME]", self._help)
         self.register("ping", "answers pong", "ping", lambda command: "pong")
         self.register("auth", "authenticate with the server's token (--debug-token)", "auth TOKEN", lambda command: "authenticated")
+        #: what ``hello`` answers: which program this is (platform, pid, start time)
+        self.identity = "tafel"
+        self.register("hello", "which program this is: platform, process id, start time", "hello", lambda command: self.identity)
 
     def add_context(self, name: str, executor: Executor, names: set[str] | None = None) -> None:
         self.contexts[name] = executor
@@ -76,7 +79,7 @@ class DebugRouter:
             self.index[name] = set(names)
 
     #: commands that need no context and change nothing: answered by the network thread on arrival
-    IMMEDIATE = frozenset({"ping", "help"})
+    IMMEDIATE = frozenset({"ping", "help", "hello"})
 
     def targets(self, command: Command) -> list[str]:
         """The contexts to ask: the one that has the named module or representation, else all."""
@@ -194,7 +197,7 @@ class _Connection:
             self.deliver(sequence, answer_bytes(f"error: line too long (at most {self.server.max_line} bytes)"))
             return
         try:
-            command = parse(raw.decode("utf-8").strip())
+            command = parse(raw.decode("utf-8").strip()).as_text()
         except UnicodeDecodeError as exc:
             self.deliver(sequence, answer_bytes(f"error: the line is not valid UTF-8 (byte {exc.start})"))
             return

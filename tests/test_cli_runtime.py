@@ -259,3 +259,25 @@ def test_context_processes_stop_when_the_supervisor_is_killed(tmp_path: Path) ->
     for pid in left:
         os.kill(pid, signal.SIGKILL)
     assert not left, "context processes outlived their supervisor"
+
+
+def test_a_taken_debug_port_is_an_error_not_a_silent_run_without_the_server() -> None:
+    import socket
+
+    holder = socket.socket()
+    holder.bind(("127.0.0.1", 0))
+    holder.listen(1)
+    port = holder.getsockname()[1]
+    try:
+        result = tafel("run", "--platform", "dummy", "--frames", "10", "--speed", "max", "--debug-port", str(port))
+    finally:
+        holder.close()
+    assert result.returncode == 2
+    assert f"debug port 127.0.0.1:{port} is taken" in result.stderr and "--debug-port 0" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize("port", ["70000", "-1", "http"])
+def test_a_debug_port_out_of_range_is_an_error(port: str) -> None:
+    result = tafel("run", "--platform", "dummy", "--frames", "10", "--debug-port", port)
+    assert result.returncode == 2 and "a port is a whole number from 0 to 65535" in result.stderr

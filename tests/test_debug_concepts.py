@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import re
+import select
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -95,10 +98,53 @@ def test_console_completion_and_an_interactive_session() -> None:
             assert completer.candidates("modules:l", "modules:l") == ["modules:list"]
             assert "KalmanBallModeler" in completer.candidates("Kal", "modules:set -module Kal")
             assert "BallModel" in completer.candidates("BallM", "representation:print BallM")
+            # contextual: representations after representation:print, modules after -module
+            assert completer.candidates("Ball", "representation:print Ball") == ["BallModel", "BallPercept"]
+            assert completer.candidates("Ball", "modules:set -module Ball") == ["BallDetector", "BallLocator"]
+            assert completer.candidates("mo", "representation:print BallModel -context mo") == ["motion"]
+            assert completer.candidates("", "ping ") == []
         session = subprocess.run([sys.executable, "-m", "tafel.tools.cli", "console", "--port", str(program.port)],
                                  input="ping\nrepresentation:print BallModel\nquit\n", capture_output=True, text=True, timeout=30)
         assert session.returncode == 0, session.stderr
         assert "connected to" in session.stdout and "pong" in session.stdout and "BallModel (cognition" in session.stdout
+        assert re.search(r"connected to 127.0.0.1:\d+: tafel [\d.]+: platform dummy, pid \d+, started \d{4}-", session.stdout)
+    finally:
+        program.stop()
+
+
+def test_console_ctrl_c_clears_the_line_and_ctrl_d_leaves() -> None:
+    import os
+    import pty
+
+    program = Program()
+    try:
+        pid, fd = pty.fork()
+        if pid == 0:  # the child: the console on a terminal
+            os.execv(sys.executable, [sys.executable, "-m", "tafel.tools.cli", "console", "--port", str(program.port)])
+        output = b""
+
+        def read_until(marker: bytes, seconds: float = 20.0) -> None:
+            nonlocal output
+            deadline = time.monotonic() + seconds
+            while marker not in output and time.monotonic() < deadline:
+                ready, _, _ = select.select([fd], [], [], 0.2)
+                if ready:
+                    try:
+                        output += os.read(fd, 4096)
+                    except OSError:
+                        return
+
+        read_until(b"tafel> ")
+        os.write(fd, b"representation:print Nonsense")
+        os.write(fd, b"\x03")  # Ctrl-C: the line is dropped, the console stays
+        read_until(b"tafel> ", 5.0)
+        os.write(fd, b"ping\r")
+        read_until(b"pong")
+        os.write(fd, b"\x04")  # Ctrl-D: leave
+        _, status = os.waitpid(pid, 0)
+        assert b"pong" in output
+        assert os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0, output.decode(errors="replace")
+        assert b"not on this blackboard" not in output  # the dropped line never ran
     finally:
         program.stop()
 

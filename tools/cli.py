@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 import argparse
+import datetime
+import errno
 import importlib
 import logging
+import os
 import pkgutil
 import sys
 import threading
 import time
 from collections.abc import Sequence
+from importlib.metadata import version
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -84,6 +88,17 @@ def positive(kind: type) -> Any:
     return parse
 
 
+def port_number(text: str) -> int:
+    """A TCP port: 0 (any free one) to 65535."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a port is a whole number from 0 to 65535, got {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"a port is a whole number from 0 to 65535 (0: any free one), got {value}")
+    return value
+
+
 def add_program_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--platform", help="where to run (see 'tafel platforms'); default from configuration")
     parser.add_argument("--config", type=Path, metavar="DIR",
@@ -115,7 +130,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--record", type=Path, metavar="FILE.mcap", help="record representations into an MCAP log")
     run.add_argument("--record-reps", metavar="A,B",
                      help="what to record besides the sensor data (default: [recording] representations; 'all': everything)")
-    run.add_argument("--debug-port", type=int, default=None, metavar="P", help=f"debug server port (default {DEFAULT_DEBUG_PORT}; 0 takes a free one)")
+    run.add_argument("--debug-port", type=port_number, default=None, metavar="P", help=f"debug server port (default {DEFAULT_DEBUG_PORT}; 0 takes a free one)")
     run.add_argument("--debug-host", default="127.0.0.1", metavar="H", help="debug server address (default: %(default)s)")
     run.add_argument("--debug-token", metavar="T", help="clients must send 'auth T' first")
     run.add_argument("--no-debug", action="store_true", help="run without the debug server")
@@ -227,6 +242,8 @@ def start_debug(args: argparse.Namespace, recorder: Recorder | None, plans: dict
         return None
     port = DEFAULT_DEBUG_PORT if args.debug_port is None else args.debug_port
     debug = ProgramDebug(host=args.debug_host, port=port, token=args.debug_token, config_dir=store_dir(args), recorder=recorder)
+    started = datetime.datetime.now().astimezone().isoformat(timespec="seconds")
+    debug.router.identity = f"tafel {version('tafel')}: platform {args.platform}, pid {os.getpid()}, started {started}"
     debug.handovers = handovers_of(plans)
     return debug
 
@@ -237,10 +254,11 @@ def listen(args: argparse.Namespace, debug: ProgramDebug | None) -> None:
     try:
         host, port = debug.server.start()
     except OSError as exc:
-        if args.debug_port is not None:
-            raise PlatformError(f"{exc}; choose another --debug-port (0 takes a free one)") from None
-        print(f"warning: {exc}; running without the debug server (use --debug-port 0 for a free port)", file=sys.stderr)
-        return
+        # Going on without the server would let the console talk to whatever program holds the port.
+        wanted = DEFAULT_DEBUG_PORT if args.debug_port is None else args.debug_port
+        reason = "is taken (another tafel run?)" if exc.errno == errno.EADDRINUSE else f"cannot be opened ({exc.strerror or exc})"
+        fail(f"debug port {args.debug_host}:{wanted} {reason}; choose another with --debug-port P, "
+             "take a free one with --debug-port 0, or run without it with --no-debug")
     print(f"debug server listening on {host}:{port}", flush=True)
 
 

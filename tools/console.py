@@ -13,10 +13,16 @@ from tafel.debug.client import DebugClient
 HISTORY = Path.home() / ".tafel_history"
 
 
+def port_number(text: str) -> int:
+    from tafel.tools.cli import port_number as parse
+
+    return parse(text)
+
+
 def add_console_command(commands: Any) -> None:
     console = commands.add_parser("console", help="talk to a running program's debug server")
     console.add_argument("--host", default="127.0.0.1")
-    console.add_argument("--port", type=int, default=5401)
+    console.add_argument("--port", type=port_number, default=5401)
     console.add_argument("--token", help="send 'auth TOKEN' first")
     console.add_argument("-c", dest="one_command", metavar="COMMAND", help="run one command, print its answer and exit (status 1 on error:)")
 
@@ -38,30 +44,48 @@ def run_console(args: argparse.Namespace) -> int:
             answer = client.ask(args.one_command)
             print(answer)
             return 1 if answer.startswith("error:") else 0
-        return interactive(client, f"{args.host}:{args.port}")
+        return interactive(client, f"{args.host}:{args.port}: {client.ask('hello')}")
 
 
 class Completer:
-    """Completes command names, then module, representation and debug request names."""
+    """Completes command names, then the names that fit where the cursor is: after
+    ``representation:print`` only representations, after ``-module`` only modules, and so on."""
+
+    #: command -> the kind of name its first argument takes
+    COMMAND_KINDS = {
+        "representation:print": "representations", "representation:get": "representations", "representation:set": "representations",
+        "modules:set": "modules", "modules:provider": "representations", "parameter:get": "modules",
+        "parameter:set": "modules", "parameter:store": "modules", "debug_request:set": "requests",
+        "modify:set": "modify", "modify:release": "modify", "help": "commands",
+    }
+    #: argument -> the kind of name it takes
+    ARGUMENT_KINDS = {"-module": "modules", "-representation": "representations", "-context": "contexts"}
+    LISTS = (("modules", "modules:list", r"^\s+(\w+)\s+(?:on|off)\b"), ("representations", "representation:list", r"^\s+(\w+)\s"),
+             ("requests", "debug_request:list", r"^\s+(?:on|off)\s+(\S+)"), ("modify", "modify:list", r"^\s+(\S+) ="))
 
     def __init__(self, client: DebugClient) -> None:
         self.client = client
         self.commands = [line.split()[0] for line in client.ask("help").splitlines() if line.strip()]
-        self.names: list[str] = []
+        self.names: dict[str, list[str]] = {}
         self.refresh()
 
     def refresh(self) -> None:
-        names: set[str] = set()
-        for command, pattern in (("modules:list", r"^\s+(\w+)\s+(?:on|off)\b"), ("representation:list", r"^\s+(\w+)\s"),
-                                 ("debug_request:list", r"^\s+(?:on|off)\s+(\S+)"), ("modify:list", r"^\s+(\S+) =")):
+        self.names = {"commands": self.commands, "contexts": ["cognition", "motion"]}
+        for kind, command, pattern in self.LISTS:
             answer = self.client.ask(command)
-            if not answer.startswith("error:"):
-                names.update(m.group(1) for line in answer.splitlines() for m in [re.match(pattern, line)] if m)
-        self.names = sorted(names)
+            found = set() if answer.startswith("error:") else {
+                m.group(1) for line in answer.splitlines() for m in [re.match(pattern, line)] if m}
+            self.names[kind] = sorted(found)
 
     def candidates(self, text: str, line: str) -> list[str]:
-        pool = self.commands if not line.strip() or (" " not in line.lstrip() and not line.endswith(" ")) else self.names
-        return [c for c in pool if c.startswith(text)]
+        words = line.split()
+        if not words or (len(words) == 1 and not line.endswith(" ")):
+            return [c for c in self.commands if c.startswith(text)]
+        before = words[-1] if line.endswith(" ") else (words[-2] if len(words) > 1 else "")
+        kind = self.ARGUMENT_KINDS.get(before) or self.COMMAND_KINDS.get(words[0].lstrip("+"))
+        if kind is None:
+            return []
+        return [name for name in self.names.get(kind, []) if name.startswith(text)]
 
     def complete(self, text: str, state: int) -> str | None:
         import readline
@@ -87,9 +111,12 @@ def interactive(client: DebugClient, where: str) -> int:
         while True:
             try:
                 line = input("tafel> ").strip()
-            except EOFError:
+            except EOFError:  # Ctrl-D: leave
                 print()
                 return 0
+            except KeyboardInterrupt:  # Ctrl-C: drop the line, as a shell does
+                print()
+                continue
             if not line:
                 continue
             if line in ("quit", "exit"):
