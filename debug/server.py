@@ -296,7 +296,8 @@ class DebugServer:
         self._thread.start()
         self._ready.wait(timeout=10)
         if self._error is not None:
-            raise OSError(f"debug server cannot listen on {self.host}:{self.port}: {self._error}")
+            code = getattr(self._error, "errno", None) or 0
+            raise OSError(code, f"debug server cannot listen on {self.host}:{self.port}: {self._error}")
         return self.address
 
     def _run(self) -> None:
