@@ -89,7 +89,7 @@ class _Slot:
     """Everything the manager keeps for one running module; plain slots keep the frame loop fast."""
 
     __slots__ = ("name", "cls", "instance", "run", "times", "first_frame", "errors", "last_error",
-                 "undo", "read_marks", "write_marks", "chosen")
+                 "undo", "read_marks", "write_marks", "chosen", "logged_at", "logged_errors")
 
     def __init__(self, cls: type, frame: int) -> None:
         self.name = cls.__name__
@@ -104,11 +104,17 @@ class _Slot:
         self.read_marks: list[tuple[str, AccessMark]] = []
         self.write_marks: list[tuple[str, AccessMark]] = []
         self.chosen: frozenset[type] = frozenset()
+        self.logged_at = 0.0  # monotonic s of the last log line about this module's errors
+        self.logged_errors = 0  # errors counted when that line was written
 
 
 def _chosen_outputs(cls: type, plan: Plan) -> frozenset[type]:
     """The representations ``cls`` writes to the blackboard under ``plan``."""
     return frozenset(r for r in cls.requirements().provides if plan.provider.get(r) is cls)
+
+
+#: s between log lines about one module's repeated errors
+ERROR_LOG_INTERVAL_S = 1.0
 
 
 class ModuleManager:
@@ -187,11 +193,20 @@ class ModuleManager:
             raise exc
         slot.errors += 1
         slot.last_error = f"{type(exc).__name__}: {exc}"
-        self.log.error(
-            "%s: module %s failed in frame %d (%d errors so far): %s\n%s",
-            self.name, slot.name, self.frame, slot.errors, slot.last_error,
-            "".join(traceback.format_exception(exc)).rstrip(),
-        )
+        # The traceback once; after that at most one line a second with the count, so that a module
+        # failing every frame cannot flood the log (or slow the loop down with logging).
+        now = time.monotonic()
+        if slot.errors == 1:
+            self.log.error(
+                "%s: module %s failed in frame %d: %s\n%s", self.name, slot.name, self.frame, slot.last_error,
+                "".join(traceback.format_exception(exc)).rstrip(),
+            )
+        elif now - slot.logged_at < ERROR_LOG_INTERVAL_S:
+            return
+        else:
+            self.log.error("%s: module %s failed %d more times (%d in all), last in frame %d: %s", self.name, slot.name,
+                           slot.errors - slot.logged_errors, slot.errors, self.frame, slot.last_error)
+        slot.logged_at, slot.logged_errors = now, slot.errors
 
     # ------------------------------------------------------------------ inspection
     @property

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+import re
 from dataclasses import dataclass
 
 import pytest
@@ -399,3 +400,26 @@ def test_prune_unsatisfiable_is_transitive() -> None:
     pruned = prune_unsatisfiable([MgrDetector, MgrPlainModel, MgrBehavior], external=[])
     assert pruned == {"MgrDetector": ["MgrImage"], "MgrPlainModel": ["MgrPercept"], "MgrBehavior": ["MgrModel"]}
     assert prune_unsatisfiable([MgrDetector, MgrPlainModel], external=[MgrImage]) == {}
+
+
+@provides(MgrPercept)
+class MgrAlwaysFails(Module):
+    def execute(self) -> None:
+        raise ValueError("broken sensor model")
+
+
+def test_a_module_failing_every_frame_logs_its_traceback_once_then_a_line_a_second(caplog, monkeypatch) -> None:
+    import tafel.core.manager as manager_module
+
+    now = [1000.0]
+    monkeypatch.setattr(manager_module.time, "monotonic", lambda: now[0])
+    manager = ModuleManager([MgrAlwaysFails])
+    with caplog.at_level("ERROR", logger="tafel.cognition"):
+        for _ in range(250):  # 250 frames within 2.5 s
+            manager.execute()
+            now[0] += 0.01
+    records = [r.getMessage() for r in caplog.records]
+    assert sum("Traceback" in m for m in records) == 1 and "broken sensor model" in records[0]
+    assert len(records) == 3, records  # the traceback, then one line each second
+    assert re.search(r"failed 10[01] more times \(10[12] in all\)", records[1]) and "ValueError: broken sensor model" in records[1]
+    assert manager.errors()["MgrAlwaysFails"][0] == 250
