@@ -125,6 +125,7 @@ def plan_program(config: Mapping[str, Any], platform: type[Platform] | Platform,
             find_module(module_name)
     _check_single_provider(plans)
     _route(plans)
+    _check_missing_providers(plans, platform)
     for plan in plans.values():  # the graph of each context must hold before any process starts
         build_plan(plan.modules, external=plan.external, providers=plan.effective_providers(), disabled=plan.effective_disabled())
     if strict:
@@ -139,6 +140,39 @@ def plan_program(config: Mapping[str, Any], platform: type[Platform] | Platform,
                 + ". Remove them from the configuration of this platform, or run without --strict to prune them."
             )
     return plans
+
+
+def _check_missing_providers(plans: Mapping[str, ContextPlan], platform: type[Platform] | Platform) -> None:
+    """A module is pruned quietly only for what this platform lacks: a representation that some
+    platform provides, or that a configured module would compute were its own inputs there. One that
+    nothing at all provides is a configuration error, and is reported as the missing provider it is."""
+    computed = {r for plan in plans.values() for m in plan.modules for r in m.requirements().provides}
+    missing = {(plan.name, module, rep) for plan in plans.values() for module, reps in plan.pruned.items() for rep in reps}
+    suspects = {rep for _c, _m, rep in missing if rep not in {r.__name__ for r in computed}}
+    if not suspects:
+        return
+    from_platforms = _provided_by_any_platform(platform)
+    for context, module, rep in sorted(missing):
+        if rep in suspects and rep not in from_platforms:
+            raise MissingProviderError(
+                f"{context}: {module} requires {rep}, but no module in the configuration provides it and no platform "
+                f"does; add the module that provides {rep} to [{context}] modules (or [{_other(context)}] modules), "
+                f"or remove {module}"
+            )
+
+
+def _provided_by_any_platform(current: type[Platform] | Platform) -> set[str]:
+    """Names of the representations that some registered platform provides (platforms load lazily)."""
+    from tafel.core.platform import available_platforms
+
+    names = {r.__name__ for reps in current.provides.values() for r in reps}
+    for entry in available_platforms().values():
+        try:
+            cls = entry.load()
+        except Exception:  # noqa: BLE001 - a platform that cannot load provides nothing here
+            continue
+        names |= {r.__name__ for reps in getattr(cls, "provides", {}).values() for r in reps}
+    return names
 
 
 def _provided(modules: list[type]) -> set[type]:

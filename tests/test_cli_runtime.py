@@ -281,3 +281,16 @@ def test_a_taken_debug_port_is_an_error_not_a_silent_run_without_the_server() ->
 def test_a_debug_port_out_of_range_is_an_error(port: str) -> None:
     result = tafel("run", "--platform", "dummy", "--frames", "10", "--debug-port", port)
     assert result.returncode == 2 and "a port is a whole number from 0 to 65535" in result.stderr
+
+
+def test_a_requirement_nobody_provides_is_a_missing_provider_not_a_platform_gap() -> None:
+    result = dummy("--frames", "10", "--set", 'cognition.modules=["LookAtBallBehavior"]', "--set", "cognition.providers={}")
+    assert result.returncode == 2
+    assert ("cognition: LookAtBallBehavior requires BallModel, but no module in the configuration provides it and no "
+            "platform does") in result.stderr
+    assert "on this platform" not in result.stderr
+    # what only some platforms provide is still a gap of this platform: pruned, and said so
+    gap = dummy("--frames", "10", "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "BallDetector"]')
+    assert gap.returncode == 0, gap.stderr
+    assert "BallDetector disabled: nothing provides CameraImageBottom, CameraImageTop on this platform" in gap.stderr \
+        or "BallDetector disabled: nothing provides CameraImageTop, CameraImageBottom on this platform" in gap.stderr
