@@ -290,7 +290,8 @@ def test_a_requirement_nobody_provides_is_a_missing_provider_not_a_platform_gap(
             "platform does") in result.stderr
     assert "on this platform" not in result.stderr
     # what only some platforms provide is still a gap of this platform: pruned, and said so
-    gap = dummy("--frames", "10", "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "BallDetector"]')
+    gap = dummy("--frames", "10", "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "BallDetector"]',
+                "--set", "cognition.disabled=[]")
     assert gap.returncode == 0, gap.stderr
     assert "BallDetector disabled: nothing provides CameraImageBottom, CameraImageTop on this platform" in gap.stderr \
         or "BallDetector disabled: nothing provides CameraImageTop, CameraImageBottom on this platform" in gap.stderr
