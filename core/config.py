@@ -23,12 +23,14 @@ A configuration file looks like::
 from __future__ import annotations
 
 import copy
+import math
 import tomllib
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 from tafel.core.errors import TafelError
+from tafel.core.naming import did_you_mean
 
 CONTEXTS = ("cognition", "motion")
 PRIVATE_FILE = "private/private.toml"
@@ -131,8 +133,59 @@ def load_config(
             config = merge(config, read_toml(path))
             sources.append(str(path))
     config = apply_overrides(config, overrides)
+    check_runtime(config)
     config["_sources"] = sources
     return config
+
+
+#: the rates (Hz) a context may run at: above this no platform keeps up and no timer is that fine
+MAX_RATE_HZ = 1000.0
+#: [runtime] key -> (what it is, check)
+RUNTIME_KEYS: dict[str, str] = {
+    "cognition_hz": "rate", "motion_hz": "rate", "stall_timeout_s": "seconds", "shutdown_grace_s": "seconds",
+    "default_platform": "name",
+}
+
+
+def check_runtime(config: Mapping[str, Any]) -> None:
+    """``[runtime]`` holds only known keys, each of its kind; ``ConfigError`` with what would be right."""
+    runtime = config.get("runtime", {})
+    if not isinstance(runtime, Mapping):
+        raise ConfigError(f"runtime must be a table of settings (runtime.motion_hz=100 and the like), got {runtime!r}")
+    for key, value in runtime.items():
+        kind = RUNTIME_KEYS.get(key)
+        if kind is None:
+            raise ConfigError(f"runtime.{key} is not a setting; {did_you_mean(key, RUNTIME_KEYS)}; "
+                              f"the settings are {', '.join(sorted(RUNTIME_KEYS))}")
+        if kind == "name":
+            if not isinstance(value, str) or not value:
+                raise ConfigError(f"runtime.{key} takes a name, got {value!r}")
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+            raise ConfigError(f"runtime.{key} takes a positive number of {'Hz' if kind == 'rate' else 'seconds'}, got {value!r}")
+        if kind == "rate" and value > MAX_RATE_HZ:
+            raise ConfigError(f"runtime.{key} = {value:g} Hz is above what the runtime supports ({MAX_RATE_HZ:g} Hz at the most)")
+
+
+def edit_modules(config: dict[str, Any], add: Iterable[str] = (), remove: Iterable[str] = ()) -> dict[str, Any]:
+    """``--add-module cognition:NAME`` and ``--remove-module motion:NAME`` on the module lists."""
+    result = copy.deepcopy(config)
+    for text, adding in [*((t, True) for t in add), *((t, False) for t in remove)]:
+        context, sep, name = str(text).partition(":")
+        option = "--add-module" if adding else "--remove-module"
+        if not sep or context not in CONTEXTS or not name:
+            raise ConfigError(f"{option} takes CONTEXT:MODULE with CONTEXT cognition or motion, e.g. cognition:BallDetector; got {text!r}")
+        section = result.setdefault(context, {})
+        modules = list(section.get("modules", []))
+        if adding:
+            if name not in modules:
+                modules.append(name)
+        elif name in modules:
+            modules.remove(name)
+        else:
+            raise ConfigError(f"{option} {text}: {name} is not in [{context}] modules; {did_you_mean(name, modules)}")
+        section["modules"] = modules
+    return result
 
 
 def context_section(config: Mapping[str, Any], context: str) -> dict[str, Any]:

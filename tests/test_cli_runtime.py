@@ -295,3 +295,34 @@ def test_a_requirement_nobody_provides_is_a_missing_provider_not_a_platform_gap(
     assert gap.returncode == 0, gap.stderr
     assert "BallDetector disabled: nothing provides CameraImageBottom, CameraImageTop on this platform" in gap.stderr \
         or "BallDetector disabled: nothing provides CameraImageTop, CameraImageBottom on this platform" in gap.stderr
+
+
+@pytest.mark.parametrize(("setting", "message"), [
+    ("runtime.motion_hz=abc", "runtime.motion_hz takes a positive number of Hz, got 'abc'"),
+    ("runtime.motion_hz=nan", "runtime.motion_hz takes a positive number of Hz, got nan"),
+    ("runtime.cognition_hz=inf", "runtime.cognition_hz takes a positive number of Hz, got inf"),
+    ("runtime.motion_hz=10000", "above what the runtime supports (1000 Hz at the most)"),
+    ("runtime=5", "runtime must be a table of settings"),
+    ("runtime.shutdown_grace_s=abc", "runtime.shutdown_grace_s takes a positive number of seconds"),
+    ("runtime.motion_hzz=100", "runtime.motion_hzz is not a setting; did you mean 'motion_hz'"),
+    ("parameters.KalmanBallModler.friction=0.3", "unknown module 'KalmanBallModler': did you mean 'KalmanBallModeler'"),
+    ("parameters.KalmanBallModeler.fricton=0.3", "KalmanBallModeler has no parameter 'fricton'; did you mean 'friction'"),
+    ("parameters.KalmanBallModeler.friction=abc", "parameter KalmanBallModeler.friction takes float, got 'abc'"),
+])
+def test_set_is_validated_with_advice(setting: str, message: str) -> None:
+    result = dummy("--frames", "5", "--set", setting)
+    assert result.returncode == 2, result.stdout
+    assert message in result.stderr and "Traceback" not in result.stderr
+
+
+def test_add_and_remove_module_edit_the_lists_without_restating_them() -> None:
+    result = tafel("modules", "--platform", "dummy", "--remove-module", "cognition:LookAtBallBehavior",
+                   "--add-module", "cognition:SimpleBallModeler")
+    assert result.returncode == 2  # without the behaviour, nothing requests the head: HeadMotion needs it
+    assert "HeadMotionRequest" in result.stderr
+    result = tafel("modules", "--platform", "dummy", "--add-module", "motion:CameraMatrixProvider")
+    assert result.returncode == 0 and "CameraMatrixProvider" in result.stdout
+    wrong = tafel("modules", "--platform", "dummy", "--remove-module", "cognition:LookAtBehavior")
+    assert wrong.returncode == 2 and "did you mean 'LookAtBallBehavior'" in wrong.stderr
+    malformed = tafel("modules", "--platform", "dummy", "--add-module", "LookAtBallBehavior")
+    assert malformed.returncode == 2 and "takes CONTEXT:MODULE" in malformed.stderr

@@ -17,7 +17,7 @@ from importlib.metadata import version
 from pathlib import Path
 from typing import Any, NoReturn
 
-from tafel.core.config import load_config
+from tafel.core.config import edit_modules, load_config
 from tafel.core.dot import contexts_dot
 from tafel.core.errors import TafelError
 from tafel.core.platform import Platform, PlatformError, PlatformOptionError, available_platforms, load_platform
@@ -109,6 +109,10 @@ def add_program_arguments(parser: argparse.ArgumentParser) -> None:
                         help="override a configuration value, e.g. runtime.cognition_hz=15 (repeatable)")
     parser.add_argument("--strict", action="store_true",
                         help="modules the platform cannot feed are an error instead of being pruned")
+    parser.add_argument("--add-module", action="append", default=[], metavar="CONTEXT:MODULE",
+                        help="add a module to a context's list, e.g. cognition:SimpleBallModeler (repeatable)")
+    parser.add_argument("--remove-module", action="append", default=[], metavar="CONTEXT:MODULE",
+                        help="remove a module from a context's list (repeatable)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -188,6 +192,7 @@ def prepare(args: argparse.Namespace, extra: Sequence[str]) -> tuple[Platform, d
     platform = platform_class(vars(options))
     overrides = [f"runtime.{context}_hz={hz}" for context, hz in (platform.rates() or {}).items()]
     config = load_config(config_dirs(args), platform.config_layers(), args.robot, [*overrides, *args.overrides])
+    config = edit_modules(config, args.add_module, args.remove_module)
     plans = plan_program(config, platform, strict=args.strict)
     return platform, vars(options), plans, config
 
