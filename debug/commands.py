@@ -28,7 +28,7 @@ from tafel.core.naming import did_you_mean
 from tafel.core.parameters import ParameterError, parameter_values, set_parameter
 from tafel.core.representation import fields_of
 from tafel.core.serialization import SerializationError, deserialize, serialize
-from tafel.debug.concepts import STATE, DebugState
+from tafel.debug.concepts import CANVASES, STATE, DebugState
 from tafel.debug.protocol import Command
 
 
@@ -340,7 +340,11 @@ class ContextDebug:
 
     def cmd_drawings_get(self, command: Command) -> str:
         canvas = argument(command, "canvas", required=False)
-        drawings = [d for d in self.state.drawings_last.get(self.context, []) if not canvas or d["canvas"] == canvas]
+        drawings = self.state.drawings_last.get(self.context, [])
+        known = list(dict.fromkeys([*CANVASES, *(d["canvas"] for d in drawings)]))
+        if canvas and canvas not in known:
+            raise CommandError(f"there is no canvas {canvas!r}; {did_you_mean(canvas, known)}; the canvases are {', '.join(known)}")
+        drawings = [d for d in drawings if not canvas or d["canvas"] == canvas]
         return "\n".join(json.dumps({"context": self.context, **d}) for d in drawings)
 
     # ------------------------------------------------------------------------- parameters

@@ -177,6 +177,10 @@ def plot(name: str, value: float) -> None:
     found.values.append((STATE.frame.get(STATE.context, 0), float(value)))
 
 
+#: the canvases every viewer knows: the field (mm, field frame) and both images (px)
+CANVASES = ("field", "image:top", "image:bottom")
+
+
 def drawing(canvas: str = "field") -> Canvas:
     """A canvas of the current frame: ``field`` (mm, field frame) or ``image:top`` / ``image:bottom`` (px)."""
     return Canvas(canvas)

@@ -360,4 +360,13 @@ def test_console_runs_one_command_for_scripts(program: Program) -> None:
 
 def test_the_listening_line_and_port_conflicts(program: Program) -> None:
     taken = tafel("run", "--platform", "dummy", "--frames", "10", "--speed", "max", "--debug-port", str(program.port))
-    assert taken.returncode == 1 and f"cannot listen on 127.0.0.1:{program.port}" in taken.stderr
+    assert taken.returncode == 2 and f"debug port 127.0.0.1:{program.port} is taken" in taken.stderr
+
+
+def test_unknown_canvas_and_bytes_without_plus_say_what_would_be_right(program: Program) -> None:
+    answer = program.ask("drawings:get -canvas nosuch")
+    assert answer.startswith("error:") and "no canvas 'nosuch'" in answer and "field, image:top, image:bottom" in answer
+    close = program.ask("drawings:get -canvas image:tpo")
+    assert "did you mean 'image:top'" in close
+    raw = program.ask("representation:get -name BallModel")
+    assert raw.startswith("error:") and "+representation:get" in raw
