@@ -95,10 +95,6 @@ def plan_program(config: Mapping[str, Any], platform: type[Platform] | Platform,
     parameters = config.get("parameters", {})
     if not isinstance(parameters, Mapping):
         raise ConfigError("[parameters] must be a table of module tables")
-    for module_name, values in parameters.items():
-        find_module(module_name)  # a misspelt module must not silently lose its parameters
-        if not isinstance(values, Mapping):
-            raise ConfigError(f"parameters.{module_name} must be a table of parameter values, got {values!r}")
     plans: dict[str, ContextPlan] = {}
     for context in CONTEXTS:
         section = context_section(config, context)
@@ -118,6 +114,10 @@ def plan_program(config: Mapping[str, Any], platform: type[Platform] | Platform,
             platform_provides=list(platform.provides.get(context, ())),
             platform_consumes=list(platform.consumes.get(context, ())),
         )
+    for module_name, values in parameters.items():  # after the module lists, which import modules given by path
+        find_module(module_name)  # a misspelt module must not silently lose its parameters
+        if not isinstance(values, Mapping):
+            raise ConfigError(f"parameters.{module_name} must be a table of parameter values, got {values!r}")
     for plan in plans.values():
         from_platform = set(plan.platform_provides)
         for module in plan.modules:

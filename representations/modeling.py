@@ -22,3 +22,9 @@ class BallModel:
     vy: float = 0.0
     position_std: float = 0.0
     time_since_seen: float = 0.0
+
+    def status_text(self) -> str:
+        """One phrase for the status line of ``tafel run`` (``[status] show`` in configuration)."""
+        if not self.valid:
+            return "ball not seen"
+        return f"ball {'seen' if self.seen else 'remembered'} at x={self.x:.0f} y={self.y:.0f} mm"

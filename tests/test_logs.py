@@ -190,7 +190,7 @@ def test_export_csv_and_jsonl(recorded: Path, tmp_path: Path) -> None:
     assert result.returncode == 0, result.stderr
     lines = [json.loads(line) for line in out.read_text().splitlines()]
     assert len(lines) == 600 and len(lines[10]["position"]) == 25
-    assert "exporting JointSensorData [" in result.stderr  # progress bar for long logs
+    assert "exporting JointSensorData [" not in result.stderr  # no progress bar into a pipe
     wrong = tafel("log", "export", str(recorded), "--rep", "BallModle", "--format", "csv", "--out", str(out))
     assert wrong.returncode == 1 and "did you mean 'BallModel'" in wrong.stderr
 
@@ -294,3 +294,33 @@ def test_chunks_hold_at_most_one_second_of_log_time_at_any_speed(recorded: Path)
     with LogReader(recorded) as reader:  # recorded at --speed max: 6 s of log time in well under a second
         spans = [c.end_ns - c.start_ns for c in reader.chunks]
     assert len(spans) >= 6 and max(spans) < CHUNK_SPAN_NS
+
+
+def test_the_progress_bar_draws_only_on_a_terminal() -> None:
+    import io
+
+    from tafel.tools.log_tools import Progress
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    for stream, drawn in ((Terminal(), True), (io.StringIO(), False)):
+        progress = Progress("exporting X", 400, stream)
+        for done in range(1, 401):
+            progress.update(done)
+        progress.close()
+        assert ("exporting X [####################] 100% (400/400)" in stream.getvalue()) is drawn
+
+
+def test_exporting_images_from_a_representation_without_images_is_an_error(recorded: Path, tmp_path: Path) -> None:
+    result = tafel("log", "export", str(recorded), "--rep", "BallModel", "--format", "png", "--out", str(tmp_path / "png"))
+    assert result.returncode == 1
+    assert "BallModel holds no image" in result.stderr and "--format csv" in result.stderr
+
+
+def test_the_summary_goes_to_one_stream_and_ran_is_the_length() -> None:
+    result = dummy("--frames", "250", "--speed", "max")
+    assert result.returncode == 0
+    assert "platform dummy (lockstep): ran 2.500 s of platform time" in result.stdout
+    assert "wall time" in result.stdout and "fingerprint" in result.stdout and result.stderr == ""

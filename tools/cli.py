@@ -31,7 +31,6 @@ from tafel.core.runtime import (
     install_signal_handlers,
     program_fingerprint,
 )
-from tafel.representations.modeling import BallModel
 from tafel.tools.debugging import (
     DEBUG_REPRESENTATIONS,
     LocalExecutor,
@@ -198,36 +197,85 @@ def prepare(args: argparse.Namespace, extra: Sequence[str]) -> tuple[Platform, d
 
 
 # ----------------------------------------------------------------------------------------- run
-def format_status(platform: str, elapsed_s: float, stats: dict[str, ContextStats], notices: Sequence[str] = ()) -> str:
-    parts = [f"[tafel] {platform} t={elapsed_s:.1f}s"]
-    for name, s in stats.items():
-        parts.append(f"{name} {s.rate_hz:.1f} Hz {s.frames} frames")
-    errors = sum(s.module_errors for s in stats.values())
-    parts.append(f"module errors {errors}")
-    parts.extend(notices)
-    return " | ".join(parts)
+class StatusLine:
+    """The status line of a run: rates over the last interval, and what ``[status] show`` names.
+
+    Which representations appear is configuration, not code: each shows its ``status_text()`` where
+    it has one, and its scalar fields otherwise.
+    """
+
+    def __init__(self, platform: str, config: dict[str, Any]) -> None:
+        self.platform = platform
+        show = config.get("status", {}).get("show", []) if isinstance(config.get("status"), dict) else []
+        self.show = [str(name) for name in show] if isinstance(show, list) else []
+        self._last: dict[str, tuple[int, float]] = {}
+
+    def rates(self, stats: dict[str, ContextStats], now: float) -> dict[str, float]:
+        """Frames per second of each context since the previous line (since the start for the first)."""
+        rates = {}
+        for name, s in stats.items():
+            frames, then = self._last.get(name, (0, now - s.wall_s))
+            rates[name] = (s.frames - frames) / (now - then) if now > then else 0.0
+            self._last[name] = (s.frames, now)
+        return rates
+
+    def format(self, elapsed_s: float, stats: dict[str, ContextStats], now: float, runners: dict[str, Any] | None = None,
+               notices: Sequence[str] = ()) -> str:
+        parts = [f"[tafel] {self.platform} t={elapsed_s:.1f}s"]
+        rates = self.rates(stats, now)
+        for name, s in stats.items():
+            state = " FAILED" if s.failure else ""
+            parts.append(f"{name} {rates[name]:.1f} Hz {s.frames} frames{state}")
+        parts.append(f"module errors {sum(s.module_errors for s in stats.values())}")
+        parts.extend(self.shown(runners or {}))
+        parts.extend(notices)
+        return " | ".join(parts)
+
+    def shown(self, runners: dict[str, Any]) -> list[str]:
+        texts = []
+        for name in self.show:
+            for runner in runners.values():
+                blackboard = runner.manager.blackboard
+                if name in blackboard.names():
+                    texts.append(describe(blackboard.get(name)))
+                    break
+        return texts
 
 
-def print_summary(platform: str, mode: str, stats: dict[str, ContextStats], wall_s: float, sim_s: float | None, reason: str) -> None:
-    time_text = f"{sim_s:.3f} s of platform time" if sim_s is not None else f"{wall_s:.3f} s"
-    print(f"platform {platform} ({mode}): ran {time_text}" + (f", stopped after {reason}" if reason else ""))
+def describe(value: Any) -> str:
+    """A representation in a few words: its ``status_text()``, else its scalar fields."""
+    if hasattr(value, "status_text"):
+        return str(value.status_text())
+    scalars = [f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in vars(value).items()
+               if isinstance(v, (bool, int, float, str))]
+    return f"{type(value).__name__} " + " ".join(scalars[:6])
+
+
+def print_summary(platform: str, mode: str, stats: dict[str, ContextStats], wall_s: float, ran_s: float, reason: str,
+                  *, simulated: bool, notes: Sequence[str] = ()) -> None:
+    """The summary of a run, all on standard output: ``ran`` is the run's length (platform time covered
+    with a simulated clock, the loops' running time otherwise), never the clock's end value."""
+    out = sys.stdout
+    time_text = f"{ran_s:.3f} s of platform time" if simulated else f"{ran_s:.3f} s"
+    print(f"platform {platform} ({mode}): ran {time_text}" + (f", stopped after {reason}" if reason else ""), file=out)
+    for note in notes:
+        print(f"  {note}", file=out)
     for name, s in stats.items():
         errors = ", ".join(f"{m} {n}" for m, n in sorted(s.errors_by_module.items())) or "none"
         line = f"  {name}: {s.frames} frames, module errors: {errors}"
         if s.failure:
             line += f", FAILED: {s.failure}"
-        print(line)
+        print(line, file=out)
         if s.period_errors:
             timing = s.period_error_percentiles()
             print(f"    timing: period error p50 {timing['p50_ms']:.2f} ms, p99 {timing['p99_ms']:.2f} ms, "
                   f"max {timing['max_ms']:.2f} ms, missed_periods={s.missed_periods}"
-                  + (f", frames_without_cognition={s.frames_without_cognition}" if name == "motion" else ""))
+                  + (f", frames_without_cognition={s.frames_without_cognition}" if name == "motion" else ""), file=out)
     fingerprint = program_fingerprint(stats)
     if fingerprint:
-        print(f"fingerprint {fingerprint} (the state of every representation; equal runs and faithful replays print the same)")
+        print(f"fingerprint {fingerprint} (the state of every representation; equal runs and faithful replays print the same)", file=out)
     rates = ", ".join(f"{n} {s.rate_hz:.1f} Hz" for n, s in stats.items())
-    sys.stdout.flush()
-    print(f"wall time {wall_s:.2f} s ({rates})", file=sys.stderr)
+    print(f"wall time {wall_s:.2f} s ({rates})", file=out, flush=True)
 
 
 def command_run(args: argparse.Namespace, extra: Sequence[str]) -> int:
@@ -286,13 +334,14 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
     listen(args, debug)
     started = time.monotonic()
     last = [started]
+    line = StatusLine(type(platform).name, config)
 
     def status(rt: LockstepRuntime) -> None:
         now = time.monotonic()
         if now - last[0] >= args.status_interval:
             last[0] = now
             stats = {name: r.stats(now - started) for name, r in rt.runners.items()}
-            print(format_status(type(platform).name, rt.time_ns * 1e-9, stats, ball_status(rt.runners)), file=sys.stderr, flush=True)
+            status_print(line.format(rt.time_ns * 1e-9, stats, now, rt.runners))
 
     runtime.after_tick.append(status)
     try:
@@ -300,7 +349,7 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
     finally:
         if debug is not None:
             debug.server.stop()
-    print_summary(type(platform).name, "lockstep", stats, runtime.wall_s, runtime.time_ns * 1e-9, runtime.end_reason)
+    print_summary(type(platform).name, "lockstep", stats, runtime.wall_s, runtime.time_ns * 1e-9, runtime.end_reason, simulated=True)
     report_recording(recorder)
     return 0
 
@@ -322,12 +371,13 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
                                 recorder=recorder, worker_setup=setup, grace_s=shutdown_grace(config))
     started = time.monotonic()
     last = [started]
+    line = StatusLine(platform_class.name, config)
 
     def on_report(rt: ConcurrentRuntime) -> None:
         now = time.monotonic()
         if now - last[0] >= args.status_interval:
             last[0] = now
-            print(format_status(platform_class.name, now - started, rt.stats, rt.notices), file=sys.stderr, flush=True)
+            status_print(line.format(now - started, rt.stats, now, None, rt.notices))
 
     runtime.on_report.append(on_report)
     install_signal_handlers(runtime.stop, on_force=lambda: [p.kill() for p in runtime.processes.values()],
@@ -341,11 +391,9 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
         if debug is not None:
             debug.server.stop()
     realtime = stats.get("motion", ContextStats("motion")).realtime
-    if realtime:
-        print(f"motion: {realtime}", file=sys.stderr)
-    for notice in runtime.notices:
-        print(f"notice: {notice}", file=sys.stderr)
-    print_summary(platform_class.name, "concurrent", stats, time.monotonic() - started, None, "")
+    notes = ([f"motion: {realtime}"] if realtime else []) + [f"notice: {notice}" for notice in runtime.notices]
+    ran = max((s.wall_s for s in stats.values()), default=0.0)
+    print_summary(platform_class.name, "concurrent", stats, time.monotonic() - started, ran, "", simulated=False, notes=notes)
     report_recording(recorder)
     return 1 if any(s.failure for s in stats.values()) else 0
 
@@ -357,15 +405,12 @@ def debug_recorded(recorder: Recorder | None) -> dict[str, list[type]]:
     return {context: [s.rep for s in selections if s.source == "debug"] for context, selections in recorder.by_context.items()}
 
 
-def ball_status(runners: dict[str, Any]) -> list[str]:
-    """The ball as cognition believes it, for the status line."""
-    cognition = runners.get("cognition")
-    if cognition is None or BallModel not in cognition.manager.blackboard:
-        return []
-    ball = cognition.manager.blackboard[BallModel]
-    if not ball.valid:
-        return ["ball not seen"]
-    return [f"ball {'seen' if ball.seen else 'remembered'} at x={ball.x:.0f} y={ball.y:.0f} mm"]
+def status_print(text: str) -> None:
+    """A status line on stderr; a closed stream (``tafel run 2>&- ``, a gone terminal) never stops the run."""
+    try:
+        print(text, file=sys.stderr, flush=True)
+    except (OSError, ValueError):
+        pass
 
 
 def make_recorder(args: argparse.Namespace, plans: dict[str, ContextPlan], config: dict[str, Any], platform: str) -> Recorder | None:

@@ -170,23 +170,26 @@ def _flatten(fields: dict[str, Any], prefix: str = "") -> dict[str, Any]:
 
 
 class Progress:
-    """A progress bar on stderr for long exports (over 200 messages)."""
+    """A progress bar on stderr for long exports (over 200 messages), drawn only on a terminal:
+    carriage returns in a file or a pipe are noise."""
 
-    def __init__(self, label: str, total: int) -> None:
+    def __init__(self, label: str, total: int, stream: Any = None) -> None:
         self.label, self.total, self.shown = label, total, -1
+        self.stream = stream or sys.stderr
+        self.enabled = total >= 200 and bool(getattr(self.stream, "isatty", lambda: False)())
 
     def update(self, done: int) -> None:
-        if self.total < 200:
+        if not self.enabled:
             return
         percent = done * 100 // self.total
         if percent != self.shown:
             self.shown = percent
             bar = "#" * (percent // 5) + "-" * (20 - percent // 5)
-            print(f"\r{self.label} [{bar}] {percent:3d}% ({done}/{self.total})", end="", file=sys.stderr, flush=True)
+            print(f"\r{self.label} [{bar}] {percent:3d}% ({done}/{self.total})", end="", file=self.stream, flush=True)
 
     def close(self) -> None:
-        if self.total >= 200:
-            print(file=sys.stderr)
+        if self.enabled:
+            print(file=self.stream)
 
 
 def export(reader: LogReader, args: argparse.Namespace) -> int:
@@ -230,6 +233,9 @@ def _write(rows: Iterator[tuple[str, int, int, dict[str, Any]]], args: argparse.
 
         args.out.mkdir(parents=True, exist_ok=True)
         for done, (context, frame, _time, fields) in enumerate(rows, start=1):
+            if done == 1 and not any(isinstance(v, np.ndarray) and _is_image(v) for v in fields.values()):
+                raise LogError(f"{args.rep} holds no image (a uint8 array of height x width, with 1, 3 or 4 channels); "
+                               "export it with --format csv or --format jsonl")
             for name, value in fields.items():
                 if isinstance(value, np.ndarray) and _is_image(value):
                     image = cv2.cvtColor(value, cv2.COLOR_RGB2BGR) if value.ndim == 3 and value.shape[2] == 3 else value
