@@ -330,3 +330,27 @@ def test_add_and_remove_module_edit_the_lists_without_restating_them() -> None:
     assert wrong.returncode == 2 and "did you mean 'LookAtBallBehavior'" in wrong.stderr
     malformed = tafel("modules", "--platform", "dummy", "--add-module", "LookAtBallBehavior")
     assert malformed.returncode == 2 and "takes CONTEXT:MODULE" in malformed.stderr
+
+
+def test_status_line_rates_are_over_the_last_interval_and_shown_from_configuration() -> None:
+    from tafel.core.runtime import ContextStats
+    from tafel.tools.cli import StatusLine
+
+    line = StatusLine("dummy", {"status": {"show": []}})
+    first = line.format(10.0, {"motion": ContextStats("motion", frames=1000, wall_s=10.0)}, now=110.0)
+    assert "motion 100.0 Hz 1000 frames" in first
+    stalled = line.format(12.0, {"motion": ContextStats("motion", frames=1010, wall_s=12.0)}, now=112.0)
+    assert "motion 5.0 Hz 1010 frames" in stalled  # since start it would still say 84 Hz
+
+
+def test_the_tools_package_knows_no_representation_by_name() -> None:
+    from tafel.core.representation import registered_representations
+    from tafel.tools.cli import discover_modules
+
+    discover_modules()
+    names = set(registered_representations()) - {"DebugDrawings", "DebugPlots"}  # the debug data tools record
+    offenders = []
+    for path in (REPO / "tools").glob("*.py"):
+        text = path.read_text()
+        offenders += [f"{path.name}: {name}" for name in names if re.search(rf"\b{name}\b", text)]
+    assert not offenders, offenders

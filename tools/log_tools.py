@@ -32,7 +32,7 @@ def add_log_commands(commands: Any) -> None:
     info.add_argument("--json", action="store_true", help="print the information as JSON")
     export = actions.add_parser("export", help="representations as CSV or JSON lines, images as PNG files")
     export.add_argument("file", type=Path)
-    export.add_argument("--rep", required=True, help="representation name, e.g. BallModel")
+    export.add_argument("--rep", required=True, help="representation name (tafel log info lists them)")
     export.add_argument("--context", choices=["cognition", "motion"], help="only this context's channel")
     export.add_argument("--format", required=True, choices=["csv", "jsonl", "png"])
     export.add_argument("--out", required=True, type=Path, help="output file (csv, jsonl) or folder (png)")
