@@ -155,6 +155,16 @@ class _Request:
     command: Command
 
 
+HTTP_FIRST_WORDS = (b"GET ", b"POST ", b"PUT ", b"HEAD ", b"DELETE ", b"OPTIONS ", b"PATCH ", b"CONNECT ", b"TRACE ")
+
+
+def looks_like_http(line: bytes) -> bool:
+    """An HTTP request line or header (``POST / HTTP/1.1``, ``Host: ...``): no command ever looks like it."""
+    head = line.lstrip()
+    return head.startswith(HTTP_FIRST_WORDS) or head.lower().startswith((b"host:", b"user-agent:", b"content-")) \
+        or b" HTTP/1." in head
+
+
 class _Connection:
     def __init__(self, server: DebugServer, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         self.server = server
@@ -189,8 +199,17 @@ class _Connection:
         self._finish_if_done()
 
     def _line(self, raw: bytes | None) -> None:
+        if self.closed:
+            return
         if raw is not None and not raw.strip():
             return  # an empty line is no command: telnet users press enter
+        if self.next_sequence == 0 and raw is not None and looks_like_http(raw):
+            # A web page can make a browser send a POST here; its body would run as commands. Never.
+            log.warning("debug server: closed a connection from %s that speaks HTTP (%r); nothing was run",
+                        self.peer, raw[:60])
+            self.closed = True
+            self.writer.close()
+            return
         sequence = self.next_sequence
         self.next_sequence += 1
         if raw is None:

@@ -79,7 +79,8 @@ def config_dir(tmp_path_factory) -> Path:
 @pytest.fixture(scope="module")
 def program(config_dir: Path) -> Iterator[Program]:
     running = Program("--config", str(config_dir), "--set",
-                      f'cognition.modules=["KalmanBallModeler", "SimpleBallModeler", "LookAtBallBehavior", "{DEBUG_USER}"]')
+                      f'cognition.modules=["KalmanBallModeler", "SimpleBallModeler", "LookAtBallBehavior", "{DEBUG_USER}"]',
+                      cwd=config_dir.parent)  # recordings go into logs/ there
     yield running
     out, err = running.stop()
     assert running.process.returncode == 0, err
@@ -197,10 +198,10 @@ def test_parameters_list_get_set_store(program: Program, config_dir: Path) -> No
     assert "friction = 0.25" in (config_dir / "private" / "private.toml").read_text()
 
 
-def test_log_start_status_stop(program: Program, tmp_path: Path) -> None:
-    path = tmp_path / "debug.mcap"
+def test_log_start_status_stop(program: Program, config_dir: Path) -> None:
+    path = config_dir.parent / "logs" / "debug.mcap"
     assert json.loads(program.ask("log:status"))["recording"] is False
-    assert program.ask(f"log:start -file {path}") == f"recording to {path}"
+    assert program.ask("log:start -file debug.mcap") == f"recording to {path}"
     time.sleep(0.5)
     status = json.loads(program.ask("log:status"))
     assert status["recording"] and status["file"] == str(path)

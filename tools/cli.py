@@ -131,6 +131,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="seconds between status lines (default: %(default)s)")
     run.add_argument("-v", "--verbose", action="store_true", help="log informational messages")
     run.add_argument("--record", type=Path, metavar="FILE.mcap", help="record representations into an MCAP log")
+    run.add_argument("--record-dir", type=Path, default=Path("logs"), metavar="DIR",
+                     help="the only folder debug clients may record into with log:start (default: %(default)s)")
     run.add_argument("--record-reps", metavar="A,B",
                      help="what to record besides the sensor data (default: [recording] representations; 'all': everything)")
     run.add_argument("--debug-port", type=port_number, default=None, metavar="P", help=f"debug server port (default {DEFAULT_DEBUG_PORT}; 0 takes a free one)")
@@ -294,7 +296,8 @@ def start_debug(args: argparse.Namespace, recorder: Recorder | None, plans: dict
     if args.no_debug:
         return None
     port = DEFAULT_DEBUG_PORT if args.debug_port is None else args.debug_port
-    debug = ProgramDebug(host=args.debug_host, port=port, token=args.debug_token, config_dir=store_dir(args), recorder=recorder)
+    debug = ProgramDebug(host=args.debug_host, port=port, token=args.debug_token, config_dir=store_dir(args), recorder=recorder,
+                         record_dir=args.record_dir)
     started = datetime.datetime.now().astimezone().isoformat(timespec="seconds")
     debug.router.identity = f"tafel {version('tafel')}: platform {args.platform}, pid {os.getpid()}, started {started}"
     debug.handovers = handovers_of(plans)

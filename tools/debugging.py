@@ -199,17 +199,38 @@ def worker_debug_setup(runner: ContextRunner, args: Mapping[str, Any]) -> None:
     runner.idle = idle
 
 
+def recording_path(folder: Path, name: str) -> Path:
+    """Where ``log:start -file NAME`` records: a plain file name inside the recordings folder.
+
+    A client must never choose where the robot writes: a path, ``..``, or a name that is not an
+    ``.mcap`` file is refused with what would be right. (``--record FILE`` on the command line stays
+    free: the user typed it.)
+    """
+    if not name or name != Path(name).name or name in (".", "..") or "/" in name or "\\" in name or "\0" in name:
+        raise CommandError(f"log:start takes a plain file name such as run.mcap, not {name!r}; "
+                           f"recordings go into the recordings folder {folder} (--record-dir)")
+    if not name.endswith(".mcap"):
+        raise CommandError(f"log:start records MCAP files: name it {name}.mcap")
+    folder.mkdir(parents=True, exist_ok=True)
+    path = (folder / name).resolve()
+    if path.parent != folder.resolve():  # a symbolic link out of the folder, say
+        raise CommandError(f"{name} would leave the recordings folder {folder}")
+    return path
+
+
 class ProgramDebug:
     """The debug server of one program run, with the program-wide commands."""
 
     def __init__(self, *, host: str, port: int, token: str | None, config_dir: Path, recorder: Recorder | None,
-                 record_path_default: Path | None = None) -> None:
+                 record_path_default: Path | None = None, record_dir: Path = Path("logs")) -> None:
         self.router = DebugRouter()
         self.server = DebugServer(self.router, host, port, token=token)
         self.config_dir = config_dir
         self.recorder = recorder
         self.executors: dict[str, Any] = {}
         self.record_default = record_path_default or Path("tafel.mcap")
+        #: the only folder clients may record into (``--record-dir``)
+        self.record_dir = record_dir
         router = self.router
         router.register("modules:graph", "Graphviz DOT of both contexts and their hand-overs", "modules:graph", self._graph)
         router.register("modules:store", "write provider choices and disabled modules to config/private/private.toml", "modules:store", self._store_modules)
@@ -292,7 +313,8 @@ class ProgramDebug:
     def _log_start(self, command: Command) -> str:
         if self.recorder is None:
             raise CommandError("this run cannot record (no representations selected)")
-        path = Path(argument(command, "file", required=False) or self.record_default)
+        name = argument(command, "file", required=False) or self.record_default.name
+        path = recording_path(self.record_dir, name)
         self.recorder.start(path)
         return f"recording to {path}"
 
