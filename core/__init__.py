@@ -21,6 +21,7 @@ from tafel.core.module import Module, Requirements, provides, requires, uses
 from tafel.core.naming import snake_case
 from tafel.core.representation import (
     array,
+    bounded,
     fields_of,
     get_representation,
     is_representation,
@@ -48,6 +49,7 @@ __all__ = [
     "TafelError",
     "UnknownModuleError",
     "array",
+    "bounded",
     "deserialize",
     "fields_of",
     "get_representation",

@@ -68,6 +68,12 @@ def read_toml(path: Path) -> dict[str, Any]:
             return tomllib.load(handle)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: not valid TOML: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{path}: not UTF-8 text (byte {exc.start} is 0x{exc.object[exc.start]:02x}); "
+                          "TOML files must be saved as UTF-8") from None
+    except RecursionError:
+        raise ConfigError(f"{path}: nested too deeply to be configuration (arrays or tables inside each other "
+                          "hundreds of levels deep); configuration needs a few levels at most") from None
     except OSError as exc:
         raise ConfigError(f"{path}: cannot read: {exc.strerror}") from None
 

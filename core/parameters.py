@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import math
 import typing
 from collections.abc import Mapping
 from typing import Any
@@ -41,11 +42,14 @@ def coerce(module_name: str, field: dataclasses.Field, hint: Any, value: Any) ->
                 raise ValueError
             if isinstance(value, float) and not value.is_integer():
                 raise ValueError
-            return int(value)
+            return _within(where, field, int(value))
         if hint is float:
             if isinstance(value, bool):
                 raise ValueError
-            return float(value)
+            number = float(value)
+            if not math.isfinite(number):
+                raise ParameterError(f"parameter {where} takes a finite number, got {value!r}")
+            return _within(where, field, number)
         if hint is str:
             return str(value)
         if isinstance(hint, type) and issubclass(hint, enum.Enum):
@@ -63,6 +67,14 @@ def coerce(module_name: str, field: dataclasses.Field, hint: Any, value: Any) ->
             expected += " (" + ", ".join(m.name for m in hint) + ")"
         raise ParameterError(f"parameter {where} takes {expected}, got {value!r}") from None
     return value
+
+
+def _within(where: str, field: dataclasses.Field, number: Any) -> Any:
+    """``number`` if it lies in the field's declared range (``bounded`` or ``metadata={"range": ...}``)."""
+    bounds = field.metadata.get("range")
+    if bounds is not None and not bounds[0] <= number <= bounds[1]:
+        raise ParameterError(f"parameter {where} takes {bounds[0]:g} to {bounds[1]:g}, got {number:g}")
+    return number
 
 
 def make_parameters(module: type, values: Mapping[str, Any] | None = None) -> Any:

@@ -41,6 +41,17 @@ class EndOfData(TafelError):
     """The platform has no more data (end of a video or log without --loop): stop cleanly."""
 
 
+def seed_number(text: str) -> int:
+    """``--seed``: a whole number from 0 to 2**32 - 1 (what numpy's generators accept)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--seed takes a whole number from 0 to 4294967295, got {text!r}") from None
+    if not 0 <= value < 2**32:
+        raise argparse.ArgumentTypeError(f"--seed takes a whole number from 0 to 4294967295, got {value}")
+    return value
+
+
 class Platform:
     """Base class of all platforms. Subclasses fill ``provides`` and ``consumes`` and the methods."""
 

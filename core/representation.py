@@ -51,11 +51,32 @@ class FieldInfo:
     type: Any
     element: FieldInfo | None = None
     array: ArraySpec | None = None
+    #: (low, high) the field's numbers must lie in, declared with ``bounded`` (for arrays and lists: each element)
+    range: tuple[float, float] | None = None
 
 
 _REGISTRY: dict[str, type] = {}
 _FIELDS_ATTR = "__tafel_fields__"
 _ARRAY_META = "tafel_array"
+RANGE_META = "range"
+
+
+def bounded(low: float, high: float, default: Any = dataclasses.MISSING, *, array_shape: tuple[int | None, ...] | None = None,
+            dtype: Any = np.float64) -> Any:
+    """A field whose numbers lie in ``[low, high]``: checked for values from outside, used by test strategies.
+
+    ``distance: float = bounded(0.0, 9000.0)`` (default: ``low``, or 0 when it lies inside), or for an
+    array, ``stiffness: np.ndarray = bounded(0.0, 1.0, array_shape=(25,))``. The same as
+    ``field(metadata={"range": (low, high)})``.
+    """
+    if not low <= high:
+        raise RepresentationDefinitionError(f"bounded({low}, {high}): the low end must not be above the high end")
+    if array_shape is not None:
+        field = array(array_shape, dtype)
+        return dataclasses.field(default_factory=field.default_factory, metadata={**field.metadata, RANGE_META: (low, high)})
+    if default is dataclasses.MISSING:
+        default = 0.0 if low <= 0.0 <= high else low
+    return dataclasses.field(default=default, metadata={RANGE_META: (low, high)})
 
 
 def array(shape: tuple[int | None, ...] = (0,), dtype: Any = np.float64) -> Any:
@@ -237,6 +258,20 @@ def _default_factory(owner: str, field_name: str, hint: Any) -> Any:
 
 def _describe(owner: str, field_name: str, hint: Any, field: dataclasses.Field | None) -> FieldInfo:
     """Classify a field type, raising a clear error for anything unsupported."""
+    info = _classify(owner, field_name, hint, field)
+    bounds = field.metadata.get(RANGE_META) if field is not None else None
+    if bounds is None:
+        return info
+    low, high = (float(v) for v in bounds)
+    numeric = info.kind in ("int", "float", "ndarray") or (info.element is not None and info.element.kind in ("int", "float"))
+    if not numeric or not low <= high:
+        raise RepresentationDefinitionError(f"{owner}.{field_name}: a range (low <= high) fits only numbers, numeric "
+                                            f"arrays and lists of numbers; got {bounds!r} on a {info.kind} field")
+    element = dataclasses.replace(info.element, range=(low, high)) if info.element is not None else None
+    return dataclasses.replace(info, range=(low, high), element=element)
+
+
+def _classify(owner: str, field_name: str, hint: Any, field: dataclasses.Field | None) -> FieldInfo:
     origin = typing.get_origin(hint)
     if hint in SCALAR_KINDS:
         return FieldInfo(field_name, SCALAR_KINDS[hint], hint)

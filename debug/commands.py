@@ -26,7 +26,8 @@ from tafel.core.errors import TafelError
 from tafel.core.manager import ModuleManager
 from tafel.core.naming import did_you_mean
 from tafel.core.parameters import ParameterError, parameter_values, set_parameter
-from tafel.core.representation import fields_of
+from tafel.core.representation import FieldInfo, fields_of
+from tafel.core.validation import ValueCheckError, check_field, check_instance, check_number
 from tafel.core.serialization import SerializationError, deserialize, serialize
 from tafel.debug.concepts import CANVASES, STATE, DebugState
 from tafel.debug.protocol import Command
@@ -157,6 +158,46 @@ def _coerce_like(current: Any, text: str, what: str) -> Any:
     raise CommandError(f"{what} holds {type(current).__name__}; {text!r} is not one")
 
 
+def parse_field_text(info: FieldInfo, text: str, where: str) -> Any:
+    """The text of ``-value`` read as the field's kind (numbers, on/off, enum names, JSON arrays); checked later."""
+    try:
+        if info.kind == "bool":
+            return parse_bool(text, where)
+        if info.kind == "int":
+            return int(text)
+        if info.kind == "float":
+            return float(text)
+        if info.kind == "enum":
+            return info.type[text]
+        if info.kind == "str":
+            return text
+        if info.kind in ("ndarray", "list"):
+            values = json.loads(text)
+            if info.kind == "list" and info.element is not None and info.element.kind == "nested":
+                raise CommandError(f"{where} holds a list of {info.element.type.__name__}; set it with +data (protobuf bytes)")
+            return values
+    except KeyError:
+        raise CommandError(f"{where} takes one of {', '.join(m.name for m in info.type)}, got {text!r}") from None
+    except (ValueError, json.JSONDecodeError):
+        raise CommandError(f"{where} takes {'a JSON array such as [0.1, 0.2]' if info.kind in ('ndarray', 'list') else info.kind}, "
+                           f"got {text!r}") from None
+    raise CommandError(f"{where} is a {info.kind} field; set it with +data (protobuf bytes) or one of its fields (-field {where.split('.', 1)[-1]}.NAME)")
+
+
+def _check_like(current: Any, value: Any, what: str) -> Any:
+    """A pinned modify value must be of the published value's kind: finite numbers, the same array shape."""
+    if isinstance(current, float):
+        return check_number(value, what)
+    if isinstance(current, np.ndarray):
+        if value.shape != current.shape:
+            raise CommandError(f"{what} is an array of shape {current.shape}; got shape {value.shape}")
+        if value.dtype.kind == "f" and not np.isfinite(value).all():
+            raise CommandError(f"{what} takes finite numbers; got {value.tolist()}")
+    if isinstance(current, list) and any(isinstance(v, float) and not np.isfinite(v) for v in value):
+        raise CommandError(f"{what} takes finite numbers; got {value}")
+    return value
+
+
 class ContextDebug:
     """Answers debug commands about one context; call ``execute`` between that context's frames."""
 
@@ -182,7 +223,7 @@ class ContextDebug:
             return "ok", handler(command)
         except NotHere as missing:
             return "missing", json.dumps([missing.kind, missing.name, missing.known])
-        except (CommandError, ParameterError, SerializationError, TafelError) as exc:
+        except (CommandError, ParameterError, SerializationError, ValueCheckError, TafelError) as exc:
             return "error", str(exc)
         except Exception as exc:  # noqa: BLE001 - a handler bug must not take the loop down
             return "error", f"{command.name} failed: {type(exc).__name__}: {exc}"
@@ -266,14 +307,25 @@ class ContextDebug:
         rep = self._representation(command)
         data = command.args.get("data")
         if isinstance(data, bytes):
-            self.manager.blackboard.set(deserialize(type(rep), data))
+            value = deserialize(type(rep), data)
+            check_instance(value)  # finite, the declared shapes and ranges: or nothing changes
+            self.manager.blackboard.set(value)
             return f"{type(rep).__name__} set from {len(data)} bytes"
-        field_name = argument(command, "field", positional=False)
-        if field_name not in {f.name for f in fields_of(type(rep))}:
-            raise CommandError(f"{type(rep).__name__} has no field {field_name!r}; {did_you_mean(field_name, [f.name for f in fields_of(type(rep))])}")
-        value = _coerce_like(getattr(rep, field_name), argument(command, "value", positional=False), f"{type(rep).__name__}.{field_name}")
-        setattr(rep, field_name, value)
-        return f"{type(rep).__name__}.{field_name} = {_short(value)}"
+        path = argument(command, "field", positional=False)
+        *parents, name = path.split(".")
+        owner = rep
+        for part in parents:  # -field ball.x: a field of a nested dataclass
+            if part not in {f.name for f in fields_of(type(owner))} or not dataclasses.is_dataclass(getattr(owner, part)):
+                raise CommandError(f"{type(owner).__name__} has no nested field {part!r}; the fields are "
+                                   f"{', '.join(f.name for f in fields_of(type(owner)))}")
+            owner = getattr(owner, part)
+        infos = {f.name: f for f in fields_of(type(owner))}
+        if name not in infos:
+            raise CommandError(f"{type(owner).__name__} has no field {name!r}; {did_you_mean(name, infos)}")
+        where = f"{type(rep).__name__}.{path}"
+        value = check_field(type(owner), name, parse_field_text(infos[name], argument(command, "value", positional=False), where), where)
+        setattr(owner, name, value)
+        return f"{where} = {_short(value)}"
 
     # --------------------------------------------------------------------- debug concepts
     def _mine(self, items: Mapping[str, Any]) -> dict[str, Any]:
@@ -309,7 +361,8 @@ class ContextDebug:
 
     def cmd_modify_set(self, command: Command) -> str:
         found = self._named(command, self.state.modifies, "modify")
-        found.pinned_value = _coerce_like(found.value, argument(command, "value", positional=False), found.name)
+        found.pinned_value = _check_like(found.value, _coerce_like(found.value, argument(command, "value", positional=False), found.name),
+                                         found.name)
         found.pinned = True
         return f"{found.name} pinned to {_short(found.pinned_value)}"
 

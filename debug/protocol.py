@@ -169,6 +169,10 @@ class TelnetDecoder:
     Accepts ``\\n``, ``\\r\\n`` and ``\\r\\0`` line ends; ``IAC IAC`` is a literal 0xFF. State survives
     chunk boundaries. Lines longer than ``MAX_LINE`` are reported (``None`` in the output) and skipped; a
     subnegotiation that does not end within ``MAX_SUBNEGOTIATION`` bytes is given up.
+
+    The input is scanned in bulk (a regular expression finds the next IAC or line end, and the bytes
+    between are copied in one piece), never byte by byte in Python: a client streaming garbage costs
+    the program little more than the copy, and holds the interpreter lock only briefly.
     """
 
     def __init__(self, max_line: int = MAX_LINE) -> None:
@@ -181,17 +185,36 @@ class TelnetDecoder:
 
     def feed(self, data: bytes) -> list[bytes | None]:
         lines: list[bytes | None] = []
-        for byte in data:
+        position, length = 0, len(data)
+        while position < length:
             state = self.state
             if state == "data":
+                if self.pending_cr:  # \r ends the line; a \n or \0 right after it belongs to it
+                    self.pending_cr = False
+                    self._end_line(lines)
+                    if data[position] in (0, 10):
+                        position += 1
+                    continue
+                match = _SPECIAL.search(data, position)
+                end = match.start() if match else length
+                if end > position:
+                    self._append(data, position, end)
+                if match is None:
+                    break
+                byte, position = data[end], end + 1
                 if byte == IAC:
                     self.state = "iac"
-                    continue
-                self._data(byte, lines)
-            elif state == "iac":
+                elif byte == 10:
+                    self._end_line(lines)
+                else:
+                    self.pending_cr = True
+                continue
+            byte = data[position]
+            if state == "iac":
+                position += 1
                 if byte == IAC:
                     self.state = "data"
-                    self._data(IAC, lines)
+                    self._append(b"\xff", 0, 1)
                 elif byte in _NEGOTIATION:
                     self.state = "option"
                 elif byte == SB:
@@ -200,37 +223,30 @@ class TelnetDecoder:
                 else:
                     self.state = "data"  # two-byte command (NOP, GA, ...)
             elif state == "option":
+                position += 1
                 self.state = "data"
             elif state == "sub":
-                self.sub_length += 1
-                if byte == IAC:
-                    self.state = "sub-iac"
-                elif self.sub_length > MAX_SUBNEGOTIATION:
-                    self.state = "data"  # no IAC SE came: not a subnegotiation after all
-                    self._data(byte, lines)
-            elif state == "sub-iac":
+                room = MAX_SUBNEGOTIATION - self.sub_length  # bytes that may still belong to it
+                stop = min(length, position + room + 1)
+                found = data.find(IAC, position, stop)
+                if found >= 0:
+                    self.sub_length += found - position + 1
+                    self.state, position = "sub-iac", found + 1
+                elif stop - position > room:  # no IAC SE came: not a subnegotiation after all
+                    self.sub_length = MAX_SUBNEGOTIATION + 1
+                    self.state, position = "data", position + room
+                else:
+                    self.sub_length += stop - position
+                    position = stop
+            else:  # sub-iac
+                position += 1
                 self.state = "data" if byte == SE else "sub"
         return lines
 
-    def _data(self, byte: int, lines: list[bytes | None]) -> None:
-        if self.pending_cr:
-            self.pending_cr = False
-            if byte == 0:  # \r\0 is a bare carriage return: end of line
-                self._end_line(lines)
-                return
-            if byte == 10:
-                self._end_line(lines)
-                return
-            self._end_line(lines)
-        if byte == 13:
-            self.pending_cr = True
-            return
-        if byte == 10:
-            self._end_line(lines)
-            return
+    def _append(self, data: bytes, start: int, end: int) -> None:
         if self.overlong:
             return
-        self.buffer.append(byte)
+        self.buffer += data[start:end]
         if len(self.buffer) > self.max_line:
             self.overlong = True
             self.buffer.clear()
@@ -239,3 +255,6 @@ class TelnetDecoder:
         lines.append(None if self.overlong else bytes(self.buffer))
         self.buffer.clear()
         self.overlong = False
+
+
+_SPECIAL = re.compile(rb"[\r\n\xff]")

@@ -32,6 +32,11 @@ log = logging.getLogger("tafel.debug")
 
 MAX_OUTSTANDING = 2000  # open commands per connection before it is read no more
 MAX_OUTPUT = 8 << 20  # unsent answer bytes per connection before it is dropped
+MAX_CONNECTIONS = 32  # connections served at once; more get one error line and are closed
+MAX_BYTES_PER_FRAME = 64 * 1024  # bytes read from one client per frame; it waits for the next frame beyond
+FRAME_WAIT = 0.05  # s a throttled client waits at most when no frame comes (a paused or ended loop)
+AUTH_PER_SECOND = 5  # auth attempts per connection and second; more are answered later
+AUTH_FAILURES = 20  # wrong tokens before the connection is closed
 
 
 class Executor:
@@ -178,6 +183,9 @@ class _Connection:
         self.closed = False
         self.reading_done = False
         self.peer = writer.get_extra_info("peername")
+        self.frame_bytes = 0  # read in the current frame
+        self.auth_times: deque[float] = deque(maxlen=AUTH_PER_SECOND)
+        self.auth_failures = 0
 
     async def serve(self) -> None:
         decoder = TelnetDecoder(self.server.max_line)
@@ -187,10 +195,16 @@ class _Connection:
                 if not data:
                     break
                 for line in decoder.feed(data):
+                    if line is not None and line.lstrip()[:4] == b"auth":
+                        await self._pace_auth()
                     self._line(line)
                 while self.outstanding > MAX_OUTSTANDING and not self.closed:
                     self.room.clear()
                     await self.room.wait()
+                self.frame_bytes += len(data)
+                if self.frame_bytes > self.server.max_bytes_per_frame:
+                    await self.server.next_frame_started()  # read no further from it this frame
+                    self.frame_bytes = 0
         except (ConnectionError, asyncio.IncompleteReadError):
             self.drop()
             return
@@ -207,8 +221,7 @@ class _Connection:
             # A web page can make a browser send a POST here; its body would run as commands. Never.
             log.warning("debug server: closed a connection from %s that speaks HTTP (%r); nothing was run",
                         self.peer, raw[:60])
-            self.closed = True
-            self.writer.close()
+            self.drop()
             return
         sequence = self.next_sequence
         self.next_sequence += 1
@@ -228,6 +241,12 @@ class _Connection:
             if self.server.token is None or hmac.compare_digest(str(token).encode(), self.server.token.encode()):
                 self.authenticated = True
                 self.deliver(sequence, answer_bytes("authenticated"))
+                return
+            self.auth_failures += 1
+            if self.auth_failures >= AUTH_FAILURES:
+                log.warning("debug server: closed %s after %d wrong tokens", self.peer, self.auth_failures)
+                self.deliver(sequence, answer_bytes(f"error: wrong token; {AUTH_FAILURES} wrong tokens, closing"))
+                self.close()
             else:
                 self.deliver(sequence, answer_bytes("error: wrong token"))
             return
@@ -240,6 +259,13 @@ class _Connection:
             return
         self.outstanding += 1
         self.server.pending.put(_Request(self, sequence, command))
+
+    async def _pace_auth(self) -> None:
+        """At most ``AUTH_PER_SECOND`` attempts a second: guessing a token takes forever."""
+        now = time.monotonic()
+        if len(self.auth_times) == AUTH_PER_SECOND and now - self.auth_times[0] < 1.0:
+            await asyncio.sleep(1.0 - (now - self.auth_times[0]))
+        self.auth_times.append(time.monotonic())
 
     def deliver(self, sequence: int, data: bytes) -> None:
         """Network thread: keep the answer and send every answer that is next in order."""
@@ -276,6 +302,14 @@ class _Connection:
             self.writer.close()  # graceful: what is buffered still goes out
             self.server.connections.discard(self)
 
+    def close(self) -> None:
+        """Close after what is already written has gone out; nothing more is read or answered."""
+        if not self.closed:
+            self.closed = True
+            self.room.set()
+            self.writer.close()
+            self.server.connections.discard(self)
+
     def drop(self) -> None:
         """Close at once, discarding unsent answers (a client that does not read, or is gone)."""
         if not self.closed:
@@ -289,12 +323,21 @@ class DebugServer:
     """The debug server; ``start`` binds and prints nothing, ``address`` says where it listens."""
 
     def __init__(self, router: DebugRouter, host: str = "127.0.0.1", port: int = 5401, *, token: str | None = None,
-                 max_line: int = 64 * 1024, max_output: int = MAX_OUTPUT) -> None:
+                 max_line: int = 64 * 1024, max_output: int = MAX_OUTPUT, max_connections: int = MAX_CONNECTIONS,
+                 max_bytes_per_frame: int = MAX_BYTES_PER_FRAME) -> None:
+        if token is not None and not token:
+            raise ValueError("an empty debug token would let anybody in; give a token or none")
         self.router = router
         self.host, self.port = host, port
         self.token = token
         self.max_line = max_line
         self.max_output = max_output
+        self.max_connections = max_connections
+        self.max_bytes_per_frame = max_bytes_per_frame
+        self.refused = 0  # connections refused over the limit
+        self._frame: asyncio.Event | None = None  # set (and replaced) when a frame starts, for throttled clients
+        self._throttled = 0
+        self._resource_errors = 0
         self.pending: queue.SimpleQueue[_Request] = queue.SimpleQueue()
         self._queues: dict[_Connection, deque[_Request]] = {}
         self._turns: deque[_Connection] = deque()  # connections with queued commands, in rotation
@@ -325,9 +368,20 @@ class DebugServer:
         asyncio.set_event_loop(loop)
 
         async def accept(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+            if len(self.connections) >= self.max_connections:
+                self.refused += 1
+                if self.refused == 1 or self.refused % 100 == 0:
+                    log.warning("debug server: refused %d connection(s) over the limit of %d", self.refused, self.max_connections)
+                writer.write(answer_bytes(f"error: too many debug connections ({self.max_connections} at most); "
+                                          "close another one and connect again"))
+                writer.close()
+                return
             connection = _Connection(self, reader, writer)
             self.connections.add(connection)
             await connection.serve()
+
+        loop.set_exception_handler(self._loop_error)
+        self._frame = asyncio.Event()
 
         try:
             self._server = loop.run_until_complete(asyncio.start_server(accept, self.host, self.port, limit=self.max_line * 2))
@@ -342,6 +396,42 @@ class DebugServer:
         finally:
             loop.run_until_complete(loop.shutdown_asyncgens())
             loop.close()
+
+    def _loop_error(self, loop: asyncio.AbstractEventLoop, context: dict[str, Any]) -> None:
+        """asyncio's errors as one line each, never a traceback per failed accept.
+
+        When file descriptors run out, asyncio retries ``accept`` every second and would log a
+        traceback each time: here the first is one line, and every hundredth after it another.
+        """
+        self._resource_errors += 1
+        if self._resource_errors == 1 or self._resource_errors % 100 == 0:
+            exc = context.get("exception")
+            log.error("debug server: %s%s (%d so far; the program goes on)", context.get("message", "error"),
+                      f": {exc}" if exc else "", self._resource_errors)
+
+    async def next_frame_started(self) -> None:
+        """Network thread: wait until the next frame starts (or ``FRAME_WAIT``, if none comes)."""
+        event = self._frame
+        if event is None:
+            return
+        self._throttled += 1
+        try:
+            await asyncio.wait_for(event.wait(), FRAME_WAIT)
+        except asyncio.TimeoutError:
+            pass
+        finally:
+            self._throttled -= 1
+
+    def next_frame(self) -> None:
+        """A frame starts: clients that used up their bytes may be read again. Costs nothing when none did."""
+        loop = self._loop
+        if self._throttled and loop is not None:
+            loop.call_soon_threadsafe(self._wake_throttled)
+
+    def _wake_throttled(self) -> None:
+        if self._frame is not None:
+            self._frame.set()
+            self._frame = asyncio.Event()
 
     def stop(self) -> None:
         loop = self._loop
@@ -399,6 +489,7 @@ class DebugServer:
     def process_pending(self, budget_s: float = 0.001, chunk: int = 8) -> int:
         """Between frames: answer queued commands for at most about ``budget_s``; the rest next frame."""
         start = time.perf_counter()
+        self.next_frame()
         self._collect()
         answered = 0
         while time.perf_counter() - start < budget_s:
@@ -444,6 +535,7 @@ class DebugServer:
     def dispatch_forever(self, stop: Any, timeout: float = 0.1, chunk: int = 32) -> None:
         """For contexts in other processes: answer batches as they come until ``stop`` is set."""
         while not stop.is_set():
+            self.next_frame()
             self._collect(wait=timeout)
             batch = self._next_batch(chunk)
             if batch:

@@ -15,7 +15,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from tafel.core.manager import Blackboard
-from tafel.core.platform import Platform
+from tafel.core.platform import Platform, seed_number
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import HEAD_YAW, JOINT_COUNT, FsrData, InertialSensorData, JointCommand, JointSensorData
 from tafel.representations.perception import BallPercept
@@ -51,7 +51,7 @@ class DummyPlatform(Platform):
 
     @classmethod
     def add_arguments(cls, parser: argparse.ArgumentParser) -> None:
-        parser.add_argument("--seed", type=int, default=0, help="dummy: seed of the synthetic sensor noise")
+        parser.add_argument("--seed", type=seed_number, default=0, help="dummy: seed of the synthetic sensor noise")
 
     def start(self, contexts: frozenset[str]) -> None:
         self.simulates_joints = "motion" in contexts

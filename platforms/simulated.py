@@ -18,7 +18,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from tafel.core.manager import Blackboard
-from tafel.core.platform import Platform, PlatformOptionError
+from tafel.core.platform import Platform, PlatformOptionError, seed_number
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import JOINT_NAMES, FsrData, InertialSensorData, JointCommand, JointSensorData
 from tafel.representations.nao import VERTICAL_FOV
@@ -94,7 +94,7 @@ class SimulatedRobotPlatform(Platform):
     @classmethod
     def add_arguments(cls, parser: argparse.ArgumentParser) -> None:
         name = cls.name
-        parser.add_argument("--seed", type=int, default=0, help=f"{name}: seed of the sensor noise")
+        parser.add_argument("--seed", type=seed_number, default=0, help=f"{name}: seed of the sensor noise")
         parser.add_argument("--cameras", choices=["on", "off"], default="on", help=f"{name}: render the cameras")
         parser.add_argument("--resolution", default="320x240", help=f"{name}: camera image size WIDTHxHEIGHT")
         parser.add_argument("--ball", default="1000,300", help=f"{name}: ball start X,Y in mm on the field")

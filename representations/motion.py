@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tafel.core import array, representation
+from tafel.core import array, bounded, representation
 
 JOINT_NAMES: tuple[str, ...] = (
     "HeadYaw", "HeadPitch",
@@ -75,7 +75,7 @@ class JointCommand:
     """What the actuators get this motion frame: ``position`` (rad) and ``stiffness`` (0..1) per joint."""
 
     position: np.ndarray = array((JOINT_COUNT,))
-    stiffness: np.ndarray = array((JOINT_COUNT,))
+    stiffness: np.ndarray = bounded(0.0, 1.0, array_shape=(JOINT_COUNT,))
 
 
 @representation

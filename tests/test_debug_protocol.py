@@ -111,3 +111,82 @@ def test_an_endless_subnegotiation_is_given_up_and_lines_follow() -> None:
     decoder = TelnetDecoder()
     lines = decoder.feed(bytes([255, 250]) + b"x" * 600 + b"\nping\n")
     assert lines[-1] == b"ping"
+
+
+class ByteByByteDecoder:
+    """The telnet rules written the slow, obvious way, one byte at a time: the reference for the bulk decoder."""
+
+    def __init__(self, max_line: int) -> None:
+        self.max_line, self.buffer, self.state, self.sub, self.overlong, self.cr = max_line, bytearray(), "data", 0, False, False
+
+    def feed(self, data: bytes) -> list[bytes | None]:
+        lines: list[bytes | None] = []
+        for byte in data:
+            if self.state == "data":
+                if byte == 255:
+                    self.state = "iac"
+                else:
+                    self.data(byte, lines)
+            elif self.state == "iac":
+                self.state = "data"
+                if byte == 255:
+                    self.data(255, lines)
+                elif byte in (251, 252, 253, 254):
+                    self.state = "option"
+                elif byte == 250:
+                    self.state, self.sub = "sub", 0
+            elif self.state == "option":
+                self.state = "data"
+            elif self.state == "sub":
+                self.sub += 1
+                if byte == 255:
+                    self.state = "sub-iac"
+                elif self.sub > 512:
+                    self.state = "data"
+                    self.data(byte, lines)
+            else:
+                self.state = "data" if byte == 240 else "sub"
+        return lines
+
+    def data(self, byte: int, lines: list[bytes | None]) -> None:
+        if self.cr:
+            self.cr = False
+            self.end(lines)
+            if byte in (0, 10):
+                return
+        if byte == 13:
+            self.cr = True
+        elif byte == 10:
+            self.end(lines)
+        elif not self.overlong:
+            self.buffer.append(byte)
+            if len(self.buffer) > self.max_line:
+                self.overlong, self.buffer = True, bytearray()
+
+    def end(self, lines: list[bytes | None]) -> None:
+        lines.append(None if self.overlong else bytes(self.buffer))
+        self.buffer, self.overlong = bytearray(), False
+
+
+# bytes that matter to telnet, so that random streams hit every state often
+TELNET_BYTES = st.sampled_from([0, 10, 13, 240, 250, 251, 253, 255, 65, 66])
+
+
+@given(st.lists(st.one_of(TELNET_BYTES, st.integers(0, 255)), max_size=1500), st.lists(st.integers(1, 200), max_size=20),
+       st.sampled_from([5, 40, 1000]))
+def test_the_bulk_decoder_splits_lines_exactly_as_the_byte_rules_say(data: list[int], cuts: list[int], max_line: int) -> None:
+    stream = bytes(data)
+    reference, bulk = ByteByByteDecoder(max_line), TelnetDecoder(max_line)
+    expected = reference.feed(stream)
+    got: list[bytes | None] = []
+    position = 0
+    for cut in [*cuts, len(stream)]:  # the same stream, arriving in chunks of any size
+        got += bulk.feed(stream[position:position + cut])
+        position += cut
+    got += bulk.feed(stream[position:])
+    assert got == expected
+
+
+def test_a_long_subnegotiation_without_end_gives_way_to_data_at_the_same_byte_as_byte_rules() -> None:
+    stream = bytes([255, 250]) + b"y" * 512 + b"ping\n"
+    assert TelnetDecoder().feed(stream) == ByteByByteDecoder(64 * 1024).feed(stream) == [b"ping"]

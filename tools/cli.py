@@ -6,7 +6,9 @@ import argparse
 import datetime
 import errno
 import importlib
+import ipaddress
 import logging
+import math
 import os
 import pkgutil
 import sys
@@ -80,7 +82,7 @@ def positive(kind: type) -> Any:
             value = kind(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"expected a {'whole ' if kind is int else ''}number, got {text!r}") from None
-        if value <= 0:
+        if not math.isfinite(value) or value <= 0:
             raise argparse.ArgumentTypeError(f"expected a number greater than zero, got {text}")
         return value
 
@@ -137,7 +139,12 @@ def build_parser() -> argparse.ArgumentParser:
                      help="what to record besides the sensor data (default: [recording] representations; 'all': everything)")
     run.add_argument("--debug-port", type=port_number, default=None, metavar="P", help=f"debug server port (default {DEFAULT_DEBUG_PORT}; 0 takes a free one)")
     run.add_argument("--debug-host", default="127.0.0.1", metavar="H", help="debug server address (default: %(default)s)")
-    run.add_argument("--debug-token", metavar="T", help="clients must send 'auth T' first")
+    token = run.add_mutually_exclusive_group()
+    token.add_argument("--debug-token", metavar="T", help="clients must send 'auth T' first")
+    token.add_argument("--debug-token-file", type=Path, metavar="F",
+                       help="read the token from a file (it then does not show in ps); a trailing newline is dropped")
+    run.add_argument("--debug-max-connections", type=positive(int), default=32, metavar="N",
+                     help="debug connections served at once; more get an error line (default: %(default)s)")
     run.add_argument("--no-debug", action="store_true", help="run without the debug server")
 
     from tafel.tools.log_tools import add_log_commands
@@ -296,12 +303,44 @@ def start_debug(args: argparse.Namespace, recorder: Recorder | None, plans: dict
     if args.no_debug:
         return None
     port = DEFAULT_DEBUG_PORT if args.debug_port is None else args.debug_port
-    debug = ProgramDebug(host=args.debug_host, port=port, token=args.debug_token, config_dir=store_dir(args), recorder=recorder,
-                         record_dir=args.record_dir)
+    token = debug_token(args)
+    if token is None and not is_loopback(args.debug_host):
+        print(f"warning: the debug server listens on {args.debug_host} without a token: anybody on that network can "
+              "steer this program and record on it; give one with --debug-token-file F (or --debug-token T)",
+              file=sys.stderr, flush=True)
+    debug = ProgramDebug(host=args.debug_host, port=port, token=token, config_dir=store_dir(args), recorder=recorder,
+                         record_dir=args.record_dir, max_connections=args.debug_max_connections)
     started = datetime.datetime.now().astimezone().isoformat(timespec="seconds")
     debug.router.identity = f"tafel {version('tafel')}: platform {args.platform}, pid {os.getpid()}, started {started}"
     debug.handovers = handovers_of(plans)
     return debug
+
+
+def debug_token(args: argparse.Namespace) -> str | None:
+    """The token from ``--debug-token`` or ``--debug-token-file``; an empty one is an error, never 'no token'."""
+    if args.debug_token_file is not None:
+        try:
+            token = args.debug_token_file.read_text(encoding="utf-8").rstrip("\r\n")
+        except (OSError, UnicodeDecodeError) as exc:
+            fail(f"--debug-token-file {args.debug_token_file}: cannot read it ({getattr(exc, 'strerror', None) or exc})")
+        if not token.strip():
+            fail(f"--debug-token-file {args.debug_token_file} is empty; put the token in it, or leave the option out")
+        if "\n" in token or "\r" in token:
+            fail(f"--debug-token-file {args.debug_token_file} holds several lines; the token is one line")
+        return token
+    if args.debug_token is not None and not args.debug_token.strip():
+        fail("--debug-token is empty, which would let anybody in; give a token, or leave the option out")
+    return args.debug_token
+
+
+def is_loopback(host: str) -> bool:
+    """Whether ``host`` is reachable only from this machine (127.0.0.0/8, ::1, localhost)."""
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
 
 
 def listen(args: argparse.Namespace, debug: ProgramDebug | None) -> None:

@@ -222,9 +222,9 @@ class ProgramDebug:
     """The debug server of one program run, with the program-wide commands."""
 
     def __init__(self, *, host: str, port: int, token: str | None, config_dir: Path, recorder: Recorder | None,
-                 record_path_default: Path | None = None, record_dir: Path = Path("logs")) -> None:
+                 record_path_default: Path | None = None, record_dir: Path = Path("logs"), max_connections: int = 32) -> None:
         self.router = DebugRouter()
-        self.server = DebugServer(self.router, host, port, token=token)
+        self.server = DebugServer(self.router, host, port, token=token, max_connections=max_connections)
         self.config_dir = config_dir
         self.recorder = recorder
         self.executors: dict[str, Any] = {}
