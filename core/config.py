@@ -219,9 +219,28 @@ def store_private(config_dir: Path, path: list[str], value: Any) -> Path:
     for part in path[:-1]:
         node = node.setdefault(part, {})
     node[path[-1]] = value
+    text = dump_toml(data)
+    try:  # never write what would not load again: the next start would fail on it
+        loaded = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"cannot store {'.'.join(path)} = {value!r}: it would not read back as TOML ({exc})") from None
+    if loaded != data or _has_nan(loaded):
+        raise ConfigError(f"cannot store {'.'.join(path)} = {value!r}: it would not read back as the same value")
     target.parent.mkdir(parents=True, exist_ok=True)
-    target.write_text(dump_toml(data))
+    temporary = target.with_name(target.name + ".tmp")
+    temporary.write_text(text)
+    temporary.replace(target)  # whole or not at all, also when the disk is full or the program dies
     return target
+
+
+def _has_nan(value: Any) -> bool:
+    if isinstance(value, float):
+        return not math.isfinite(value)
+    if isinstance(value, Mapping):
+        return any(_has_nan(v) for v in value.values())
+    if isinstance(value, (list, tuple)):
+        return any(_has_nan(v) for v in value)
+    return False
 
 
 def dump_toml(data: Mapping[str, Any], prefix: str = "") -> str:

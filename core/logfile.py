@@ -79,6 +79,8 @@ class LogWriter:
         self.dropped = 0
         self.bytes_written = 0
         self.error = ""
+        #: a write to the file failed (disk full, say): recording stopped, what was written stays readable
+        self.failed = False
         self._closed = False
         self._thread = threading.Thread(target=self._run, name="tafel-log-writer", daemon=True)
         self._thread.start()
@@ -89,7 +91,7 @@ class LogWriter:
 
         With ``blocking`` set (a run without a beat to keep, ``--speed max``) it waits for room instead.
         """
-        if self._closed:
+        if self._closed or self.failed:
             return False
         item = _Item(topic, cls, time_ns, sequence, data, metadata or {})
         try:
@@ -107,13 +109,18 @@ class LogWriter:
         if self._closed:
             return
         self._closed = True
-        self._queue.put(None)
+        if not self.failed:
+            self._queue.put(None)
         self._thread.join()
+        if not self.failed:
+            try:
+                self._writer.finish()
+            except Exception as exc:  # noqa: BLE001 - report, never lose the rest
+                self.error = self.error or f"{type(exc).__name__}: {exc}"
         try:
-            self._writer.finish()
-        except Exception as exc:  # noqa: BLE001 - report, never lose the rest
+            self._stream.close()
+        except OSError as exc:  # the last buffered bytes did not fit either: what is on disk stays
             self.error = self.error or f"{type(exc).__name__}: {exc}"
-        self._stream.close()
 
     def _run(self) -> None:
         last_flush = time.monotonic()
@@ -137,9 +144,23 @@ class LogWriter:
                 if time.monotonic() - last_flush >= self.flush_interval:
                     self._writer.flush()
                     last_flush, chunk_start_ns = time.monotonic(), None
-            except Exception as exc:  # noqa: BLE001 - a full disk must not kill the program
+            except OSError as exc:  # a full disk, a quota, a gone USB stick: stop cleanly, keep what is written
+                self._fail(exc)
+                return
+            except Exception as exc:  # noqa: BLE001 - a bad message must not kill the program
                 self.error = f"{type(exc).__name__}: {exc}"
                 self.dropped += 1
+
+    def _fail(self, exc: OSError) -> None:
+        """The first write error: say so at once, stop recording, keep every chunk already on disk."""
+        self.failed = True
+        self.error = f"{exc.strerror or exc} (errno {exc.errno})" if exc.errno else f"{type(exc).__name__}: {exc}"
+        log.error("recording to %s stopped: %s; the %d messages written before are kept", self.path, self.error, self.written)
+        while True:  # whoever waits for room in the queue (a blocking writer) goes on
+            try:
+                self._queue.get_nowait()
+            except queue.Empty:
+                break
 
     def _add(self, item: _Item) -> None:
         channel = self._channels.get(item.topic)

@@ -61,6 +61,8 @@ def coerce(module_name: str, field: dataclasses.Field, hint: Any, value: Any) ->
             if isinstance(value, str):
                 value = [v for v in value.split(",") if v.strip()]
             return [coerce(module_name, field, element, v) for v in value]
+    except ParameterError:
+        raise
     except (ValueError, TypeError, KeyError):
         expected = getattr(hint, "__name__", str(hint))
         if isinstance(hint, type) and issubclass(hint, enum.Enum):

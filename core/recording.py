@@ -109,7 +109,13 @@ class Recorder:
 
     @property
     def recording(self) -> bool:
-        return self.sink is not None
+        return self.sink is not None and not self.failed
+
+    @property
+    def failed(self) -> str:
+        """Why recording stopped by itself (the file could not be written), or ''."""
+        writer = self.writer or self._last_writer
+        return writer.error if writer is not None and writer.failed else ""
 
     def start(self, path: str | Path, *, blocking: bool | None = None) -> None:
         """Start writing to a new file (stops the current one first).
@@ -155,6 +161,7 @@ class Recorder:
             "dropped": writer.dropped if writer else 0,
             "bytes": writer.bytes_written if writer else 0,
             "error": (writer.error if writer else "") or "; ".join(f"{k}: {v}" for k, v in self.errors.items()),
+            "failed": bool(writer and writer.failed),
         }
 
     def dropped_total(self) -> int:
@@ -162,7 +169,7 @@ class Recorder:
 
     def record(self, context: str, blackboard: Blackboard, frame_number: int, time_ns: int) -> None:
         sink = self.sink
-        if sink is None or (self.gate is not None and not self.gate()):
+        if sink is None or (self.gate is not None and not self.gate()) or (self.writer is not None and self.writer.failed):
             return
         for selection in self.by_context.get(context, ()):
             try:

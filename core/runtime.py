@@ -630,6 +630,8 @@ class ConcurrentRuntime:
         self.main = next(name for name in MAIN_CONTEXT_ORDER if name in self.plans)
         self.stats: dict[str, ContextStats] = {name: ContextStats(name=name) for name in self.plans}
         self.exit_codes: dict[str, int | None] = {}
+        #: contexts whose process died before finishing, with why (the status line and the debug server say so)
+        self.dead: dict[str, str] = {}
         self.notices: list[str] = []
         self.on_report: list[Callable[[ConcurrentRuntime], None]] = []
         self._mp = multiprocessing.get_context("spawn")
@@ -713,9 +715,16 @@ class ConcurrentRuntime:
                     reported_dead.add(name)
                     self.exit_codes[name] = process.exitcode
                     if not self.stats[name].finished:
-                        self.notices.append(f"{name} process died (exit code {process.exitcode}); the other context keeps running")
+                        self.dead[name] = f"process died (exit code {process.exitcode})"
+                        if name == self.main:  # nothing drives the robot any more: the program ends, and fails
+                            self.stats[name].failure = self.dead[name]
+                            self.notices.append(f"{name} process died (exit code {process.exitcode}); the program ends")
+                        else:
+                            self.notices.append(f"{name} process died (exit code {process.exitcode}); the other context keeps running")
                         log.error(self.notices[-1])
                         open_connections.pop(name, None)
+                        for hook in self.on_report:
+                            hook(self)
             if self.stop.is_set() and all(not p.is_alive() for p in self.processes.values()):
                 break
             if not self.processes[self.main].is_alive() and self.main in reported_dead:
@@ -724,6 +733,10 @@ class ConcurrentRuntime:
                 self._stopping_since = self._stopping_since or time.monotonic()
                 if time.monotonic() - self._stopping_since > self.grace_s:
                     break  # a context that does not stop in time: run() ends it
+
+    def alive(self, name: str) -> bool:
+        """Whether the context's process runs (or has not started yet)."""
+        return name not in self.dead
 
     def _end_processes(self, grace_s: float) -> None:
         """Every process this runtime started ends: asked to stop, given the grace period, then its

@@ -25,7 +25,7 @@ import numpy as np
 from tafel.core.errors import TafelError
 from tafel.core.manager import ModuleManager
 from tafel.core.naming import did_you_mean
-from tafel.core.parameters import ParameterError, parameter_values, set_parameter
+from tafel.core.parameters import ParameterError, make_parameters, parameter_values, set_parameter
 from tafel.core.representation import FieldInfo, fields_of
 from tafel.core.validation import ValueCheckError, check_field, check_instance, check_number
 from tafel.core.serialization import SerializationError, deserialize, serialize
@@ -432,11 +432,19 @@ class ContextDebug:
         return f"{module}.{parameter} = {_short(value)}"
 
     def parameter_values(self, module: str) -> dict[str, Any] | None:
+        """A module's parameters as plain data, checked to load again (for ``parameter:store``)."""
         try:
             instance = self.manager.module(module)
         except (KeyError, TafelError):
             return None
-        return parameter_values(instance.parameters) if instance.parameters is not None else None
+        if instance.parameters is None:
+            return None
+        values = parameter_values(instance.parameters)
+        try:
+            make_parameters(type(instance), values)  # what would not load at the next start is not stored
+        except ParameterError as exc:
+            raise CommandError(f"not stored: {exc}") from None
+        return values
 
     def choices(self) -> dict[str, Any]:
         """Provider choices and disabled modules, for ``modules:store``."""

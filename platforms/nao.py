@@ -30,6 +30,7 @@ import numpy as np
 from tafel.core import clock
 from tafel.core.manager import Blackboard
 from tafel.core.platform import Platform, PlatformError
+from tafel.platforms.actuators import ActuatorGuard
 from tafel.platforms.v4l2 import image_time_ns
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import (
@@ -125,6 +126,7 @@ class NaoPlatform(Platform):
         self.captures: dict[str, Any] = {}
         self.measured = np.zeros(JOINT_COUNT)
         self.commanded_stiffness = np.zeros(JOINT_COUNT)
+        self.guard = ActuatorGuard("nao")  # joint limits, 0..1, no NaN reaches LoLA
         self.time_ns = 0
         self.packets = 0
         self.pending_answer = False
@@ -252,6 +254,7 @@ class NaoPlatform(Platform):
             self.time_ns = clock.now_ns()
             blackboard.set(FrameInfo(frame_number=frame_number, time_ns=self.time_ns))
             self.measured = values["Position"]
+            self.guard.hold(self.measured)
             blackboard.set(JointSensorData(position=values["Position"], stiffness=values["Stiffness"],
                                            current=values["Current"], temperature=values["Temperature"]))
             inertial = convert_inertial(values["Accelerometer"], values["Gyroscope"], values["Angles"])
@@ -285,10 +288,10 @@ class NaoPlatform(Platform):
         if context != "motion" or not self.pending_answer:
             return
         command, leds = blackboard[JointCommand], blackboard[LedRequest]
-        self.commanded_stiffness = np.clip(np.asarray(command.stiffness, dtype=float), 0.0, 1.0)
+        position, self.commanded_stiffness = self.guard(command.position, command.stiffness)
         try:
             self.send({
-                "Position": np.asarray(command.position, dtype=float).tolist(),
+                "Position": position.tolist(),
                 "Stiffness": self.commanded_stiffness.tolist(),
                 "Chest": leds.chest.tolist(), "LFoot": leds.left_foot.tolist(), "RFoot": leds.right_foot.tolist(),
                 "LEye": leds.left_eye.tolist(), "REye": leds.right_eye.tolist(),

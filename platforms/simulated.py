@@ -19,8 +19,10 @@ import numpy as np
 
 from tafel.core.manager import Blackboard
 from tafel.core.platform import Platform, PlatformOptionError, seed_number
+from tafel.platforms.actuators import ActuatorGuard
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import JOINT_NAMES, FsrData, InertialSensorData, JointCommand, JointSensorData
+from tafel.representations import field
 from tafel.representations.nao import VERTICAL_FOV
 from tafel.representations.perception import CameraImageBottom, CameraImageTop
 
@@ -33,6 +35,8 @@ def parse_pair(text: str, what: str) -> tuple[float, float]:
         x, y = (float(v) for v in str(text).split(","))
     except ValueError:
         raise PlatformOptionError(f"{what} takes X,Y in mm, e.g. 1000,300; got {text!r}") from None
+    if not (math.isfinite(x) and math.isfinite(y) and abs(x) <= CARPET_X and abs(y) <= CARPET_Y):
+        raise PlatformOptionError(f"{what} takes X,Y in mm on the carpet (|X| <= {CARPET_X:g}, |Y| <= {CARPET_Y:g}); got {text!r}")
     return x, y
 
 
@@ -50,13 +54,23 @@ def has_display() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
-def number(args: Mapping[str, Any], name: str, default: float = 0.0) -> float:
-    """A numeric debug command argument, with an error that names it."""
+#: how far from the centre spot things can be put (mm): the field and its border strip
+CARPET_X = field.LENGTH / 2 + field.BORDER_STRIP
+CARPET_Y = field.WIDTH / 2 + field.BORDER_STRIP
+
+
+def number(args: Mapping[str, Any], name: str, default: float = 0.0, limit: float = math.inf) -> float:
+    """A finite numeric debug command argument within ``±limit``, with an error that names it."""
     text = args.get(name, default)
     try:
-        return float(text)
+        value = float(text)
     except (TypeError, ValueError):
         raise PlatformOptionError(f"-{name} takes a number, got {text!r}") from None
+    if not math.isfinite(value):
+        raise PlatformOptionError(f"-{name} takes a finite number, got {text!r}")
+    if abs(value) > limit:
+        raise PlatformOptionError(f"-{name} takes -{limit:g} to {limit:g} (mm from the centre spot: the carpet ends there), got {value:g}")
+    return value
 
 
 class SimulatedRobotPlatform(Platform):
@@ -81,6 +95,7 @@ class SimulatedRobotPlatform(Platform):
         self.viewer_requested = bool(self.options.get("viewer"))
         self.rng = np.random.default_rng(self.seed)
         self.stiffness = np.zeros(len(JOINT_NAMES))
+        self.guard = ActuatorGuard(self.name)  # joint limits, 0..1, no NaN: whatever the modules send
         self.paused = False
         self.time_ns = 0
         self.last_steps = 0  # physics steps of the last advance (benchmarks read it)
@@ -186,6 +201,7 @@ class SimulatedRobotPlatform(Platform):
         if context == "motion":
             joints = blackboard[JointSensorData]
             joints.position = self.joint_angles() + self.rng.normal(0.0, 0.0005, len(JOINT_NAMES))
+            self.guard.hold(joints.position)
             joints.stiffness = self.stiffness.copy()
             joints.current = np.abs(self.joint_torques()) / 10.0  # a rough N m -> A of the NAO's motors
             joints.temperature = np.full(len(JOINT_NAMES), 30.0)
@@ -220,8 +236,8 @@ class SimulatedRobotPlatform(Platform):
         if context != "motion":
             return
         command = blackboard[JointCommand]
-        self.stiffness = np.clip(np.asarray(command.stiffness, dtype=float), 0.0, 1.0)
-        self.drive(np.asarray(command.position, dtype=float), self.stiffness)
+        targets, self.stiffness = self.guard(command.position, command.stiffness)
+        self.drive(targets, self.stiffness)
 
     def fov(self) -> tuple[float, float]:
         """(horizontal, vertical) field of view of the rendered images (rad)."""
@@ -254,12 +270,13 @@ class SimulatedRobotPlatform(Platform):
     # ------------------------------------------------------------------------ debug commands
     def commands(self) -> Mapping[str, tuple[str, Any]]:
         def ball(args: Mapping[str, Any]) -> str:
-            x, y = number(args, "x"), number(args, "y")
+            x, y = number(args, "x", limit=CARPET_X), number(args, "y", limit=CARPET_Y)
             self.move_ball(x, y)
             return f"ball at x={x:.0f} y={y:.0f} mm"
 
         def robot(args: Mapping[str, Any]) -> str:
-            x, y, heading = number(args, "x"), number(args, "y"), number(args, "rotation")
+            x, y = number(args, "x", limit=CARPET_X), number(args, "y", limit=CARPET_Y)
+            heading = math.remainder(number(args, "rotation"), math.tau)
             self.move_robot(x, y, heading)
             return f"robot at x={x:.0f} y={y:.0f} mm, rotation {heading:.3f} rad"
 

@@ -14,7 +14,7 @@ import pkgutil
 import sys
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from importlib.metadata import version
 from pathlib import Path
 from typing import Any, NoReturn
@@ -229,10 +229,13 @@ class StatusLine:
         return rates
 
     def format(self, elapsed_s: float, stats: dict[str, ContextStats], now: float, runners: dict[str, Any] | None = None,
-               notices: Sequence[str] = ()) -> str:
+               notices: Sequence[str] = (), dead: Mapping[str, str] | None = None) -> str:
         parts = [f"[tafel] {self.platform} t={elapsed_s:.1f}s"]
         rates = self.rates(stats, now)
         for name, s in stats.items():
+            if dead and name in dead:
+                parts.append(f"{name} DEAD ({dead[name]}) after {s.frames} frames")
+                continue
             state = " FAILED" if s.failure else ""
             parts.append(f"{name} {rates[name]:.1f} Hz {s.frames} frames{state}")
         parts.append(f"module errors {sum(s.module_errors for s in stats.values())}")
@@ -383,7 +386,7 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
         if now - last[0] >= args.status_interval:
             last[0] = now
             stats = {name: r.stats(now - started) for name, r in rt.runners.items()}
-            status_print(line.format(rt.time_ns * 1e-9, stats, now, rt.runners))
+            status_print(line.format(rt.time_ns * 1e-9, stats, now, rt.runners, recording_notices(recorder)))
 
     runtime.after_tick.append(status)
     try:
@@ -414,12 +417,17 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
     started = time.monotonic()
     last = [started]
     line = StatusLine(platform_class.name, config)
+    shown_dead: set[str] = set()
+    if debug is not None:
+        for name, executor in debug.executors.items():
+            executor.alive = lambda name=name: runtime.dead.get(name)
 
     def on_report(rt: ConcurrentRuntime) -> None:
         now = time.monotonic()
-        if now - last[0] >= args.status_interval:
+        if now - last[0] >= args.status_interval or set(rt.dead) != shown_dead:
             last[0] = now
-            status_print(line.format(now - started, rt.stats, now, None, rt.notices))
+            shown_dead.update(rt.dead)
+            status_print(line.format(now - started, rt.stats, now, None, [*rt.notices, *recording_notices(recorder)], rt.dead))
 
     runtime.on_report.append(on_report)
     install_signal_handlers(runtime.stop, on_force=lambda: [p.kill() for p in runtime.processes.values()],
@@ -474,6 +482,11 @@ def make_recorder(args: argparse.Namespace, plans: dict[str, ContextPlan], confi
     if args.record is not None:
         recorder.start(args.record)
     return recorder
+
+
+def recording_notices(recorder: Recorder | None) -> list[str]:
+    """What the status line says about recording when it stopped by itself (a full disk, say)."""
+    return [f"RECORDING STOPPED: {recorder.failed}"] if recorder is not None and recorder.failed else []
 
 
 def report_recording(recorder: Recorder | None) -> None:
@@ -579,7 +592,42 @@ COMMANDS = {"run": command_run, "platforms": command_platforms, "modules": comma
             "console": command_console}
 
 
+class PipeSafeStream:
+    """Standard output that may be closed under the program (``tafel run | head -1``).
+
+    The first write to a closed pipe points the file descriptor at /dev/null, so the run goes on, its
+    summary goes nowhere, and the interpreter's final flush does not fail either.
+    """
+
+    def __init__(self, stream: Any) -> None:
+        self._stream = stream
+
+    def _quietly(self, action: str, *args: Any) -> Any:
+        try:
+            return getattr(self._stream, action)(*args)
+        except (BrokenPipeError, ValueError):
+            try:
+                devnull = os.open(os.devnull, os.O_WRONLY)
+                os.dup2(devnull, self._stream.fileno())
+                os.close(devnull)
+            except (OSError, ValueError):
+                pass
+            return None
+
+    def write(self, text: str) -> int:
+        result = self._quietly("write", text)
+        return len(text) if result is None else result
+
+    def flush(self) -> None:
+        self._quietly("flush")
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    if not isinstance(sys.stdout, PipeSafeStream) and sys.stdout is not None:
+        sys.stdout = PipeSafeStream(sys.stdout)
     parser = build_parser()
     args, extra = parser.parse_known_args(argv)
     if extra and args.command == "platforms":

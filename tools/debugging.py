@@ -12,7 +12,7 @@ import multiprocessing
 import threading
 import time
 from collections import deque
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -29,6 +29,7 @@ from tafel.debug.protocol import Command
 from tafel.debug.server import DebugRouter, DebugServer, Executor
 
 DEBUG_REPRESENTATIONS = (DebugDrawings, DebugPlots)
+INTERNAL_ERROR = "__error__"  # key of a context's answer to an internal question it could not answer
 #: s before a context's next frame when command work stops, so the frame starts on time
 RESERVE = 0.002
 
@@ -106,6 +107,8 @@ class RemoteExecutor(Executor):
         self.timeout = timeout
         self.batch = 0
         self.lock = threading.Lock()
+        #: why the context's process is gone, or None while it runs (set by whoever supervises it)
+        self.alive: Callable[[], str | None] = lambda: None
 
     def _ask(self, payload: Any) -> Any:
         with self.lock:
@@ -121,6 +124,9 @@ class RemoteExecutor(Executor):
 
     def start(self, commands: Sequence[Command]) -> Any:
         """Send the batch; the process answers as many as fit in its frame budget."""
+        gone = self.alive()
+        if gone:  # answer at once: nobody should wait seconds for a context that is not there
+            return (list(commands), gone)
         self.lock.acquire()
         self.batch += 1
         try:
@@ -132,6 +138,8 @@ class RemoteExecutor(Executor):
     def finish(self, started: Any) -> list[tuple[str, str | bytes]]:
         """Collect the answers, sending what did not fit again until all are answered."""
         commands, sent = started
+        if isinstance(sent, str):
+            return [("error", f"{self.context} cannot answer: its {sent}")] * len(commands)
         answers: list[tuple[str, str | bytes]] = []
         try:
             while sent:
@@ -159,9 +167,14 @@ class RemoteExecutor(Executor):
         return None
 
     def internal(self, what: str, argument_: str = "") -> Any:
+        gone = self.alive()
+        if gone:
+            raise CommandError(f"{self.context} cannot answer: its {gone}")
         answers = self._ask(("internal", (what, argument_)))
         if answers is None:
             raise CommandError(f"{self.context} does not answer (stalled or gone)")
+        if isinstance(answers, dict) and INTERNAL_ERROR in answers:
+            raise CommandError(answers[INTERNAL_ERROR])
         return answers
 
 
@@ -177,8 +190,11 @@ def worker_debug_setup(runner: ContextRunner, args: Mapping[str, Any]) -> None:
         batch, (kind, payload) = connection.recv()
         if kind == "commands":
             connection.send((batch, debug.execute_batch(payload, budget_s=budget_s)))
-        else:
+            return
+        try:
             connection.send((batch, internal_answer(debug, *payload)))
+        except (TafelError, ValueError) as exc:  # the question cannot be answered: say so, never stop the loop
+            connection.send((batch, {INTERNAL_ERROR: str(exc)}))
 
     def serve(_runner: ContextRunner) -> None:
         while connection.poll():
@@ -305,8 +321,11 @@ class ProgramDebug:
             values = executor.internal("parameters", module)
             if values is not None:
                 path = None
-                for name, value in values.items():
-                    path = store_private(self.config_dir, ["parameters", module, name], value)
+                try:
+                    for name, value in values.items():
+                        path = store_private(self.config_dir, ["parameters", module, name], value)
+                except TafelError as exc:
+                    raise CommandError(str(exc)) from None
                 return f"stored {len(values)} parameters of {module} in {path}"
         raise CommandError(f"no running module {module!r} with parameters")
 

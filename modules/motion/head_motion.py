@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from tafel.core import Module, provides, requires
+from tafel.core import Module, bounded, provides, requires
 from tafel.representations.behavior import HeadMotionRequest
 from tafel.representations.infrastructure import CognitionStatus, FrameInfo
 from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, HeadJointTargets, JointSensorData
@@ -28,7 +28,7 @@ class HeadMotion(Module):
         """rad, HeadPitch limit up"""
         pitch_max: float = math.radians(29.5)
         """rad, HeadPitch limit down"""
-        max_speed: float = 4.0
+        max_speed: float = bounded(0.1, 10.0, 4.0)
         """rad/s, never faster than this whatever the request says"""
         safe_pitch: float = 0.0
         """rad, head pitch held when cognition is gone"""

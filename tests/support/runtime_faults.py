@@ -59,3 +59,8 @@ class StuckForever(Module):
     def execute(self) -> None:
         while True:
             time.sleep(0.1)
+
+
+@requires(FrameInfo)
+class CrashMotionProcess(CrashCognitionProcess):
+    """The same abrupt end, placed in motion: the program must end and say why."""

@@ -1,0 +1,81 @@
+"""Loop rates of the default simulation (MuJoCo, both cameras, speed 1) without and during the attack.
+
+The attack is the security issue's: 20 clients pipelining commands, one streaming 50 MB without
+newlines, 40 connections over the limit of 32, and an HTTP POST. Rates are the program's own, from its
+status line (one a second); the baseline is measured in the same run, just before the attack.
+
+    python benchmarks/debug_attack.py [--seconds 10]
+
+Prints one JSON line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(REPO))
+
+from tests.support.attack import Attack, status_rates  # noqa: E402
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--seconds", type=float, default=10.0, help="length of each phase (without, during)")
+    args = parser.parse_args()
+    folder = Path(tempfile.mkdtemp(prefix="tafel-attack-"))
+    victim = folder / "victim.txt"
+    victim.write_text("precious\n")
+    process = subprocess.Popen(
+        [sys.executable, "-m", "tafel.tools.cli", "run", "--platform", "mujoco", "--debug-port", "0", "--status-interval", "1"],
+        cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(REPO)})
+    port = int(re.search(r":(\d+)", process.stdout.readline()).group(1))
+    lines: list[str] = []
+    threading.Thread(target=lambda: lines.extend(process.stderr), daemon=True).start()
+    threading.Thread(target=lambda: [None for _ in process.stdout], daemon=True).start()
+    try:
+        time.sleep(3.0)  # stand up, first images
+        start = len(lines)
+        time.sleep(args.seconds)
+        without = status_rates(lines[start + 1:])
+        attack = Attack("127.0.0.1", port, http_victim=str(victim))
+        started = time.perf_counter()
+        attack.start()
+        start = len(lines)
+        time.sleep(args.seconds)
+        during = status_rates(lines[start + 1:])
+        report = attack.stop()
+        attack_s = time.perf_counter() - started
+    finally:
+        process.terminate()
+        process.wait(timeout=30)
+
+    def summary(rates: dict[str, list[float]]) -> dict[str, float]:
+        return {f"{name}_{what}_hz": round(func(values), 2) for name, values in rates.items() if values
+                for what, func in (("mean", statistics.fmean), ("min", min))}
+
+    print(json.dumps({
+        "benchmark": "debug_attack", "platform": "mujoco", "speed": 1, "phase_s": args.seconds,
+        "without_attack": summary(without), "during_attack": summary(during),
+        "targets": {"motion_min_hz": 95.0, "cognition_min_hz": 28.0},
+        "attack": {"pipelined_answers": report.answers, "answers_per_s": round(report.answers / attack_s),
+                   "streamed_mb": round(report.streamed_bytes / 2**20, 1), "refused_over_limit": report.refused,
+                   "over_limit_left_open": report.over_limit_open, "http_post_answered": report.http_answered,
+                   "client_errors": report.errors[:3]},
+        "victim_unchanged": victim.read_text() == "precious\n",
+        "files_in_working_folder": sorted(p.name for p in folder.iterdir()),
+    }))
+
+
+if __name__ == "__main__":
+    main()

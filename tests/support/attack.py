@@ -1,0 +1,176 @@
+"""A debug-server attack as the security issue describes it, for the stress test and ``benchmarks/debug_attack.py``.
+
+All at once against one running program on loopback: clients pipelining commands, one client
+streaming bytes without a newline, connections beyond the limit, and an HTTP POST whose body would
+record over a file. Every loop is bounded in count and time, and everything stops by itself.
+"""
+
+from __future__ import annotations
+
+import re
+import socket
+import threading
+import time
+from dataclasses import dataclass, field
+
+#: commands the pipelining clients send, round and round
+PIPELINED = ("ping", "modules:list", "representation:print FrameInfo", "stopwatch:list", "debug_request:list", "help")
+
+
+@dataclass
+class AttackReport:
+    answers: int = 0  # answers the pipelining clients received
+    streamed_bytes: int = 0  # bytes the streaming client got through
+    refused: int = 0  # connections over the limit that were answered with an error and closed
+    over_limit_open: int = 0  # connections over the limit that stayed open (should be none)
+    http_answered: bool = False  # the POST got anything back (it should not)
+    errors: list[str] = field(default_factory=list)
+
+
+class Attack:
+    """Start with ``start()``, end with ``stop()``, which returns what happened."""
+
+    def __init__(self, host: str, port: int, *, pipelining_clients: int = 20, stream_bytes: int = 50 << 20,
+                 extra_connections: int = 40, limit: int = 32, http_victim: str = "/tmp/tafel-attack-victim.txt") -> None:
+        self.host, self.port = host, port
+        self.pipelining_clients = pipelining_clients
+        self.stream_bytes = stream_bytes
+        self.extra_connections = extra_connections
+        self.limit = limit
+        self.http_victim = http_victim
+        self.report = AttackReport()
+        self._stop = threading.Event()
+        self._lock = threading.Lock()
+        self._threads: list[threading.Thread] = []
+        self._held: list[socket.socket] = []
+
+    def _connect(self) -> socket.socket:
+        return socket.create_connection((self.host, self.port), timeout=10)
+
+    def start(self) -> None:
+        targets = [self._pipeline] * self.pipelining_clients + [self._stream]
+        for target in targets:
+            thread = threading.Thread(target=target, daemon=True)
+            thread.start()
+            self._threads.append(thread)
+        time.sleep(0.5)  # the attack's own clients are in
+        self._http_post()
+        self._fill_to_limit(self.limit - self.pipelining_clients - 1)
+        self._over_limit()
+
+    def stop(self) -> AttackReport:
+        self._stop.set()
+        for thread in self._threads:
+            thread.join(timeout=15)
+        for held in self._held:
+            held.close()
+        return self.report
+
+    def _pipeline(self) -> None:
+        try:
+            with self._connect() as connection:
+                connection.settimeout(5)
+                burst = "".join(f"{c}\n" for c in PIPELINED * 5).encode()
+                buffer = b""
+                while not self._stop.is_set():
+                    connection.sendall(burst)
+                    wanted = len(PIPELINED) * 5
+                    while wanted and not self._stop.is_set():
+                        chunk = connection.recv(1 << 16)
+                        if not chunk:
+                            return
+                        buffer += chunk
+                        count = buffer.count(b"\0")
+                        if count:
+                            buffer = buffer[buffer.rindex(b"\0") + 1:]
+                            wanted -= count
+                            with self._lock:
+                                self.report.answers += count
+        except OSError as exc:
+            if not self._stop.is_set():
+                self.report.errors.append(f"pipelining client: {exc}")
+
+    def _stream(self) -> None:
+        block = b"x" * (1 << 16)
+        try:
+            with self._connect() as connection:
+                while self.report.streamed_bytes < self.stream_bytes and not self._stop.is_set():
+                    connection.sendall(block)
+                    self.report.streamed_bytes += len(block)
+        except OSError as exc:
+            if not self._stop.is_set():
+                self.report.errors.append(f"streaming client: {exc}")
+
+    def _fill_to_limit(self, count: int) -> None:
+        """Idle connections up to the limit, held open: every further one is over it."""
+        for _ in range(max(0, count)):
+            try:
+                connection = self._connect()
+                connection.settimeout(0.3)
+                connection.recv(1)  # an accepted connection says nothing
+                connection.close()  # it said something: it was refused (someone else holds a place)
+            except TimeoutError:
+                self._held.append(connection)
+            except OSError as exc:
+                self.report.errors.append(f"connection up to the limit: {exc}")
+
+    def _over_limit(self) -> None:
+        for _ in range(self.extra_connections):
+            try:
+                connection = self._connect()
+            except OSError as exc:
+                self.report.errors.append(f"connection over the limit: {exc}")
+                continue
+            connection.settimeout(3)
+            try:
+                data = connection.recv(4096)
+            except TimeoutError:
+                self.report.over_limit_open += 1
+                self._held.append(connection)
+                continue
+            except OSError:
+                data = b""
+            if data.startswith(b"error:"):
+                self.report.refused += 1
+            connection.close()
+
+    def _http_post(self) -> None:
+        body = f"\nlog:start -file {self.http_victim}\n".encode()
+        request = (b"POST / HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: text/plain\r\n"
+                   + f"Content-Length: {len(body)}\r\n\r\n".encode() + body)
+        try:
+            with self._connect() as connection:
+                connection.settimeout(3)
+                connection.sendall(request)
+                try:
+                    self.report.http_answered = bool(connection.recv(4096))
+                except TimeoutError:
+                    self.report.http_answered = True  # kept open: it was not closed at once
+                except OSError:
+                    pass
+        except OSError as exc:
+            self.report.errors.append(f"http client: {exc}")
+
+
+STATUS_RATE = re.compile(r"(cognition|motion) ([\d.]+) Hz")
+
+
+def status_rates(lines: list[str]) -> dict[str, list[float]]:
+    """Each context's rates from the program's status lines (its own count over each interval)."""
+    rates: dict[str, list[float]] = {"cognition": [], "motion": []}
+    for line in lines:
+        if line.startswith("[tafel]"):
+            for name, value in STATUS_RATE.findall(line):
+                rates[name].append(float(value))
+    return rates
+
+
+def rates_during(errors: list[str], seconds: float) -> dict[str, float]:
+    """The lowest rate of each context over the status lines printed in the next ``seconds``.
+
+    The first line after the start is skipped: its interval began before.
+    """
+    start = len(errors)
+    time.sleep(seconds)
+    rates = status_rates(errors[start:])
+    return {name: min(values[1:]) if len(values) > 1 else float("nan") for name, values in rates.items()}
