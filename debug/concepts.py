@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tafel.core import representation
+from tafel.core.testing import RESET_HOOKS
 
 HISTORY = 300  # values kept per plot and per stopwatch
 
@@ -138,7 +139,28 @@ class DebugState:
         self.drawings_now[context] = []
 
 
+    def reset(self) -> None:
+        """As in a fresh process, for tests: requests off, pins released, no times, values or drawings.
+
+        Requests and modify values stay registered (modules hold them from import time); only their
+        state goes back to the start.
+        """
+        for found in self.requests.values():
+            found.on = False
+        for pinned in self.modifies.values():
+            pinned.pinned, pinned.pinned_value = False, None
+        for watch in self.stopwatches.values():
+            watch.times_ns.clear()
+        for series in self.plots.values():
+            series.values.clear()
+        self.context = ""
+        self.frame.clear()
+        self.drawings_now.clear()
+        self.drawings_last.clear()
+
+
 STATE = DebugState()
+RESET_HOOKS.append(STATE.reset)  # the pytest plugin resets it after every test; core never imports debug
 
 
 def request(name: str, description: str = "") -> DebugRequest:
