@@ -237,7 +237,7 @@ def differences(actual: Any, expected: Any, *, rel: float = 1e-9, abs: float = 0
         else:
             close = a == e
         bad = np.flatnonzero(~np.asarray(close))
-        return [f"{where}[{np.unravel_index(i, e.shape) if e.ndim > 1 else i}]: {a.flat[i]!r} instead of {e.flat[i]!r}"
+        return [f"{where}[{np.unravel_index(i, e.shape) if e.ndim > 1 else i}]: {a.flat[i].item()!r} instead of {e.flat[i].item()!r}"
                 for i in bad[:10]] + ([f"{where}: and {len(bad) - 10} more elements"] if len(bad) > 10 else [])
     if isinstance(expected, (list, tuple)):
         if not isinstance(actual, (list, tuple)) or len(actual) != len(expected):

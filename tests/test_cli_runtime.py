@@ -175,9 +175,11 @@ def test_motion_sees_a_stalled_cognition_and_its_return() -> None:
     assert result.returncode == 0, result.stderr
     assert frames(result.stdout)["motion"] == 500
     without = summary_value(result.stdout, "frames_without_cognition")
-    # a 2 s stall with a 1 s timeout: roughly 100 motion frames without cognition, then it is back
-    assert 30 < without < 200, without
-    assert frames(result.stdout)["cognition"] > 20
+    assert without > 0  # a 2 s stall outlasts the 1 s timeout: motion saw cognition as gone
+    assert frames(result.stdout)["cognition"] > 20  # and then back
+    # the baseline in the same test: a stall shorter than the timeout is never taken for a loss
+    short = run_concurrent_fault("StallCognition", "0.3", 300)
+    assert short.returncode == 0 and summary_value(short.stdout, "frames_without_cognition") == 0, short.stdout
 
 
 @pytest.mark.slow

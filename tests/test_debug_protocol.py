@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+import socket
+import threading
+
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
 from tafel.debug.protocol import Command, ParseError, TelnetDecoder, answer_bytes, format_command, parse
+from tafel.debug.server import DebugRouter, DebugServer, looks_like_http
 
 
 def test_the_example_from_the_protocol() -> None:
@@ -59,27 +63,81 @@ def test_well_formed_commands_round_trip(command: Command) -> None:
     assert parse(format_command(command)) == command
 
 
-@given(st.binary(max_size=300))
-def test_random_bytes_never_raise_anything_but_parse_errors(data: bytes) -> None:
-    for line in TelnetDecoder().feed(data + b"\n"):
-        if line is None:
-            continue
-        try:
-            text = line.decode("utf-8")
-        except UnicodeDecodeError:
-            continue
-        try:
-            parse(text.strip())
-        except ParseError:
-            pass
-
-
 @given(st.text(max_size=200))
-def test_random_text_never_raises_anything_but_parse_errors(text: str) -> None:
+def test_random_text_parses_to_a_command_that_round_trips_or_says_what_was_expected(text: str) -> None:
     try:
-        parse(text)
-    except ParseError:
-        pass
+        command = parse(text)
+    except ParseError as exc:
+        assert str(exc).startswith(("expected", "argument", "the value of")), str(exc)
+        return
+    assert parse(format_command(command)) == command
+
+
+@pytest.fixture(scope="module")
+def echo_server():
+    """A real debug server whose one command answers its argument: the order of answers is visible."""
+    router = DebugRouter()
+    router.register("echo", "answers its argument", "echo -n N", lambda command: str(command.args.get("n", "")))
+    server = DebugServer(router, "127.0.0.1", 0)
+    server.start()
+    stop = threading.Event()
+    threading.Thread(target=server.dispatch_forever, args=(stop,), daemon=True).start()
+    yield server
+    stop.set()
+    server.stop()
+
+
+def _answers(server: DebugServer, payload: bytes, count: int) -> list[bytes]:
+    with socket.create_connection(server.address, timeout=10) as connection:
+        connection.sendall(payload)
+        received = b""
+        while received.count(b"\0") < count:
+            chunk = connection.recv(65536)
+            if not chunk:
+                return received.split(b"\0")[:-1]  # closed early: the caller checks whether it should have been
+            received += chunk
+    return received.split(b"\0")[:count]
+
+
+# lines a fuzzer makes from the protocol's own pieces, well-formed or not
+FUZZ_LINE = st.lists(st.sampled_from(["echo", "-n", "+n", " ", '"', "x y", "aGk=", "@", "help", "\t", "é", "-", "+", "zz"]),
+                     min_size=1, max_size=8).map("".join)
+
+
+@given(st.lists(FUZZ_LINE, min_size=1, max_size=15))
+def test_every_fuzzed_line_gets_exactly_one_answer_in_order(echo_server: DebugServer, lines: list[str]) -> None:
+    lines = [line.replace("\n", " ") for line in lines if line.strip()]
+    if not lines:
+        return
+    payload = b"".join(f"{line}\necho -n {i}\n".encode() for i, line in enumerate(lines))  # a marker after each line
+    answers = _answers(echo_server, payload, 2 * len(lines))
+    for i, line in enumerate(lines):
+        answer, marker = answers[2 * i].decode(), answers[2 * i + 1].decode()
+        assert marker == f"{i}\n", (line, answers)  # the pipeline kept its order: one answer per line
+        try:
+            parsed = parse(line.strip())
+        except ParseError as exc:
+            assert answer == f"error: {exc}\n", (line, answer)  # malformed: the parser's own message
+            continue
+        if parsed.name not in ("echo", "help"):
+            assert answer.startswith("error: unknown command"), (line, answer)
+
+
+@given(st.binary(max_size=300))
+def test_random_bytes_get_one_answer_per_line_and_errors_for_what_is_not_a_command(echo_server: DebugServer, data: bytes) -> None:
+    lines = [line for line in TelnetDecoder().feed(data + b"\n") if line is None or line.strip()]
+    payload = data + b"\necho -n end\n"
+    answers = _answers(echo_server, payload, len(lines) + 1)
+    if lines and lines[0] is not None and looks_like_http(lines[0]):
+        assert answers == [], answers  # what a browser sends is closed at once, unanswered
+        return
+    assert len(answers) == len(lines) + 1, (lines, answers)
+    assert answers[-1] == b"end\n"  # everything before it was answered, one by one, in order
+    for line, answer in zip(lines, answers):
+        try:
+            parse(line.decode("utf-8").strip())
+        except (ParseError, UnicodeDecodeError):
+            assert answer.startswith(b"error:"), (line, answer)
 
 
 def test_telnet_negotiation_and_line_ends_are_stripped() -> None:

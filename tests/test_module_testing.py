@@ -1,0 +1,171 @@
+"""The module-testing tools themselves: clock, sequences, history, access, assert_close, strategies, isolation."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from tafel.core import Module, bounded, provides, representation, requires, uses
+from tafel.core.representation import fields_of
+from tafel.core.testing import ModuleHarness, assert_close, differences, strategy_for
+from tafel.debug.concepts import STATE, modify, request
+from tafel.representations.infrastructure import FrameInfo
+
+
+@representation
+class MtSpeed:
+    """A speed in mm/s, and a distance that cannot be negative."""
+
+    value: float = 0.0
+    distance: float = bounded(0.0, 9000.0)
+    counts: np.ndarray = bounded(0.0, 1.0, array_shape=(3,))
+    steps: int = bounded(-5, 5)
+
+
+@representation
+class MtPosition:
+    x: float = 0.0  # mm
+    time_s: float = 0.0
+
+
+@representation
+class MtUnread:
+    value: float = 0.0
+
+
+@requires(MtSpeed, FrameInfo)
+@uses(MtUnread)
+@provides(MtPosition)
+class MtIntegrator(Module):
+    """x += speed * dt, with dt from the frame clock: a module that needs time to pass."""
+
+    def __init__(self) -> None:
+        self.last_ns: int | None = None
+
+    def execute(self) -> None:
+        now = self.frame_info.time_ns
+        if self.last_ns is not None:
+            self.mt_position.x += self.mt_speed.value * (now - self.last_ns) * 1e-9
+        self.last_ns = now
+        self.mt_position.time_s = now * 1e-9
+
+
+def test_the_harness_owns_the_clock() -> None:
+    harness = ModuleHarness(MtIntegrator, MtSpeed(value=300.0))
+    assert harness.rate_hz == 30.0 and harness.context == "cognition"
+    harness.execute(frames=31)  # 30 periods of 1/30 s
+    assert_close(harness[MtPosition].x, 300.0, rel=1e-6)
+    assert harness[FrameInfo].frame_number == 31
+    harness.advance(2.0)  # the frames that fit into two seconds
+    assert harness.frame_number == 91
+    assert_close(harness[MtPosition].time_s, 3.0, rel=1e-6)
+    assert_close(harness[MtPosition].x, 900.0, rel=1e-6)
+
+
+def test_a_motion_rate_and_an_explicit_frame_info_take_over_the_clock() -> None:
+    harness = ModuleHarness(MtIntegrator, MtSpeed(value=100.0), context="motion")
+    assert harness.period_ns == 10_000_000
+    harness.execute(frames=101)
+    assert_close(harness[MtPosition].x, 100.0, rel=1e-6)
+    harness.set(FrameInfo(frame_number=500, time_ns=2_000_000_000))  # a test may set the time itself
+    harness.execute()
+    assert harness.frame_number == 500 and harness.time_ns == 2_000_000_000
+    harness.execute()
+    assert harness.time_ns == 2_010_000_000  # and the clock goes on from there
+
+
+def test_sequences_feed_one_value_per_frame_and_the_history_keeps_every_output() -> None:
+    harness = ModuleHarness(MtIntegrator)
+    harness.feed({MtSpeed: [MtSpeed(value=v) for v in (0.0, 30.0, 60.0, 90.0)]})
+    harness.execute()  # all that was fed
+    xs = [p.x for p in harness.history(MtPosition)]
+    assert_close(xs, [0.0, 1.0, 3.0, 6.0], rel=1e-6)
+    with pytest.raises(IndexError, match="the fed sequence of MtSpeed ran out after 4 frames"):
+        harness.execute(frames=1)
+    with pytest.raises(KeyError, match="does not provide MtSpeed"):
+        harness.history(MtSpeed)
+
+
+def test_sequences_of_different_lengths_or_types_are_errors_naming_the_representation() -> None:
+    harness = ModuleHarness(MtIntegrator)
+    with pytest.raises(ValueError, match="MtSpeed: 2, MtUnread: 3"):
+        harness.feed({MtSpeed: [MtSpeed()] * 2, MtUnread: [MtUnread()] * 3})
+    with pytest.raises(TypeError, match="element 1 for MtSpeed is a MtUnread"):
+        harness.feed({MtSpeed: [MtSpeed(), MtUnread()]})
+    with pytest.raises(TypeError, match="MtIntegrator does not require, use or provide MtOther"):
+        ModuleHarness(MtIntegrator).feed({MtOther: [MtOther()]})
+
+
+@representation
+class MtOther:
+    value: int = 0
+
+
+def test_reads_and_writes_pin_a_modules_data_dependencies() -> None:
+    harness = ModuleHarness(MtIntegrator)
+    with pytest.raises(RuntimeError, match="execute a frame first"):
+        harness.reads()
+    harness.execute()
+    assert harness.reads(MtIntegrator) == {FrameInfo}  # the first frame reads only the clock
+    assert harness.writes(MtIntegrator) == {MtPosition}
+    harness.execute()
+    assert harness.reads() == {FrameInfo, MtSpeed}  # MtUnread is declared but never read
+    with pytest.raises(ValueError, match="runs MtIntegrator"):
+        harness.reads(_Unrelated)
+
+
+class _Unrelated:
+    pass
+
+
+def test_assert_close_names_every_differing_field_with_both_values() -> None:
+    actual = MtSpeed(value=1.0, distance=5.0, counts=np.array([0.1, 0.2, 0.3]))
+    expected = MtSpeed(value=1.1, distance=5.0, counts=np.array([0.1, 0.25, 0.3]))
+    with pytest.raises(AssertionError) as failure:
+        assert_close(actual, expected, abs=0.01)
+    text = str(failure.value)
+    assert "2 difference(s)" in text
+    assert "MtSpeed.value: 1.0 instead of 1.1" in text
+    assert "MtSpeed.counts[1]: 0.2 instead of 0.25" in text
+    assert_close(actual, expected, abs=0.11)  # within the tolerance: passes
+    assert differences([1.0, 2.0], [1.0]) == ["list: [1.0, 2.0] instead of [1.0] (lengths differ)"]
+    assert differences(np.zeros((2, 2)), np.zeros(3)) == ["ndarray: shape (2, 2) instead of (3,)"]
+
+
+@given(strategy_for(MtSpeed))
+def test_bounded_strategies_keep_to_the_declared_ranges(speed: MtSpeed) -> None:
+    assert math.isfinite(speed.value) and abs(speed.value) <= 1e6  # no range: finite, sensible
+    assert 0.0 <= speed.distance <= 9000.0
+    assert speed.counts.shape == (3,) and np.all((speed.counts >= 0.0) & (speed.counts <= 1.0))
+    assert -5 <= speed.steps <= 5
+
+
+@given(strategy_for(MtSpeed, value=st.just(0.0)))
+def test_a_field_of_a_strategy_can_be_overridden(speed: MtSpeed) -> None:
+    assert speed.value == 0.0
+
+
+def test_an_override_for_a_field_that_does_not_exist_is_an_error() -> None:
+    with pytest.raises(TypeError, match="no field 'valeu'; did you mean 'value'"):
+        strategy_for(MtSpeed, valeu=st.just(0.0))
+    assert dict((f.name, f.range) for f in fields_of(MtSpeed))["distance"] == (0.0, 9000.0)
+
+
+# Two tests in this order: the first leaves a pin and a switched-on request, the second must not see them.
+LEAKY = request("MtLeaky:draw", "a request a test switches on")
+
+
+def test_isolation_part_one_leaves_debug_state_behind() -> None:
+    LEAKY.on = True
+    modify("MtLeaky:gain", 1.0)
+    STATE.modifies["MtLeaky:gain"].pinned, STATE.modifies["MtLeaky:gain"].pinned_value = True, 5.0
+    assert modify("MtLeaky:gain", 1.0) == 5.0
+
+
+def test_isolation_part_two_starts_clean() -> None:
+    assert LEAKY.on is False
+    assert modify("MtLeaky:gain", 1.0) == 1.0
