@@ -194,6 +194,8 @@ class LogChannel:
     metadata: dict[str, str]
     messages: int = 0
     bytes: int = 0
+    #: the schema as stored (a protobuf FileDescriptorSet), to copy the channel into another log
+    schema_data: bytes = b""
 
     @property
     def context(self) -> str:
@@ -316,7 +318,8 @@ class LogReader:
         self._topics[record.id] = record.topic
         if record.topic not in self.channels:
             schema = self._schemas.get(record.schema_id)
-            self.channels[record.topic] = LogChannel(record.topic, schema.name if schema else "", _file_of(schema), dict(record.metadata))
+            self.channels[record.topic] = LogChannel(record.topic, schema.name if schema else "", _file_of(schema), dict(record.metadata),
+                                                     schema_data=bytes(schema.data) if schema else b"")
 
     def _problem(self, text: str) -> None:
         self.problems.append(text)
@@ -443,6 +446,58 @@ def read_log(path: str | Path) -> LogContents:
             channel.bytes += len(message.data)
         return LogContents(path=reader.path, channels=reader.channels, messages=messages, metadata=reader.metadata,
                            complete=reader.complete and not reader.problems, problem="; ".join(reader.problems))
+
+
+def write_slice(source: str | Path, target: str | Path, *, representations: Iterable[str] | None = None,
+                start_s: float = 0.0, seconds: float | None = None) -> dict[str, int]:
+    """Copy part of a log into a new one: the chosen representations (all without a choice), from
+    ``start_s`` after the log's first message for ``seconds``. Schemas, channel metadata and the
+    recording's metadata travel along, so the slice replays and decodes like the original.
+
+    Returns messages per topic. Raises ``LogError`` when nothing would be copied.
+    """
+    wanted = set(representations) if representations else None
+    with LogReader(source) as reader:
+        topics = [t for t, c in reader.channels.items() if wanted is None or c.representation in wanted]
+        if wanted is not None and (unknown := wanted - {reader.channels[t].representation for t in topics}):
+            from tafel.core.naming import did_you_mean
+
+            names = sorted({c.representation for c in reader.channels.values()})
+            name = sorted(unknown)[0]
+            raise LogError(f"{source} holds no representation {name!r}; {did_you_mean(name, names)}")
+        first = next(iter(reader.messages(topics)), None)
+        if first is None:
+            raise LogError(f"{source} holds no messages of {', '.join(sorted(wanted or []) or 'any channel')}")
+        begin = first.time_ns + int(start_s * 1e9)
+        end = None if seconds is None else begin + int(seconds * 1e9)
+        counts: dict[str, int] = {}
+        with open(target, "wb") as stream:
+            writer = Writer(stream, compression=CompressionType.ZSTD)
+            writer.start(profile=PROFILE, library="tafel")
+            if reader.metadata:
+                writer.add_metadata(PROFILE, {**reader.metadata, "sliced_from": Path(source).name,
+                                              "slice_start_s": f"{start_s:g}"})
+            schema_ids: dict[str, int] = {}
+            channel_ids: dict[str, int] = {}
+            for message in reader.messages(topics, start_ns=begin):
+                if message.time_ns < begin or (end is not None and message.time_ns >= end):
+                    continue
+                channel = reader.channels[message.topic]
+                if message.topic not in channel_ids:
+                    if channel.schema_name not in schema_ids:
+                        schema_ids[channel.schema_name] = writer.register_schema(
+                            name=channel.schema_name, encoding="protobuf", data=channel.schema_data)
+                    channel_ids[message.topic] = writer.register_channel(
+                        topic=message.topic, message_encoding="protobuf", schema_id=schema_ids[channel.schema_name],
+                        metadata=dict(channel.metadata))
+                writer.add_message(channel_ids[message.topic], log_time=message.time_ns, data=message.data,
+                                   publish_time=message.time_ns, sequence=message.sequence)
+                counts[message.topic] = counts.get(message.topic, 0) + 1
+            writer.finish()
+    if not counts:
+        Path(target).unlink(missing_ok=True)
+        raise LogError(f"{source}: no message between {start_s:g} s and {'the end' if seconds is None else f'{start_s + seconds:g} s'}")
+    return counts
 
 
 def _file_of(schema: Schema | None) -> descriptor_pb2.FileDescriptorProto | None:

@@ -189,7 +189,10 @@ class TelnetDecoder:
         while position < length:
             state = self.state
             if state == "data":
-                if self.pending_cr:  # \r ends the line; a \n or \0 right after it belongs to it
+                if self.pending_cr:  # \r ends the line at the next data byte; a \n or \0 belongs to it
+                    if data[position] == IAC:  # telnet commands in between do not count as data
+                        self.state, position = "iac", position + 1
+                        continue
                     self.pending_cr = False
                     self._end_line(lines)
                     if data[position] in (0, 10):
@@ -214,6 +217,9 @@ class TelnetDecoder:
                 position += 1
                 if byte == IAC:
                     self.state = "data"
+                    if self.pending_cr:
+                        self.pending_cr = False
+                        self._end_line(lines)
                     self._append(b"\xff", 0, 1)
                 elif byte in _NEGOTIATION:
                     self.state = "option"

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from tafel.core import representation
+import math
+
+from tafel.core import bounded, representation
 
 
 @representation
@@ -10,6 +12,6 @@ class HeadMotionRequest:
     """Where the head should look: joint angles ``yaw``/``pitch`` (rad) reached with at most
     ``max_speed`` (rad/s)."""
 
-    yaw: float = 0.0
-    pitch: float = 0.0
-    max_speed: float = 2.0
+    yaw: float = bounded(-math.pi, math.pi)
+    pitch: float = bounded(-math.pi / 2, math.pi / 2)
+    max_speed: float = bounded(0.0, 20.0, 2.0)

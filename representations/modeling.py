@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from tafel.core import representation
+from tafel.core import bounded, representation
 
 
 @representation
@@ -16,12 +16,12 @@ class BallModel:
 
     valid: bool = False
     seen: bool = False
-    x: float = 0.0
-    y: float = 0.0
-    vx: float = 0.0
-    vy: float = 0.0
-    position_std: float = 0.0
-    time_since_seen: float = 0.0
+    x: float = bounded(-15000.0, 15000.0)
+    y: float = bounded(-15000.0, 15000.0)
+    vx: float = bounded(-20000.0, 20000.0)
+    vy: float = bounded(-20000.0, 20000.0)
+    position_std: float = bounded(0.0, 1e6)
+    time_since_seen: float = bounded(0.0, 1e6)
 
     def status_text(self) -> str:
         """One phrase for the status line of ``tafel run`` (``[status] show`` in configuration)."""

@@ -5,6 +5,8 @@ Every 25-element joint array is in ``JOINT_NAMES`` order (the order of the NAO's
 
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -29,10 +31,10 @@ class JointSensorData:
     """Measured joint state: ``position`` (rad; hands 0..1 open), ``stiffness`` (0..1), ``current`` (A),
     ``temperature`` (deg C), in ``JOINT_NAMES`` order."""
 
-    position: np.ndarray = array((JOINT_COUNT,))
-    stiffness: np.ndarray = array((JOINT_COUNT,))
-    current: np.ndarray = array((JOINT_COUNT,))
-    temperature: np.ndarray = array((JOINT_COUNT,))
+    position: np.ndarray = bounded(-math.pi, math.pi, array_shape=(JOINT_COUNT,))
+    stiffness: np.ndarray = bounded(0.0, 1.0, array_shape=(JOINT_COUNT,))
+    current: np.ndarray = bounded(0.0, 10.0, array_shape=(JOINT_COUNT,))
+    temperature: np.ndarray = bounded(-20.0, 150.0, array_shape=(JOINT_COUNT,))
 
 
 @representation
@@ -40,16 +42,16 @@ class InertialSensorData:
     """The IMU in the robot frame: ``accelerometer`` (m/s^2, about +9.81 on z when upright),
     ``gyroscope`` (rad/s about x, y, z), ``angles`` (torso roll and pitch, rad)."""
 
-    accelerometer: np.ndarray = array((3,))
-    gyroscope: np.ndarray = array((3,))
-    angles: np.ndarray = array((2,))
+    accelerometer: np.ndarray = bounded(-160.0, 160.0, array_shape=(3,))
+    gyroscope: np.ndarray = bounded(-35.0, 35.0, array_shape=(3,))
+    angles: np.ndarray = bounded(-math.pi, math.pi, array_shape=(2,))
 
 
 @representation
 class FsrData:
     """Foot pressure (kg): left foot front-left, front-right, rear-left, rear-right, then the right foot."""
 
-    pressure: np.ndarray = array((8,))
+    pressure: np.ndarray = bounded(0.0, 25.0, array_shape=(8,))
 
 
 @representation
@@ -58,7 +60,7 @@ class HeadJointTargets:
 
     yaw: float = 0.0
     pitch: float = 0.0
-    stiffness: float = 0.0
+    stiffness: float = bounded(0.0, 1.0)
 
 
 @representation
@@ -67,7 +69,7 @@ class BodyJointTargets:
     entries are ignored), with stiffness per joint (0..1)."""
 
     position: np.ndarray = array((JOINT_COUNT,))
-    stiffness: np.ndarray = array((JOINT_COUNT,))
+    stiffness: np.ndarray = bounded(0.0, 1.0, array_shape=(JOINT_COUNT,))
 
 
 @representation

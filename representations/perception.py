@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tafel.core import array, representation
+from tafel.core import array, bounded, representation
 
 
 @representation
@@ -18,8 +18,8 @@ class BallPercept:
     """
 
     seen: bool = False
-    x: float = 0.0
-    y: float = 0.0
+    x: float = bounded(-15000.0, 15000.0)
+    y: float = bounded(-15000.0, 15000.0)
     image_x: float = 0.0
     image_y: float = 0.0
     radius: float = 0.0

@@ -11,7 +11,13 @@ from hypothesis import strategies as st
 
 from tafel.core import Module, bounded, provides, representation, requires, uses
 from tafel.core.representation import fields_of
-from tafel.core.testing import ModuleHarness, assert_close, differences, strategy_for
+from tafel.core.testing import ModuleHarness, assert_close, differences, replay_module, strategy_for
+from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler
+from tafel.modules.modeling.simple_ball_modeler import SimpleBallModeler
+from tafel.modules.motion.head_motion import HeadMotion
+from tafel.modules.perception.ball_locator import BallLocator
+from tafel.representations.perception import BallPercept
+from tests.test_cli_runtime import REPO, tafel
 from tafel.debug.concepts import STATE, modify, request
 from tafel.representations.infrastructure import FrameInfo
 
@@ -169,3 +175,48 @@ def test_isolation_part_one_leaves_debug_state_behind() -> None:
 def test_isolation_part_two_starts_clean() -> None:
     assert LEAKY.on is False
     assert modify("MtLeaky:gain", 1.0) == 1.0
+
+
+# ------------------------------------------------------------------------------ recorded situations
+SITUATION = REPO / "tests" / "data" / "ball_situation.mcap"
+
+
+def test_replay_feeds_recorded_inputs_with_recorded_times_and_compares_outputs() -> None:
+    result = replay_module(BallLocator, SITUATION, start_s=1.0, seconds=1.0)
+    assert result.context == "cognition" and len(result.frames) == 30
+    times = [frame.time_ns for frame in result.frames]
+    # lockstep at 30 and 100 Hz: cognition runs on motion's 10 ms ticks, 3 frames per 100 ms
+    assert {b - a for a, b in zip(times, times[1:])} == {30_000_000, 40_000_000}
+    assert all(frame.recorded for frame in result.frames) and result.differences() == []
+
+
+def test_replay_of_a_stateful_module_shows_where_it_differs_from_the_recording() -> None:
+    result = replay_module(KalmanBallModeler, SITUATION, start_s=1.0, seconds=1.0)
+    found = result.differences(abs=1.0)
+    assert found and found[0].startswith("frame ")  # it starts without the history the recorded one had
+    assert result.differences(abs=1e9) == []  # and never strays far
+
+
+def test_replay_names_what_the_log_lacks() -> None:
+    with pytest.raises(ValueError, match=r"does not hold HeadMotionRequest, JointSensorData, CognitionStatus, which HeadMotion reads"):
+        replay_module(HeadMotion, SITUATION)
+    with pytest.raises(ValueError, match=r"has no vision/FrameInfo: was vision running .* \['cognition', 'motion'\]"):
+        replay_module(BallLocator, SITUATION, context="vision")
+    with pytest.raises(ValueError, match="no cognition frame between 100"):
+        replay_module(BallLocator, SITUATION, start_s=100.0)
+    result = replay_module(SimpleBallModeler, SITUATION, seconds=0.5)  # BallPercept and FrameInfo are there
+    assert len(result.frames) == 15
+
+
+def test_log_slice_cuts_a_situation_that_replays_like_the_original(tmp_path) -> None:
+    piece = tmp_path / "piece.mcap"
+    done = tafel("log", "slice", str(SITUATION), "--out", str(piece), "--rep", "FrameInfo,BallImagePercept,CameraMatrixBuffer,BallPercept",
+                 "--start", "1", "--seconds", "1")
+    assert done.returncode == 0, done.stderr
+    assert "wrote" in done.stdout
+    whole = replay_module(BallLocator, SITUATION, start_s=1.0, seconds=1.0)
+    sliced = replay_module(BallLocator, piece)
+    assert [f.time_ns for f in sliced.frames] == [f.time_ns for f in whole.frames]
+    assert_close(sliced.outputs(BallPercept), whole.outputs(BallPercept))
+    wrong = tafel("log", "slice", str(SITUATION), "--out", str(tmp_path / "x.mcap"), "--rep", "BallPercpt")
+    assert wrong.returncode == 1 and "did you mean 'BallPercept'" in wrong.stderr

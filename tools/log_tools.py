@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 from google.protobuf import descriptor_pool, message_factory
 
-from tafel.core.logfile import LogError, LogReader
+from tafel.core.logfile import LogError, LogReader, write_slice
 from tafel.core.naming import did_you_mean
 
 
@@ -43,6 +43,14 @@ def add_log_commands(commands: Any) -> None:
     compare.add_argument("second", type=Path, metavar="B.mcap")
     compare.add_argument("--rep", metavar="A,B", help="only these representations")
     compare.add_argument("--json", action="store_true", help="print the report as JSON")
+    piece = actions.add_parser("slice", help="copy a piece of a log (some representations, some seconds) into a new one",
+                               description="A situation from a game as a small log: for module tests (replay_module) "
+                                           "and for sharing.")
+    piece.add_argument("file", type=Path)
+    piece.add_argument("--out", required=True, type=Path, help="the new log")
+    piece.add_argument("--rep", metavar="A,B", help="only these representations (default: all)")
+    piece.add_argument("--start", type=float, default=0.0, metavar="S", help="seconds after the log's start (default 0)")
+    piece.add_argument("--seconds", type=float, metavar="N", help="how long (default: to the end)")
 
 
 def run_log_command(args: argparse.Namespace) -> int:
@@ -50,6 +58,8 @@ def run_log_command(args: argparse.Namespace) -> int:
         from tafel.tools.log_compare import run_compare
 
         return run_compare(args)
+    if args.log_command == "slice":
+        return run_slice(args)
     logging.getLogger("tafel.log").setLevel(logging.ERROR)  # the commands print the problems themselves
     try:
         reader = LogReader(args.file)
@@ -60,6 +70,23 @@ def run_log_command(args: argparse.Namespace) -> int:
         if args.log_command == "info":
             return print_info(reader, args.json)
         return export(reader, args)
+
+
+def run_slice(args: argparse.Namespace) -> int:
+    if args.start < 0 or not np.isfinite(args.start) or (args.seconds is not None and not (np.isfinite(args.seconds) and args.seconds > 0)):
+        print("tafel log slice: error: --start takes seconds from 0 on, --seconds a positive number", file=sys.stderr)
+        return 2
+    if args.out.resolve() == args.file.resolve():
+        print("tafel log slice: error: --out must be another file than the log it slices", file=sys.stderr)
+        return 2
+    try:
+        counts = write_slice(args.file, args.out, representations=args.rep.split(",") if args.rep else None,
+                             start_s=args.start, seconds=args.seconds)
+    except LogError as exc:
+        print(f"tafel log slice: error: {exc}", file=sys.stderr)
+        return 1
+    print(f"wrote {args.out}: {sum(counts.values())} messages in {len(counts)} channels ({_size(args.out.stat().st_size)})")
+    return 0
 
 
 def print_info(reader: LogReader, as_json: bool) -> int:

@@ -46,9 +46,9 @@ class HeadMotion(Module):
         p, targets = self.parameters, self.head_joint_targets
         now_ns = self.frame_info.time_ns
         dt = p.nominal_dt
-        if self.last_time_ns is None:
-            targets.yaw = float(self.joint_sensor_data.position[HEAD_YAW])
-            targets.pitch = float(self.joint_sensor_data.position[HEAD_PITCH])
+        if self.last_time_ns is None:  # start where the head is (a sensor may read past a limit: clamp)
+            targets.yaw = min(max(float(self.joint_sensor_data.position[HEAD_YAW]), -p.yaw_limit), p.yaw_limit)
+            targets.pitch = min(max(float(self.joint_sensor_data.position[HEAD_PITCH]), p.pitch_min), p.pitch_max)
         elif now_ns > self.last_time_ns:
             dt = (now_ns - self.last_time_ns) * 1e-9
         self.last_time_ns = now_ns
