@@ -1,0 +1,78 @@
+"""KeyframePlayer: plays the motions stored as data (kicks, get-up, sitting down, falling safely)."""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from tafel.core import Module, provides, requires
+from tafel.modules.motion.keyframes import KeyframeMotion, MotionFileError, load_motion
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.motion import JointSensorData
+from tafel.representations.motion_control import FallDirection, FallPhase, FallState, Foot, KeyframeOutput, MotionRequest, MotionSelection, MotionType
+
+log = logging.getLogger("tafel.motion")
+
+
+@requires(MotionSelection, MotionRequest, FallState, JointSensorData, FrameInfo)
+@provides(KeyframeOutput)
+class KeyframePlayer(Module):
+    """Plays the motion file that fits what motion selected, from where the joints are when it starts.
+
+    Which file: ``kick_left``/``kick_right`` by the request's foot, ``getup_front``/``getup_back`` by how
+    the robot lies, ``sit``, and ``fall_front``/``fall_back`` by the fall's direction. Files are read
+    once and kept; a file that cannot be played is logged and the robot keeps still instead.
+    """
+
+    @dataclass
+    class Parameters:
+        motions_dir: str = ""
+        """folder of the motion files (empty: the shipped config/motions)"""
+
+    def __init__(self) -> None:
+        self.motions: dict[str, KeyframeMotion | None] = {}
+        self.playing: KeyframeMotion | None = None
+        self.start_pose = np.zeros(0)
+        self.start_ns = 0
+        self.selected = MotionType.stand
+
+    def execute(self) -> None:
+        out, active = self.keyframe_output, self.motion_selection.active
+        now = self.frame_info.time_ns
+        name = self.motion_for(active) if active in (MotionType.kick, MotionType.getup, MotionType.sit, MotionType.fall) else ""
+        current = self.playing.name if self.playing else ""
+        retry = active is MotionType.getup and out.done and self.fall_state.lying  # still lying after getting up: again
+        if active is not self.selected or name != current or retry:
+            self.selected = active
+            self.playing = self.load(name) if name else None
+            self.start_pose = np.array(self.joint_sensor_data.position, dtype=float)
+            self.start_ns = now
+        out.motion = self.playing.name if self.playing else ""
+        if self.playing is None:
+            out.done, out.time = True, 0.0
+            out.position = np.array(self.joint_sensor_data.position, dtype=float)
+            return
+        out.time = (now - self.start_ns) * 1e-9
+        out.position, out.stiffness = self.playing.at(out.time, self.start_pose)
+        out.done = out.time >= self.playing.duration
+
+    def motion_for(self, active: MotionType) -> str:
+        if active is MotionType.kick:
+            return "kick_left" if self.motion_request.kick_foot is Foot.left else "kick_right"
+        if active is MotionType.getup:
+            lying_back = self.fall_state.phase is FallPhase.lying_back or self.fall_state.direction is FallDirection.back
+            return "getup_back" if lying_back else "getup_front"
+        if active is MotionType.fall:
+            return "fall_back" if self.fall_state.direction is FallDirection.back else "fall_front"
+        return "sit"
+
+    def load(self, name: str) -> KeyframeMotion | None:
+        if name not in self.motions:
+            try:
+                self.motions[name] = load_motion(name, self.parameters.motions_dir)
+            except MotionFileError as exc:
+                log.error("KeyframePlayer: %s", exc)
+                self.motions[name] = None
+        return self.motions[name]

@@ -1,0 +1,86 @@
+"""MotionSelector: which motion runs, and the blend from one motion into the next."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tafel.core import Module, bounded, provides, requires, uses
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.motion_control import (
+    FallPhase,
+    FallState,
+    KeyframeOutput,
+    MotionRequest,
+    MotionSelection,
+    MotionType,
+    WalkingEngineOutput,
+)
+
+WALKING = (MotionType.walk, MotionType.walk_to)
+
+
+@requires(MotionRequest, FallState, FrameInfo)
+@uses(WalkingEngineOutput, KeyframeOutput)
+@provides(MotionSelection)
+class MotionSelector(Module):
+    """Follows the request, but never cuts a motion off where that would throw the robot over.
+
+    - A fall overrides everything at once (the protective motion); lying is followed by getting up,
+      and nothing else runs until the robot stands again.
+    - A kick or get-up plays to its end. A walk stops with its feet together before anything else
+      starts. A kick runs once per request: the request must change before the next.
+    - The joint commands blend from the old motion into the new one over ``blend_time``.
+    """
+
+    @dataclass
+    class Parameters:
+        blend_time: float = bounded(0.0, 2.0, 0.3)
+        """s over which one motion blends into the next"""
+
+    def __init__(self) -> None:
+        self.kicked = False
+        self.last_ns: int | None = None
+
+    def execute(self) -> None:
+        selection = self.motion_selection
+        previous = selection.active
+        active = self.choose(previous)
+        now = self.frame_info.time_ns
+        dt = (now - self.last_ns) * 1e-9 if self.last_ns is not None and now > self.last_ns else 0.01
+        self.last_ns = now
+        weights = np.array(selection.weights, dtype=float)
+        if not weights.any() or active is MotionType.fall:
+            weights = np.zeros(len(MotionType))
+            weights[active.value] = 1.0
+        else:
+            share = min(1.0, weights[active.value] + dt / max(self.parameters.blend_time, 1e-6))
+            others = weights.sum() - weights[active.value]
+            if others > 0:
+                weights *= (1.0 - share) / others
+            weights[active.value] = share
+        selection.active, selection.weights = active, weights
+
+    def choose(self, current: MotionType) -> MotionType:
+        fall, keyframe, walk, request = self.fall_state, self.keyframe_output, self.walking_engine_output, self.motion_request
+        if current is MotionType.getup and (not keyframe.done or fall.lying):
+            return MotionType.getup
+        if fall.phase is FallPhase.falling and current is not MotionType.getup:
+            return MotionType.fall
+        if fall.lying:
+            return MotionType.getup
+        if current is MotionType.kick and not keyframe.done:
+            return MotionType.kick
+        if current in WALKING and not walk.standing and request.motion not in WALKING:
+            return current  # the walk stops first, with its feet together
+        wanted = request.motion
+        if wanted is MotionType.kick:
+            if self.kicked:
+                return MotionType.stand
+            if current is MotionType.kick:  # the one frame in which the kick is done
+                self.kicked = True
+                return MotionType.stand
+            return MotionType.kick
+        self.kicked = False
+        return wanted if wanted in (MotionType.stand, MotionType.walk, MotionType.walk_to, MotionType.sit) else MotionType.stand

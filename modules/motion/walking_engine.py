@@ -1,0 +1,228 @@
+"""WalkingEngine: an omnidirectional walk in the family of rUNSWift's Walk2014.
+
+No dynamics model: each step moves the swing foot from where it is to half a step ahead along a smooth
+curve, lifted in the middle, while the support foot slides back linearly; the legs follow through the
+analytic inverse kinematics. The torso sways over the support foot, the gyroscope damps the ankles, and
+the support foot changes when the foot pressure says the swing foot has landed (or a step has taken
+too long). Odometry is the support foot's motion, so it needs no ground truth.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tafel.core import Module, bounded, provides, requires
+from tafel.debug import drawing, plot, request
+from tafel.modules.motion.inverse_kinematics import apply_leg_angles, leg_angles, pose
+from tafel.modules.motion.stand_motion import stand_pose
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.motion import JOINT_COUNT, JOINT_INDEX, FsrData, InertialSensorData
+from tafel.representations.motion_control import Foot, MotionRequest, MotionSelection, MotionType, Odometry, WalkingEngineOutput
+from tafel.representations.nao import HIP_OFFSET_Z
+
+DRAW_STEPS = request("WalkingEngine:draw_steps", "planned footsteps and the walk target on the field canvas")
+WALKING = (MotionType.walk, MotionType.walk_to)
+ARMS = [JOINT_INDEX[n] for n in ("LShoulderPitch", "RShoulderPitch")]
+
+
+@requires(MotionRequest, MotionSelection, FrameInfo, InertialSensorData, FsrData)
+@provides(WalkingEngineOutput, Odometry)
+class WalkingEngine(Module):
+    @dataclass
+    class Parameters:
+        step_duration: float = bounded(0.15, 0.6, 0.25)
+        """s per step"""
+        hip_height: float = bounded(180.0, 240.0, 226.0)
+        """mm of the hip joints above the ground while walking"""
+        torso_offset_x: float = bounded(-40.0, 40.0, 0.0)
+        """mm the torso stands ahead of the feet"""
+        foot_lift: float = bounded(0.0, 40.0, 22.0)
+        """mm the swing foot rises"""
+        sway: float = bounded(0.0, 40.0, 25.0)
+        """mm the torso moves sideways over the support foot"""
+        max_forward: float = bounded(0.0, 400.0, 320.0)
+        """mm/s"""
+        max_backward: float = bounded(0.0, 400.0, 150.0)
+        """mm/s"""
+        max_sideways: float = bounded(0.0, 300.0, 140.0)
+        """mm/s"""
+        max_turn: float = bounded(0.0, 3.0, 1.2)
+        """rad/s"""
+        max_acceleration: float = bounded(10.0, 2000.0, 400.0)
+        """mm/s^2 by which the walking speed may change"""
+        max_turn_acceleration: float = bounded(0.1, 20.0, 4.0)
+        """rad/s^2 by which the turning speed may change"""
+        gyro_pitch_gain: float = bounded(-1.0, 1.0, 0.08)
+        """rad of ankle pitch per rad/s of pitch rate, on the support foot"""
+        gyro_roll_gain: float = bounded(-1.0, 1.0, 0.05)
+        """rad of ankle roll per rad/s of roll rate, on the support foot"""
+        switch_after: float = bounded(0.3, 1.0, 0.75)
+        """share of a step after which landing (foot pressure) ends it"""
+        leg_stiffness: float = bounded(0.0, 1.0, 1.0)
+        arm_swing: float = bounded(0.0, 1.0, 0.3)
+        """rad of shoulder pitch per 100 mm of step"""
+        target_gain: float = bounded(0.1, 5.0, 1.5)
+        """1/s: walk_to speed per mm (and rad) still to go"""
+        target_tolerance: float = bounded(5.0, 300.0, 40.0)
+        """mm (and tolerance / 400 rad) within which walk_to has arrived"""
+
+    def __init__(self) -> None:
+        self.support = Foot.left  # the first swing foot is the right one
+        self.phase_s = 0.0
+        self.step = np.zeros(3)  # forward, left (mm), turn (rad) of the current step
+        self.velocity = np.zeros(3)  # the walk's speed (mm/s, mm/s, rad/s), approaching the request within the accelerations
+        self.start = {Foot.left: np.zeros(3), Foot.right: np.zeros(3)}  # foot offsets (x, y, yaw) at step start
+        self.now = {Foot.left: np.zeros(3), Foot.right: np.zeros(3)}
+        self.walking = False
+        self.gyro = np.zeros(2)
+        self.target: np.ndarray | None = None  # walk_to target in odometry coordinates
+        self.last_target = np.full(3, np.nan)
+        self.last_ns: int | None = None
+
+    def execute(self) -> None:
+        p, out = self.parameters, self.walking_engine_output
+        now_ns = self.frame_info.time_ns
+        dt = (now_ns - self.last_ns) * 1e-9 if self.last_ns is not None and now_ns > self.last_ns else 0.01
+        self.last_ns = now_ns
+        selected = self.motion_selection.active in WALKING
+        velocity, reached = self.requested_velocity() if selected else (np.zeros(3), False)
+        out.target_reached = reached
+        if not self.walking and not selected:
+            self.rest()
+            return
+        self.walking = True
+        phase = min(1.0, self.phase_s / p.step_duration)
+        swing = Foot.right if self.support is Foot.left else Foot.left
+        pressure = self.fsr_data.pressure
+        left, right = float(np.sum(pressure[:4])), float(np.sum(pressure[4:]))
+        landed = (left > right) if swing is Foot.left else (right > left)
+        if (phase >= p.switch_after and landed) or self.phase_s >= 1.5 * p.step_duration or self.phase_s == 0.0:
+            self.begin_step(velocity)
+            phase = 0.0
+            swing = Foot.right if self.support is Foot.left else Foot.left
+        support_before = self.now[self.support].copy()
+        smooth = 0.5 - 0.5 * math.cos(math.pi * phase)
+        self.now[swing] = self.start[swing] + (self.goal(swing) - self.start[swing]) * smooth
+        self.now[self.support] = self.start[self.support] + (self.goal(self.support) - self.start[self.support]) * phase
+        self.accumulate_odometry(support_before, self.now[self.support])
+        lift = p.foot_lift * math.sin(math.pi * phase) if np.any(self.step) or phase < 1.0 else 0.0
+        sway = p.sway * math.sin(math.pi * phase) * (1.0 if self.support is Foot.left else -1.0)
+        self.set_joints(swing, lift, sway, phase)
+        self.phase_s += dt
+        out.support_foot, out.step_phase = self.support, phase
+        # at a standstill with the feet together: stop stepping
+        if not np.any(velocity) and not np.any(self.step) and phase >= 1.0 and all(not np.any(v) for v in self.now.values()):
+            self.walking = False
+            self.phase_s = 0.0
+        out.standing = not self.walking
+
+    def requested_velocity(self) -> tuple[np.ndarray, bool]:
+        """(forward mm/s, left mm/s, turn rad/s) within the limits, and whether a walk_to target is reached."""
+        p, request = self.parameters, self.motion_request
+        if request.motion is MotionType.walk:
+            velocity = np.array([request.walk_x, request.walk_y, request.walk_rotation])
+        elif request.motion is MotionType.walk_to:
+            velocity, reached = self.towards_target()
+            if reached:
+                return np.zeros(3), True
+        else:
+            return np.zeros(3), False
+        limits = np.array([p.max_forward if velocity[0] >= 0 else p.max_backward, p.max_sideways, p.max_turn])
+        share = float(np.sqrt(np.sum((velocity / np.maximum(limits, 1e-6)) ** 2)))  # within an ellipsoid
+        return (velocity / share if share > 1.0 else velocity), False
+
+    def towards_target(self) -> tuple[np.ndarray, bool]:
+        """Speed towards the walk_to target, kept in odometry coordinates while the request stays the same."""
+        request, odometry, p = self.motion_request, self.odometry, self.parameters
+        wanted = np.array([request.target_x, request.target_y, request.target_rotation])
+        if self.target is None or not np.allclose(wanted, self.last_target):
+            c, s = math.cos(odometry.rotation), math.sin(odometry.rotation)
+            self.target = np.array([odometry.x + c * wanted[0] - s * wanted[1], odometry.y + s * wanted[0] + c * wanted[1],
+                                    odometry.rotation + wanted[2]])
+            self.last_target = wanted
+        dx, dy = self.target[0] - odometry.x, self.target[1] - odometry.y
+        c, s = math.cos(-odometry.rotation), math.sin(-odometry.rotation)
+        x, y = c * dx - s * dy, s * dx + c * dy
+        turn = math.remainder(self.target[2] - odometry.rotation, math.tau)
+        if DRAW_STEPS:
+            drawing("field").robot_pose(float(self.target[0]), float(self.target[1]), float(self.target[2]), color="yellow")
+        if math.hypot(x, y) < p.target_tolerance and abs(turn) < p.target_tolerance / 400:
+            return np.zeros(3), True
+        far = math.hypot(x, y) > 400.0  # far away: face the target first, then turn to its rotation
+        heading = math.atan2(y, x) if far and x > -200 else turn
+        return np.array([x, y, heading]) * p.target_gain, False
+
+    def begin_step(self, velocity: np.ndarray) -> None:
+        """The swing foot has landed: it supports now, and the next step is planned."""
+        p = self.parameters
+        if self.phase_s > 0.0:
+            self.support = Foot.right if self.support is Foot.left else Foot.left
+        self.phase_s = 0.0
+        self.start = {foot: offset.copy() for foot, offset in self.now.items()}
+        swing = Foot.right if self.support is Foot.left else Foot.left
+        limit = np.array([p.max_acceleration, p.max_acceleration, p.max_turn_acceleration]) * p.step_duration
+        self.velocity = self.velocity + np.clip(velocity - self.velocity, -limit, limit)
+        # forward every step; sideways and turning steps open with the foot on that side (twice as long),
+        # and the next step closes the feet again
+        wanted = self.velocity * p.step_duration * np.array([1.0, 2.0, 2.0])
+        side = 1.0 if swing is Foot.left else -1.0
+        if wanted[1] * side < 0:
+            wanted[1] = 0.0
+        if wanted[2] * side < 0:
+            wanted[2] = 0.0
+        self.step = wanted
+        if DRAW_STEPS:
+            goal = self.goal(swing)
+            drawing("field").rectangle(float(goal[0]) - 50, float(goal[1]) - 25 + side * 50, float(goal[0]) + 100,
+                                       float(goal[1]) + 25 + side * 50, color="white")
+
+    def goal(self, foot: Foot) -> np.ndarray:
+        """Where a foot ends this step (x, y mm, yaw rad, relative to its place beside the torso)."""
+        swing = self.support is not foot
+        sign = 0.5 if swing else -0.5
+        return self.step * sign
+
+    def set_joints(self, swing: Foot, lift: float, sway: float, phase: float) -> None:
+        p, out = self.parameters, self.walking_engine_output
+        height = p.hip_height + HIP_OFFSET_Z
+        soles = {}
+        for foot, side in ((Foot.left, 1.0), (Foot.right, -1.0)):
+            x, y, yaw = self.now[foot]
+            z = -height + (lift if foot is swing else 0.0)
+            soles[foot] = pose(x - p.torso_offset_x, side * 50.0 + y - sway, z, yaw=yaw)
+        angles = leg_angles(soles[Foot.left], soles[Foot.right])
+        # gyroscope feedback on the support ankle: lean against the torso's rotation
+        self.gyro = 0.7 * self.gyro + 0.3 * np.asarray(self.inertial_sensor_data.gyroscope[:2], dtype=float)
+        prefix = "L" if self.support is Foot.left else "R"
+        angles[f"{prefix}AnklePitch"] += p.gyro_pitch_gain * self.gyro[1]
+        angles[f"{prefix}AnkleRoll"] += p.gyro_roll_gain * self.gyro[0]
+        position = apply_leg_angles(stand_pose(), angles)
+        swing_x = self.now[Foot.left][0] - self.now[Foot.right][0]
+        position[ARMS[0]] += p.arm_swing * swing_x / 100.0  # the arm opposite the forward foot swings forward
+        position[ARMS[1]] -= p.arm_swing * swing_x / 100.0
+        out.position = position
+        out.stiffness = np.full(JOINT_COUNT, p.leg_stiffness)
+        plot("WalkingEngine:phase", phase)
+
+    def accumulate_odometry(self, before: np.ndarray, after: np.ndarray) -> None:
+        """The torso moves against the support foot: its backward slide is the robot's forward motion."""
+        odometry = self.odometry
+        dx, dy, dyaw = before - after
+        c, s = math.cos(odometry.rotation), math.sin(odometry.rotation)
+        odometry.x += c * dx - s * dy
+        odometry.y += s * dx + c * dy
+        odometry.rotation = math.remainder(odometry.rotation + dyaw, math.tau)
+
+    def rest(self) -> None:
+        """Not selected and not walking: stand in the walk's own pose, ready to start."""
+        out = self.walking_engine_output
+        self.now = {Foot.left: np.zeros(3), Foot.right: np.zeros(3)}
+        self.step = np.zeros(3)
+        self.velocity = np.zeros(3)
+        self.phase_s = 0.0
+        self.target = None
+        self.set_joints(Foot.right, 0.0, 0.0, 0.0)
+        out.standing, out.step_phase = True, 0.0
