@@ -11,6 +11,7 @@ heading per context; a command about one name takes the answer of the context th
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import enum
 import json
@@ -27,8 +28,8 @@ from tafel.core.manager import ModuleManager
 from tafel.core.naming import did_you_mean
 from tafel.core.parameters import ParameterError, make_parameters, parameter_values, set_parameter
 from tafel.core.representation import FieldInfo, fields_of
-from tafel.core.validation import ValueCheckError, check_field, check_instance, check_number
 from tafel.core.serialization import SerializationError, deserialize, serialize
+from tafel.core.validation import ValueCheckError, check_field, check_instance, check_number
 from tafel.debug.concepts import CANVASES, STATE, DebugState
 from tafel.debug.protocol import Command
 
@@ -69,6 +70,10 @@ _spec("representation:list", "the representations of both contexts and who provi
 _spec("representation:print", "a representation's current value as readable text", "representation:print -name NAME", "first")
 _spec("representation:get", "a representation's current value as protobuf bytes (use +representation:get for base64)", "+representation:get -name NAME", "first")
 _spec("representation:set", "set a representation from protobuf bytes or one field", "representation:set -name NAME +data BASE64 | -field FIELD -value VALUE", "first")
+_spec("representation:override", "keep a representation at a value before every frame until representation:release (remote control)",
+      "representation:override -name NAME [-fields JSON] [+data BASE64]", "first")
+_spec("representation:release", "end an override: the representation's provider writes it again",
+      "representation:release -name NAME", "first")
 _spec("debug_request:list", "debug requests, on or off")
 _spec("debug_request:set", "switch a debug request on or off", "debug_request:set -name NAME -value on|off", "first")
 _spec("modify:list", "published modify values, and which are pinned")
@@ -210,6 +215,13 @@ class ContextDebug:
         self.handlers: dict[str, Callable[[Command], str | bytes]] = {
             name: getattr(self, "cmd_" + name.replace(":", "_")) for name in SPECS
         }
+        #: representation name -> the value put on the blackboard before every frame (representation:override)
+        self.overrides: dict[str, Any] = {}
+        manager.before_frame.append(self._apply_overrides)
+
+    def _apply_overrides(self) -> None:
+        for value in self.overrides.values():
+            self.manager.blackboard.set(copy.deepcopy(value))
 
     def execute(self, command: Command) -> tuple[str, str | bytes]:
         """("ok", text), ("error", message) or ("missing", json of kind, name, known)."""
@@ -326,6 +338,42 @@ class ContextDebug:
         value = check_field(type(owner), name, parse_field_text(infos[name], argument(command, "value", positional=False), where), where)
         setattr(owner, name, value)
         return f"{where} = {_short(value)}"
+
+    def cmd_representation_override(self, command: Command) -> str:
+        rep = self._representation(command)
+        cls = type(rep)
+        data = command.args.get("data")
+        if isinstance(data, bytes):
+            value = deserialize(cls, data)
+        else:
+            text = argument(command, "fields", positional=False, required=False) or "{}"
+            try:
+                fields = json.loads(text)
+            except json.JSONDecodeError as exc:
+                raise CommandError(f"-fields takes a JSON object of field names and values, e.g. "
+                                   f'{{"walk_x": 200}}; {exc.msg} at column {exc.colno}') from None
+            if not isinstance(fields, dict):
+                raise CommandError('-fields takes a JSON object of field names and values, e.g. {"walk_x": 200}')
+            value = cls()
+            infos = {f.name: f for f in fields_of(cls)}
+            for name, raw in fields.items():
+                if name not in infos:
+                    raise CommandError(f"{cls.__name__} has no field {name!r}; {did_you_mean(name, infos)}")
+                given = infos[name].type[raw] if infos[name].kind == "enum" and isinstance(raw, str) and raw in infos[name].type.__members__ \
+                    else raw
+                setattr(value, name, check_field(cls, name, given, f"{cls.__name__}.{name}"))
+        check_instance(value)
+        self.overrides[cls.__name__] = value
+        self._apply_overrides()
+        return f"{cls.__name__} overridden in {self.context} until representation:release -name {cls.__name__}"
+
+    def cmd_representation_release(self, command: Command) -> str:
+        name = argument(command, "name", "representation")
+        if name not in self.manager.blackboard.names():
+            raise NotHere("representation", name, self.manager.blackboard.names())
+        if self.overrides.pop(name, None) is None:
+            raise CommandError(f"{name} is not overridden in {self.context}")
+        return f"{name} released in {self.context}"
 
     # --------------------------------------------------------------------- debug concepts
     def _mine(self, items: Mapping[str, Any]) -> dict[str, Any]:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import ctypes.util
-import math
 import os
 import sys
 from typing import Any
@@ -11,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from tafel.core.platform import PlatformError
-from tafel.platforms.robot_model import SERVO_GAIN, STANDING_HEIGHT, fsr_sites, mjcf
+from tafel.platforms.robot_model import SERVO_GAIN, fsr_sites, mjcf
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.motion import JOINT_NAMES
 
@@ -100,11 +99,6 @@ class MujocoPlatform(SimulatedRobotPlatform):
             self.viewer = None
 
     # ---------------------------------------------------------------------------------- engine
-    def step_physics(self, steps: int) -> None:
-        for _ in range(steps):
-            mujoco.mj_step(self.model, self.data)
-        if self.viewer is not None and self.viewer.is_running():
-            self.viewer.sync()
 
     def joint_angles(self) -> np.ndarray:
         return self.data.qpos[self.joint_qpos].copy()
@@ -165,9 +159,19 @@ class MujocoPlatform(SimulatedRobotPlatform):
         self.data.qvel[v : v + 6] = 0.0
         mujoco.mj_forward(self.model, self.data)
 
-    def move_robot(self, x_mm: float, y_mm: float, heading: float = 0.0) -> None:
+    def place_robot(self, position_m: np.ndarray, quaternion_wxyz: np.ndarray) -> None:
         q, v = self.root_qpos, self.root_qvel
-        height = self.data.qpos[q + 2] if self.data.qpos[q + 2] > 0.2 else STANDING_HEIGHT + 0.002
-        self.data.qpos[q : q + 7] = [x_mm / 1000.0, y_mm / 1000.0, height, math.cos(heading / 2), 0.0, 0.0, math.sin(heading / 2)]
+        self.data.qpos[q : q + 3] = position_m
+        self.data.qpos[q + 3 : q + 7] = quaternion_wxyz
         self.data.qvel[v : v + 6] = 0.0
         mujoco.mj_forward(self.model, self.data)
+
+    def apply_push(self, force_n: np.ndarray) -> None:
+        self.data.xfrc_applied[self.torso, :3] = force_n
+
+    def step_physics(self, steps: int) -> None:
+        for _ in range(steps):
+            mujoco.mj_step(self.model, self.data)
+        self.data.xfrc_applied[self.torso, :3] = 0.0  # a push lasts the steps it was applied for
+        if self.viewer is not None and self.viewer.is_running():
+            self.viewer.sync()

@@ -233,10 +233,14 @@ class PybulletPlatform(SimulatedRobotPlatform):
         pybullet.resetBasePositionAndOrientation(ball, [x_mm * M, y_mm * M, 0.05], [0, 0, 0, 1], physicsClientId=self.client)
         pybullet.resetBaseVelocity(ball, [0, 0, 0], [0, 0, 0], physicsClientId=self.client)
 
-    def move_robot(self, x_mm: float, y_mm: float, heading: float = 0.0) -> None:
-        position, _ = self.torso_pose()
-        height = position[2] if position[2] > 0.2 else STANDING_HEIGHT + 0.002
-        rotation = _matrix(_quaternion_yaw(heading))
-        base = np.array([x_mm * M, y_mm * M, height]) + rotation @ self.base_inertial
-        pybullet.resetBasePositionAndOrientation(self.robot, base.tolist(), _quaternion_yaw(heading), physicsClientId=self.client)
+    def place_robot(self, position_m: np.ndarray, quaternion_wxyz: np.ndarray) -> None:
+        w, x, y, z = (float(v) for v in quaternion_wxyz)
+        orientation = (x, y, z, w)
+        base = np.asarray(position_m) + _matrix(orientation) @ self.base_inertial
+        pybullet.resetBasePositionAndOrientation(self.robot, base.tolist(), orientation, physicsClientId=self.client)
         pybullet.resetBaseVelocity(self.robot, [0, 0, 0], [0, 0, 0], physicsClientId=self.client)
+
+    def apply_push(self, force_n: np.ndarray) -> None:
+        position, _ = pybullet.getBasePositionAndOrientation(self.robot, physicsClientId=self.client)
+        pybullet.applyExternalForce(self.robot, -1, [float(v) for v in force_n], position, pybullet.WORLD_FRAME,
+                                    physicsClientId=self.client)

@@ -20,14 +20,17 @@ import numpy as np
 from tafel.core.manager import Blackboard
 from tafel.core.platform import Platform, PlatformOptionError, seed_number
 from tafel.platforms.actuators import ActuatorGuard
+from tafel.platforms.robot_model import STANDING_HEIGHT
+from tafel.representations import field
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import JOINT_NAMES, FsrData, InertialSensorData, JointCommand, JointSensorData
-from tafel.representations import field
 from tafel.representations.nao import VERTICAL_FOV
 from tafel.representations.perception import CameraImageBottom, CameraImageTop
 
 GRAVITY = 9.81
 TIMESTEP = 0.002  # s of physics per step
+PUSH_SECONDS = 0.1  # how long sim:push pushes
+LYING_HEIGHT = 0.12  # m of the torso above the ground when put down lying (it drops the last bit)
 
 
 def parse_pair(text: str, what: str) -> tuple[float, float]:
@@ -54,6 +57,7 @@ def has_display() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
+MAX_PUSH = 500.0  # N: more would throw the robot off the field, not test a fall
 #: how far from the centre spot things can be put (mm): the field and its border strip
 CARPET_X = field.LENGTH / 2 + field.BORDER_STRIP
 CARPET_Y = field.WIDTH / 2 + field.BORDER_STRIP
@@ -97,6 +101,8 @@ class SimulatedRobotPlatform(Platform):
         self.stiffness = np.zeros(len(JOINT_NAMES))
         self.guard = ActuatorGuard(self.name)  # joint limits, 0..1, no NaN: whatever the modules send
         self.paused = False
+        self.push_force = np.zeros(3)
+        self.push_steps = 0  # physics steps the current push still lasts
         self.time_ns = 0
         self.last_steps = 0  # physics steps of the last advance (benchmarks read it)
         latency = float(self.options.get("camera_latency_ms") or 0.0)
@@ -171,8 +177,21 @@ class SimulatedRobotPlatform(Platform):
     def move_ball(self, x_mm: float, y_mm: float) -> None:
         raise NotImplementedError
 
-    def move_robot(self, x_mm: float, y_mm: float, heading: float = 0.0) -> None:
+    def place_robot(self, position_m: np.ndarray, quaternion_wxyz: np.ndarray) -> None:
+        """Put the torso at ``position_m`` turned by ``quaternion_wxyz``, at rest."""
         raise NotImplementedError
+
+    def apply_push(self, force_n: np.ndarray) -> None:
+        """Apply a horizontal force (N, world frame) to the torso during the next physics step."""
+        raise NotImplementedError
+
+    def move_robot(self, x_mm: float, y_mm: float, heading: float = 0.0, lying: str = "") -> None:
+        """Put the robot at (x, y) facing ``heading``: standing at its height, or ``lying`` front or back."""
+        position, _ = self.torso_pose()
+        pitch = {"": 0.0, "front": math.pi / 2, "back": -math.pi / 2}[lying]
+        height = LYING_HEIGHT if lying else position[2] if position[2] > 0.2 else STANDING_HEIGHT + 0.002
+        cy, sy, cp, sp = math.cos(heading / 2), math.sin(heading / 2), math.cos(pitch / 2), math.sin(pitch / 2)
+        self.place_robot(np.array([x_mm / 1000.0, y_mm / 1000.0, height]), np.array([cy * cp, -sy * sp, cy * sp, sy * cp]))
 
     # ------------------------------------------------------------------------------ platform
     def start(self, contexts: frozenset[str]) -> None:
@@ -185,6 +204,14 @@ class SimulatedRobotPlatform(Platform):
         steps = int(round((time_ns - self.time_ns) * 1e-9 / TIMESTEP))
         start_ns, self.time_ns = self.time_ns, time_ns
         self.last_steps = 0 if self.paused else max(steps, 0)
+        if not self.last_steps:
+            return
+        while self.push_steps and self.last_steps:  # a push lasts PUSH_SECONDS of physics
+            self.apply_push(self.push_force)
+            self.step_physics(1)
+            self.push_steps -= 1
+            self.last_steps -= 1
+            start_ns += int(round(TIMESTEP * 1e9))
         if not self.last_steps:
             return
         if not (self.camera_latency_ns and self.cameras):
@@ -254,6 +281,17 @@ class SimulatedRobotPlatform(Platform):
         """mm above the ground."""
         return float(self.torso_pose()[0][2]) * 1000.0
 
+    def posture(self) -> str:
+        """upright, lying front, lying back or lying side, from the torso's orientation (ground truth)."""
+        _, matrix = self.torso_pose()
+        if matrix[2, 2] > 0.7:
+            return "upright"
+        if matrix[2, 0] < -0.7:
+            return "lying front"
+        if matrix[2, 0] > 0.7:
+            return "lying back"
+        return "lying side" if matrix[2, 2] < 0.5 else "tilted"
+
     def robot_pose(self) -> tuple[float, float, float]:
         """The torso on the field: x, y (mm) and heading (rad)."""
         position, matrix = self.torso_pose()
@@ -277,8 +315,17 @@ class SimulatedRobotPlatform(Platform):
         def robot(args: Mapping[str, Any]) -> str:
             x, y = number(args, "x", limit=CARPET_X), number(args, "y", limit=CARPET_Y)
             heading = math.remainder(number(args, "rotation"), math.tau)
-            self.move_robot(x, y, heading)
-            return f"robot at x={x:.0f} y={y:.0f} mm, rotation {heading:.3f} rad"
+            lying = str(args.get("lying", ""))
+            if lying not in ("", "front", "back"):
+                raise PlatformOptionError(f"-lying takes front or back, got {lying!r}")
+            self.move_robot(x, y, heading, lying)
+            return f"robot at x={x:.0f} y={y:.0f} mm, rotation {heading:.3f} rad" + (f", lying on its {lying}" if lying else "")
+
+        def push(args: Mapping[str, Any]) -> str:
+            fx, fy = number(args, "x", limit=MAX_PUSH), number(args, "y", limit=MAX_PUSH)
+            self.push_force = np.array([fx, fy, 0.0])
+            self.push_steps = int(round(PUSH_SECONDS / TIMESTEP))
+            return f"pushing the torso with ({fx:.0f}, {fy:.0f}) N for {PUSH_SECONDS} s"
 
         def pause(args: Mapping[str, Any]) -> str:
             self.paused = True
@@ -292,11 +339,12 @@ class SimulatedRobotPlatform(Platform):
             bx, by = self.ball_position()
             x, y, heading = self.robot_pose()
             return (f"time {self.time_ns * 1e-9:.3f} s{' (paused)' if self.paused else ''}; robot x={x:.0f} y={y:.0f} mm "
-                    f"rotation {heading:.3f} rad, torso height {self.torso_height():.0f} mm; ball x={bx:.0f} y={by:.0f} mm")
+                    f"rotation {heading:.3f} rad, torso height {self.torso_height():.0f} mm, {self.posture()}; ball x={bx:.0f} y={by:.0f} mm")
 
         return {
             "sim:move_ball": ("put the ball at -x X -y Y (mm, field)", ball),
-            "sim:move_robot": ("put the robot at -x X -y Y (mm, field) -rotation R (rad)", robot),
+            "sim:move_robot": ("put the robot at -x X -y Y (mm, field) -rotation R (rad) [-lying front|back]", robot),
+            "sim:push": ("push the torso for 0.1 s with -x FX -y FY (N, field frame)", push),
             "sim:pause": ("stop the physics (the loops go on)", pause),
             "sim:resume": ("run the physics again", resume),
             "sim:status": ("where the robot and the ball are (ground truth)", status),

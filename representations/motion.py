@@ -6,7 +6,6 @@ Every 25-element joint array is in ``JOINT_NAMES`` order (the order of the NAO's
 from __future__ import annotations
 
 import math
-
 from dataclasses import dataclass, field
 
 import numpy as np

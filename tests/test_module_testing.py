@@ -12,14 +12,14 @@ from hypothesis import strategies as st
 from tafel.core import Module, bounded, provides, representation, requires, uses
 from tafel.core.representation import fields_of
 from tafel.core.testing import ModuleHarness, assert_close, differences, replay_module, strategy_for
+from tafel.debug.concepts import STATE, modify, request
 from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler
 from tafel.modules.modeling.simple_ball_modeler import SimpleBallModeler
 from tafel.modules.motion.head_motion import HeadMotion
 from tafel.modules.perception.ball_locator import BallLocator
+from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.perception import BallPercept
 from tests.test_cli_runtime import REPO, tafel
-from tafel.debug.concepts import STATE, modify, request
-from tafel.representations.infrastructure import FrameInfo
 
 
 @representation

@@ -301,7 +301,8 @@ def command_run(args: argparse.Namespace, extra: Sequence[str]) -> int:
     return run_lockstep(args, platform, plans, recorder, limits, config)
 
 
-def start_debug(args: argparse.Namespace, recorder: Recorder | None, plans: dict[str, ContextPlan]) -> ProgramDebug | None:
+def start_debug(args: argparse.Namespace, recorder: Recorder | None, plans: dict[str, ContextPlan],
+                config: dict[str, Any]) -> ProgramDebug | None:
     """The debug server of this run, not yet listening; None with --no-debug."""
     if args.no_debug:
         return None
@@ -316,6 +317,11 @@ def start_debug(args: argparse.Namespace, recorder: Recorder | None, plans: dict
     started = datetime.datetime.now().astimezone().isoformat(timespec="seconds")
     debug.router.identity = f"tafel {version('tafel')}: platform {args.platform}, pid {os.getpid()}, started {started}"
     debug.handovers = handovers_of(plans)
+    aliases = config.get("debug", {}).get("aliases", {}) if isinstance(config.get("debug"), dict) else {}
+    try:
+        debug.add_aliases(aliases)
+    except TafelError as exc:
+        fail(f"configuration: {exc}")
     return debug
 
 
@@ -367,7 +373,7 @@ def shutdown_grace(config: dict[str, Any]) -> float:
 def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, ContextPlan], recorder: Recorder | None,
                  limits: Limits, config: dict[str, Any]) -> int:
     runtime = LockstepRuntime(plans, platform, strict=args.strict, recorder=recorder)
-    debug = start_debug(args, recorder, plans)
+    debug = start_debug(args, recorder, plans, config)
     if debug is not None:
         recorded = debug_recorded(recorder)
         for name, runner in runtime.runners.items():
@@ -403,7 +409,7 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
                    config: dict[str, Any], recorder: Recorder | None, limits: Limits) -> int:
     platform.stop()  # each context process makes its own
     platform_class = type(platform)
-    debug = start_debug(args, recorder, plans)
+    debug = start_debug(args, recorder, plans, config)
     setup = None
     if debug is not None:
         running = [name for name, plan in plans.items() if plan.runs]

@@ -8,7 +8,9 @@ between its frames, and a dispatcher thread in the supervising process routes an
 from __future__ import annotations
 
 import json
+import math
 import multiprocessing
+import string
 import threading
 import time
 from collections import deque
@@ -25,7 +27,7 @@ from tafel.core.recording import Recorder
 from tafel.core.runtime import ContextRunner
 from tafel.debug.commands import CommandError, ContextDebug, argument
 from tafel.debug.concepts import STATE, DebugDrawings, DebugPlots, frame_debug_data
-from tafel.debug.protocol import Command
+from tafel.debug.protocol import Command, parse
 from tafel.debug.server import DebugRouter, DebugServer, Executor
 
 DEBUG_REPRESENTATIONS = (DebugDrawings, DebugPlots)
@@ -256,6 +258,53 @@ class ProgramDebug:
         router.register("log:status", "whether and where recording goes, with counts", "log:status", self._log_status)
         self.handovers: list[tuple[str, str, str]] = []
 
+    def add_aliases(self, aliases: Mapping[str, Any]) -> None:
+        """Commands defined in configuration (``[debug.aliases]``) as a template of another command.
+
+        Each names its ``command`` with ``$argument`` places, its ``arguments`` with defaults (a number:
+        the argument takes finite numbers; a list: one of its words, the first by default), and a
+        ``summary``. ``motion:walk -x 200`` is how people drive the robot by hand, written as data.
+        """
+        for name, spec in aliases.items():
+            if not isinstance(spec, Mapping) or not isinstance(spec.get("command"), str):
+                raise TafelError(f"debug alias {name!r} needs command = 'COMMAND LINE with $ARGUMENTS'")
+            arguments = dict(spec.get("arguments", {}))
+            template = string.Template(spec["command"])
+            try:  # the template must expand to a command that exists, with the defaults
+                probe = parse(template.substitute({k: _default(v) for k, v in arguments.items()}))
+            except (KeyError, ValueError) as exc:
+                raise TafelError(f"debug alias {name!r}: its command does not expand to a command line ({exc})") from None
+            if probe.name not in self.router.names():
+                raise TafelError(f"debug alias {name!r} runs {probe.name!r}, which is no command")
+            usage = name + "".join(f" [-{k} {'|'.join(v) if isinstance(v, list) else 'NUMBER'}]" for k, v in arguments.items())
+            self.router.register(name, str(spec.get("summary", f"runs {probe.name}")), usage,
+                                 lambda command, t=template, a=arguments, n=name: self._run_alias(n, t, a, command))
+
+    def _run_alias(self, name: str, template: string.Template, arguments: Mapping[str, Any], command: Command) -> str | bytes:
+        values = {}
+        for key, default in arguments.items():
+            given = command.args.get(key)
+            text = given if isinstance(given, str) and given != "" else _default(default)
+            if isinstance(default, list):
+                if text not in default:
+                    raise CommandError(f"{name}: -{key} takes {' or '.join(default)}, got {text!r}")
+            else:
+                try:
+                    number = float(text)
+                except ValueError:
+                    raise CommandError(f"{name}: -{key} takes a number, got {text!r}") from None
+                if not math.isfinite(number):
+                    raise CommandError(f"{name}: -{key} takes a finite number, got {text!r}")
+                text = repr(number)
+            values[key] = text
+        unknown = set(command.args) - set(arguments) - {"context"}
+        if unknown:
+            raise CommandError(f"{name} has no argument -{sorted(unknown)[0]}; usage: {self.router.globals[name].usage}")
+        ((is_error, answer),) = self.router.handle_batch([parse(template.substitute(values))])
+        if is_error:
+            raise CommandError(str(answer))
+        return answer
+
     def add_context(self, name: str, executor: Any, plan: ContextPlan | None = None) -> None:
         self.executors[name] = executor
         names = None
@@ -347,6 +396,10 @@ class ProgramDebug:
         if self.recorder is None:
             return "recording: not available"
         return json.dumps(self.recorder.status())
+
+
+def _default(value: Any) -> str:
+    return str(value[0]) if isinstance(value, list) else repr(float(value))
 
 
 def concurrent_pipes(contexts: Sequence[str]) -> tuple[dict[str, Any], dict[str, Any]]:

@@ -11,7 +11,16 @@ from tafel.core import Module, provides, requires
 from tafel.modules.motion.keyframes import KeyframeMotion, MotionFileError, load_motion
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import JointSensorData
-from tafel.representations.motion_control import FallDirection, FallPhase, FallState, Foot, KeyframeOutput, MotionRequest, MotionSelection, MotionType
+from tafel.representations.motion_control import (
+    FallDirection,
+    FallPhase,
+    FallState,
+    Foot,
+    KeyframeOutput,
+    MotionRequest,
+    MotionSelection,
+    MotionType,
+)
 
 log = logging.getLogger("tafel.motion")
 

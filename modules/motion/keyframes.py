@@ -17,7 +17,6 @@ from __future__ import annotations
 import math
 import tomllib
 from dataclasses import dataclass, field
-from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +24,8 @@ import numpy as np
 from tafel.representations.motion import JOINT_COUNT, JOINT_INDEX, JOINT_NAMES
 from tafel.representations.nao import JOINTS_BY_NAME
 
+#: the motions shipped with the package (config/motions, beside the modules folder)
+SHIPPED_MOTIONS = Path(__file__).resolve().parents[2] / "config" / "motions"
 #: joints whose angle changes sign in a mirror image (rotations about x and z)
 MIRROR_NEGATED = ("HeadYaw", "ShoulderRoll", "ElbowYaw", "ElbowRoll", "WristYaw", "HipRoll", "AnkleRoll")
 
@@ -71,7 +72,7 @@ class KeyframeMotion:
 
 def motions_folder(folder: str = "") -> Path:
     """The folder of motion files: ``folder`` if given, else the shipped ``config/motions``."""
-    return Path(folder) if folder else Path(str(files("tafel.config") / "motions"))
+    return Path(folder) if folder else SHIPPED_MOTIONS
 
 
 def load_motion(name: str, folder: str = "") -> KeyframeMotion:
@@ -84,6 +85,8 @@ def load_motion(name: str, folder: str = "") -> KeyframeMotion:
         raise MotionFileError(f"no motion file {path}; the motions are {', '.join(known) or 'none'}") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise MotionFileError(f"{path}: not valid TOML: {exc}") from None
+    except OSError as exc:
+        raise MotionFileError(f"{path}: cannot read it ({exc.strerror or exc})") from None
     if "mirror" in data:
         original = load_motion(str(data["mirror"]), folder)
         return KeyframeMotion(name, str(data.get("description", f"{original.description}, mirrored")),
