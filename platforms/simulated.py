@@ -43,6 +43,21 @@ def parse_pair(text: str, what: str) -> tuple[float, float]:
     return x, y
 
 
+#: the default scene: the robot in its own half facing the opponent goal, the ball on the centre spot
+DEFAULT_START = "-1500,0,0"
+DEFAULT_BALL = "0,0"
+
+
+def parse_pose(text: str) -> tuple[float, float, float]:
+    try:
+        x, y, rotation = (float(v) for v in str(text).split(","))
+    except ValueError:
+        raise PlatformOptionError(f"--start takes X,Y,ROT (mm, mm, rad), e.g. -1500,0,0; got {text!r}") from None
+    if not all(math.isfinite(v) for v in (x, y, rotation)) or abs(x) > CARPET_X or abs(y) > CARPET_Y:
+        raise PlatformOptionError(f"--start takes a pose on the carpet (|X| <= {CARPET_X:g}, |Y| <= {CARPET_Y:g}), got {text!r}")
+    return x, y, math.remainder(rotation, math.tau)
+
+
 def parse_resolution(text: str) -> tuple[int, int]:
     try:
         width, height = (int(v) for v in str(text).lower().split("x"))
@@ -95,7 +110,8 @@ class SimulatedRobotPlatform(Platform):
         self.seed = int(self.options.get("seed") or 0)
         self.cameras = str(self.options.get("cameras", "on")).lower() not in ("off", "false", "0", "no")
         self.width, self.height = parse_resolution(self.options.get("resolution") or "320x240")
-        self.initial_ball = parse_pair(self.options.get("ball") or "1000,300", "--ball")
+        self.initial_ball = parse_pair(self.options.get("ball") or DEFAULT_BALL, "--ball")
+        self.initial_pose = parse_pose(self.options.get("start") or DEFAULT_START)
         self.viewer_requested = bool(self.options.get("viewer"))
         self.rng = np.random.default_rng(self.seed)
         self.stiffness = np.zeros(len(JOINT_NAMES))
@@ -118,14 +134,17 @@ class SimulatedRobotPlatform(Platform):
         parser.add_argument("--seed", type=seed_number, default=0, help=f"{name}: seed of the sensor noise")
         parser.add_argument("--cameras", choices=["on", "off"], default="on", help=f"{name}: render the cameras")
         parser.add_argument("--resolution", default="320x240", help=f"{name}: camera image size WIDTHxHEIGHT")
-        parser.add_argument("--ball", default="1000,300", help=f"{name}: ball start X,Y in mm on the field")
+        parser.add_argument("--ball", default=DEFAULT_BALL, help=f"{name}: ball start X,Y in mm on the field (default: the centre spot)")
+        parser.add_argument("--start", default=DEFAULT_START, metavar="X,Y,ROT",
+                            help=f"{name}: robot start pose, mm on the field and rad (default: {DEFAULT_START}, in its own half facing the opponent goal)")
         parser.add_argument("--viewer", action="store_true", help=f"{name}: open the {cls.engine} viewer (needs a display)")
         parser.add_argument("--camera-latency-ms", type=float, default=0.0, metavar="MS",
                             help=f"{name}: images are rendered at time t and delivered MS later, as on the NAO (30 to 40)")
 
     # ------------------------------------------------------------------ what an engine implements
     def build(self, contexts: frozenset[str], viewer: bool) -> None:
-        """Create the world (robot at the field's centre facing +x, ball at ``initial_ball``)."""
+        """Create the world (robot at the field's centre facing +x, ball at ``initial_ball``); ``start``
+        then puts the robot at ``initial_pose``."""
         raise NotImplementedError
 
     def step_physics(self, steps: int) -> None:
@@ -199,6 +218,7 @@ class SimulatedRobotPlatform(Platform):
         if self.viewer_requested and not viewer:
             print(f"{self.name}: --viewer needs a display (DISPLAY is not set); running headless", file=sys.stderr)
         self.build(contexts, viewer)
+        self.move_robot(*self.initial_pose)
 
     def advance(self, time_ns: int) -> None:
         steps = int(round((time_ns - self.time_ns) * 1e-9 / TIMESTEP))

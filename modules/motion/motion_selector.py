@@ -38,20 +38,25 @@ class MotionSelector(Module):
     class Parameters:
         blend_time: float = bounded(0.0, 2.0, 0.3)
         """s over which one motion blends into the next"""
+        startup: float = bounded(0.0, 10.0, 1.6)
+        """s of standing at the start, while the stand motion brings the joints from where they are"""
 
     def __init__(self) -> None:
         self.kicked = False
         self.last_ns: int | None = None
+        self.first_ns: int | None = None
 
     def execute(self) -> None:
         selection = self.motion_selection
         previous = selection.active
-        active = self.choose(previous)
         now = self.frame_info.time_ns
+        self.first_ns = now if self.first_ns is None else self.first_ns
+        starting = (now - self.first_ns) * 1e-9 < self.parameters.startup
+        active = MotionType.stand if starting else self.choose(previous)
         dt = (now - self.last_ns) * 1e-9 if self.last_ns is not None and now > self.last_ns else 0.01
         self.last_ns = now
         weights = np.array(selection.weights, dtype=float)
-        if not weights.any() or active is MotionType.fall:
+        if not weights.any() or active is MotionType.fall or starting:
             weights = np.zeros(len(MotionType))
             weights[active.value] = 1.0
         else:

@@ -4,7 +4,8 @@ No dynamics model: each step moves the swing foot from where it is to half a ste
 curve, lifted in the middle, while the support foot slides back linearly; the legs follow through the
 analytic inverse kinematics. The torso sways over the support foot, the gyroscope damps the ankles, and
 the support foot changes when the foot pressure says the swing foot has landed (or a step has taken
-too long). Odometry is the support foot's motion, so it needs no ground truth.
+too long). Odometry is the support foot's motion and the gyroscope's yaw rate, so it needs no ground
+truth.
 """
 
 from __future__ import annotations
@@ -87,6 +88,9 @@ class WalkingEngine(Module):
         now_ns = self.frame_info.time_ns
         dt = (now_ns - self.last_ns) * 1e-9 if self.last_ns is not None and now_ns > self.last_ns else 0.01
         self.last_ns = now_ns
+        # the turn comes from the gyroscope: feet slip when they turn, the torso's yaw rate does not
+        yaw_rate = float(self.inertial_sensor_data.gyroscope[2])
+        self.odometry.rotation = math.remainder(self.odometry.rotation + yaw_rate * dt, math.tau)
         selected = self.motion_selection.active in WALKING
         velocity, reached = self.requested_velocity() if selected else (np.zeros(3), False)
         out.target_reached = reached
@@ -210,11 +214,10 @@ class WalkingEngine(Module):
     def accumulate_odometry(self, before: np.ndarray, after: np.ndarray) -> None:
         """The torso moves against the support foot: its backward slide is the robot's forward motion."""
         odometry = self.odometry
-        dx, dy, dyaw = before - after
+        dx, dy, _ = before - after
         c, s = math.cos(odometry.rotation), math.sin(odometry.rotation)
         odometry.x += c * dx - s * dy
         odometry.y += s * dx + c * dy
-        odometry.rotation = math.remainder(odometry.rotation + dyaw, math.tau)
 
     def rest(self) -> None:
         """Not selected and not walking: stand in the walk's own pose, ready to start."""
