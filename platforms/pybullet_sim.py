@@ -120,6 +120,10 @@ class PybulletPlatform(SimulatedRobotPlatform):
                                            physicsClientId=c)
         for link in [-1, *all_joints]:
             pybullet.changeVisualShape(self.robot, link, rgbaColor=ROBOT_RGBA, physicsClientId=c)
+        for joint in all_joints:
+            # PyBullet applies the URDF's joint damping explicitly: on the small links (neck, shoulders)
+            # one step of it overshoots, and a limp robot blows up. The servos damp instead.
+            pybullet.changeDynamics(self.robot, joint, jointDamping=0.0, physicsClientId=c)
         for link in self.foot_links.values():
             pybullet.changeDynamics(self.robot, link, lateralFriction=1.0, spinningFriction=0.02, physicsClientId=c)
         self.move_ball(*self.initial_ball)

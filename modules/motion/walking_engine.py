@@ -62,6 +62,10 @@ class WalkingEngine(Module):
         """rad of ankle roll per rad/s of roll rate, on the support foot"""
         switch_after: float = bounded(0.3, 1.0, 0.75)
         """share of a step after which landing (foot pressure) ends it"""
+        landing_share: float = bounded(0.05, 0.95, 0.4)
+        """share of the weight on the swing foot that counts as its landing"""
+        longest_step: float = bounded(1.0, 3.0, 1.0)
+        """step durations after which a step ends without a landing"""
         leg_stiffness: float = bounded(0.0, 1.0, 1.0)
         arm_swing: float = bounded(0.0, 1.0, 0.3)
         """rad of shoulder pitch per 100 mm of step"""
@@ -78,6 +82,7 @@ class WalkingEngine(Module):
         self.start = {Foot.left: np.zeros(3), Foot.right: np.zeros(3)}  # foot offsets (x, y, yaw) at step start
         self.now = {Foot.left: np.zeros(3), Foot.right: np.zeros(3)}
         self.walking = False
+        self.started = False  # a step has begun since the walk last stood still
         self.gyro = np.zeros(2)
         self.target: np.ndarray | None = None  # walk_to target in odometry coordinates
         self.last_target = np.full(3, np.nan)
@@ -94,19 +99,26 @@ class WalkingEngine(Module):
         selected = self.motion_selection.active in WALKING
         velocity, reached = self.requested_velocity() if selected else (np.zeros(3), False)
         out.target_reached = reached
-        if not self.walking and not selected:
+        if not self.walking and not np.any(velocity):  # not selected, or nowhere to go: stand in the walk's pose
             self.rest()
             return
         self.walking = True
-        phase = min(1.0, self.phase_s / p.step_duration)
+        phase = min(1.0, self.phase_s / p.step_duration)  # where the last frame left the step
         swing = Foot.right if self.support is Foot.left else Foot.left
         pressure = self.fsr_data.pressure
         left, right = float(np.sum(pressure[:4])), float(np.sum(pressure[4:]))
-        landed = (left > right) if swing is Foot.left else (right > left)
-        if (phase >= p.switch_after and landed) or self.phase_s >= 1.5 * p.step_duration or self.phase_s == 0.0:
+        swing_load = left if swing is Foot.left else right
+        landed = swing_load > p.landing_share * (left + right)  # the swing foot carries its share: it has landed
+        if self.phase_s == 0.0 or self.phase_s >= p.longest_step * p.step_duration - 1e-9 or (phase >= p.switch_after and landed):
+            at_rest = not np.any(velocity) and not np.any(self.velocity) and not np.any(self.step)
+            if at_rest and self.phase_s > 0.0 and all(np.allclose(v, 0.0, atol=1e-9) for v in self.now.values()):
+                self.rest()  # a standstill with the feet together: stop stepping
+                self.walking = False
+                return
             self.begin_step(velocity)
-            phase = 0.0
             swing = Foot.right if self.support is Foot.left else Foot.left
+        self.phase_s += dt
+        phase = min(1.0, self.phase_s / p.step_duration)  # this frame's: the last frame of a step reaches 1
         support_before = self.now[self.support].copy()
         smooth = 0.5 - 0.5 * math.cos(math.pi * phase)
         self.now[swing] = self.start[swing] + (self.goal(swing) - self.start[swing]) * smooth
@@ -115,17 +127,14 @@ class WalkingEngine(Module):
         lift = p.foot_lift * math.sin(math.pi * phase) if np.any(self.step) or phase < 1.0 else 0.0
         sway = p.sway * math.sin(math.pi * phase) * (1.0 if self.support is Foot.left else -1.0)
         self.set_joints(swing, lift, sway, phase)
-        self.phase_s += dt
         out.support_foot, out.step_phase = self.support, phase
-        # at a standstill with the feet together: stop stepping
-        if not np.any(velocity) and not np.any(self.step) and phase >= 1.0 and all(not np.any(v) for v in self.now.values()):
-            self.walking = False
-            self.phase_s = 0.0
-        out.standing = not self.walking
+        out.standing = False
 
     def requested_velocity(self) -> tuple[np.ndarray, bool]:
         """(forward mm/s, left mm/s, turn rad/s) within the limits, and whether a walk_to target is reached."""
         p, request = self.parameters, self.motion_request
+        if request.motion is not MotionType.walk_to:
+            self.target, self.last_target = None, np.full(3, np.nan)  # the next walk_to is a new one
         if request.motion is MotionType.walk:
             velocity = np.array([request.walk_x, request.walk_y, request.walk_rotation])
         elif request.motion is MotionType.walk_to:
@@ -162,8 +171,9 @@ class WalkingEngine(Module):
     def begin_step(self, velocity: np.ndarray) -> None:
         """The swing foot has landed: it supports now, and the next step is planned."""
         p = self.parameters
-        if self.phase_s > 0.0:
+        if self.phase_s > 0.0 or self.started:
             self.support = Foot.right if self.support is Foot.left else Foot.left
+        self.started = True
         self.phase_s = 0.0
         self.start = {foot: offset.copy() for foot, offset in self.now.items()}
         swing = Foot.right if self.support is Foot.left else Foot.left
@@ -226,6 +236,6 @@ class WalkingEngine(Module):
         self.step = np.zeros(3)
         self.velocity = np.zeros(3)
         self.phase_s = 0.0
-        self.target = None
+        self.started = False
         self.set_joints(Foot.right, 0.0, 0.0, 0.0)
         out.standing, out.step_phase = True, 0.0

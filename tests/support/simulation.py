@@ -12,11 +12,24 @@ from tafel.core.runtime import LockstepRuntime
 from tafel.tools.cli import DEFAULT_CONFIG, discover_modules
 
 
-class Simulation:
-    """The default configuration on a simulated platform, stepped by hand; the platform is ground truth."""
+#: the behaviour replaced by a robot that stands still: for tests of perception and head motion
+STANDING = ["cognition.modules=[\"BallDetector\", \"BallLocator\", \"KalmanBallModeler\", \"SimpleBallModeler\", "
+            "\"LookAtBallBehavior\", \"tests.support.motion_requests:ConstantMotionRequest\"]"]
 
-    def __init__(self, platform: str, overrides: list[str] | None = None, **options: Any) -> None:
+
+class Simulation:
+    """The default configuration on a simulated platform, stepped by hand; the platform is ground truth.
+
+    ``scene="still"`` (the default here) keeps the robot standing at the centre spot facing the
+    opponent goal with the ball at (1000, 300) unless options say otherwise; ``scene="default"`` is
+    the program as ``tafel run`` starts it (striker at (-1500, 0), ball on the centre spot).
+    """
+
+    def __init__(self, platform: str, overrides: list[str] | None = None, scene: str = "still", **options: Any) -> None:
         discover_modules()
+        if scene == "still":
+            options = {"start": "0,0,0", "ball": "1000,300", **options}
+            overrides = [*STANDING, *(overrides or [])]
         self.platform = load_platform(platform)(options)
         self.plans = plan_program(load_config(DEFAULT_CONFIG, platform, overrides=overrides or []), self.platform)
         self.runtime = LockstepRuntime(self.plans, self.platform)

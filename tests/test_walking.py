@@ -1,0 +1,159 @@
+"""Walking, kicking, falling and getting up in both simulators, driven as a person drives the robot:
+``tafel run`` in a subprocess, the ``motion:*`` and ``sim:*`` commands over the debug server, and
+the simulator's ground truth from ``sim:status``."""
+
+from __future__ import annotations
+
+import math
+import re
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from tests.support.simulation import Simulation
+from tests.test_debug_server import Program
+
+ENGINES = ["mujoco", "pybullet"]
+STATUS = re.compile(r"time ([\d.]+) s.*?robot x=(-?\d+) y=(-?\d+) mm rotation (-?[\d.]+) rad, torso height (\d+) mm, ([a-z ]+); "
+                    r"ball x=(-?\d+) y=(-?\d+)")
+
+
+class Robot:
+    """A running simulation and what ``sim:status`` says of it."""
+
+    def __init__(self, program: Program) -> None:
+        self.program = program
+        self.client = program.client()
+        self.heading_turned = 0.0  # rad, unwrapped
+        self.last_heading: float | None = None
+
+    def ask(self, line: str) -> str:
+        answer = self.client.ask(line)
+        assert not answer.startswith("error:"), f"{line}: {answer}"
+        return answer
+
+    def status(self) -> dict[str, float | str]:
+        match = STATUS.search(self.ask("sim:status"))
+        assert match, self.ask("sim:status")
+        t, x, y, heading, height, posture, bx, by = match.groups()
+        heading_f = float(heading)
+        if self.last_heading is not None:
+            self.heading_turned += math.remainder(heading_f - self.last_heading, math.tau)
+        self.last_heading = heading_f
+        return {"time": float(t), "x": float(x), "y": float(y), "heading": heading_f, "height": float(height),
+                "posture": posture.strip(), "ball_x": float(bx), "ball_y": float(by)}
+
+    def run_for(self, seconds: float, watch: list[str] | None = None) -> dict[str, float | str]:
+        """Let ``seconds`` of simulated time pass (polling), noting every posture seen."""
+        start = self.status()["time"]
+        deadline = time.monotonic() + 30 * seconds + 30
+        while True:
+            status = self.status()
+            if watch is not None:
+                watch.append(str(status["posture"]))
+            if status["time"] >= start + seconds:
+                return status
+            assert time.monotonic() < deadline, "the simulation does not advance"
+            time.sleep(0.02)
+
+
+@pytest.fixture(params=ENGINES)
+def robot(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[Robot]:
+    program = Program("--platform", request.param, "--cameras", "off", "--speed", "3", "--start", "0,0,0", "--ball", "3000,2500",
+                      cwd=tmp_path)
+    try:
+        robot = Robot(program)
+        robot.run_for(2.0)  # stand up
+        yield robot
+        robot.client.close()
+    finally:
+        program.stop()
+
+
+@pytest.mark.slow
+def test_walk_forward_sideways_and_turn_as_requested(robot: Robot) -> None:
+    postures: list[str] = []
+    start = robot.status()
+    robot.ask("motion:walk -x 200")
+    after_forward = robot.run_for(10.0, postures)
+    forward = math.hypot(after_forward["x"] - start["x"], after_forward["y"] - start["y"])
+    robot.ask("motion:walk -y 100")
+    after_sideways = robot.run_for(5.0, postures)
+    heading = after_sideways["heading"]
+    dx, dy = after_sideways["x"] - after_forward["x"], after_sideways["y"] - after_forward["y"]
+    sideways = -math.sin(heading) * dx + math.cos(heading) * dy  # to the robot's left
+    robot.ask("motion:walk -rotation 0.8")
+    turned_before = robot.heading_turned
+    robot.run_for(math.pi / 0.8, postures)
+    turned = robot.heading_turned - turned_before
+    robot.ask("motion:stand")
+    robot.run_for(1.0, postures)
+    assert set(postures) == {"upright"}, postures  # never fell
+    assert 1600 <= forward <= 2400, forward  # 2 m requested, within 20 %
+    assert 400 <= sideways <= 600, sideways  # 0.5 m requested
+    assert 0.8 * math.pi <= turned <= 1.2 * math.pi, turned  # 180 degrees requested
+
+
+@pytest.mark.slow
+def test_a_kick_sends_the_ball_two_metres_ahead_and_the_robot_stays_up(robot: Robot) -> None:
+    robot.ask("motion:stand")
+    robot.run_for(1.0)
+    here = robot.status()
+    c, s = math.cos(here["heading"]), math.sin(here["heading"])
+    robot.ask(f"sim:move_ball -x {here['x'] + 185 * c - 50 * s:.0f} -y {here['y'] + 185 * s + 50 * c:.0f}")  # before the left foot
+    before = robot.status()
+    postures: list[str] = []
+    robot.ask("motion:kick -foot left")
+    after = robot.run_for(6.0, postures)
+    dx, dy = after["ball_x"] - before["ball_x"], after["ball_y"] - before["ball_y"]
+    assert math.hypot(dx, dy) >= 2000, (dx, dy)
+    assert abs(math.atan2(dy, dx) - before["heading"]) < math.radians(20)  # roughly where the robot faced
+    assert set(postures) == {"upright"}, postures
+
+
+@pytest.mark.slow
+def test_a_push_that_topples_the_robot_is_detected_as_a_fall(robot: Robot) -> None:
+    robot.ask("sim:push -x 250")
+    seen = set()
+    deadline = robot.status()["time"] + 4.0
+    while robot.status()["time"] < deadline:
+        seen.add(re.search(r"phase: (\w+)", robot.ask("representation:print FallState -context motion")).group(1))
+        time.sleep(0.02)
+    assert "falling" in seen and ("lying_back" in seen or "lying_front" in seen or "getting_up" in seen), seen
+    assert robot.status()["posture"] != "upright"
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="the get-up motions do not yet bring the simulated robot up (issue 15's note)")
+@pytest.mark.parametrize("side", ["front", "back"])
+def test_getting_up_from_lying(robot: Robot, side: str) -> None:
+    here = robot.status()
+    robot.ask(f"sim:move_robot -x {here['x']:.0f} -y {here['y']:.0f} -lying {side}")
+    deadline = robot.status()["time"] + 15.0
+    while robot.status()["time"] < deadline:
+        if robot.status()["posture"] == "upright" and robot.status()["height"] > 280:
+            return
+        time.sleep(0.05)
+    pytest.fail(f"still {robot.status()['posture']} after 15 s")
+
+
+@pytest.mark.slow
+def test_the_striker_scores_in_the_default_scene() -> None:
+    """The default program and scene in MuJoCo: the ball crosses the opponent goal line within 120 s.
+    (In PyBullet the striker still falls after its first kick: issue 15's note.)"""
+    sim = Simulation("mujoco", scene="default")
+    scored: list[float] = []
+
+    def goal(s: Simulation) -> None:
+        x, y = s.platform.ball_position()
+        if not scored and x > 4500 and abs(y) < 750:
+            scored.append(s.time)
+
+    try:
+        while sim.time < 120 and not scored:
+            sim.run(1.0, goal)
+    finally:
+        sim.close()
+    assert scored, "no goal in 120 s"
