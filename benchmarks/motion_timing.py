@@ -29,7 +29,7 @@ def plans(load_ms: float):
     import loads  # noqa: F401 - registers PythonHeavyLoad
 
     config = load_config(DEFAULT_CONFIG, "dummy", overrides=[
-        'cognition.modules=["KalmanBallModeler", "SimpleBallModeler", "LookAtBallBehavior", "loads:PythonHeavyLoad"]',
+        'cognition.modules=["KalmanBallModeler", "SimpleBallModeler", "LookAtBallBehavior", "Striker", "loads:PythonHeavyLoad"]',
         f"parameters.PythonHeavyLoad.milliseconds={load_ms}",
     ])
     return plan_program(config, DummyPlatform)

@@ -99,7 +99,8 @@ def test_modules_shows_order_providers_and_hand_overs() -> None:
     result = tafel("modules", "--platform", "dummy")
     assert result.returncode == 0, result.stderr
     out = result.stdout
-    assert "order: InertialFilter -> CameraMatrixProvider -> CameraMatrixBufferProvider -> StandMotion -> HeadMotion -> MotionCombinator" in out
+    assert ("order: InertialFilter -> CameraMatrixProvider -> CameraMatrixBufferProvider -> FallDetector -> MotionSelector -> "
+            "StandMotion -> WalkingEngine -> KeyframePlayer -> HeadMotion -> MotionCombinator -> StatusLeds") in out
     assert "provider BallModel: KalmanBallModeler (alternatives: SimpleBallModeler)" in out
     assert "hand-over in: HeadMotionRequest from cognition" in out
     assert "hand-over out: HeadMotionRequest to motion" in out
@@ -114,7 +115,7 @@ def test_modules_dot_has_both_contexts_and_the_hand_over() -> None:
 
 def test_module_exceptions_are_counted_and_the_loop_goes_on() -> None:
     result = dummy("--frames", "100", "--speed", "max", "--set",
-                   'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "tests.support.runtime_faults:RaiseEveryFrame"]')
+                   'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "Striker", "tests.support.runtime_faults:RaiseEveryFrame"]')
     assert result.returncode == 0, result.stderr
     assert frames(result.stdout) == {"cognition": 30, "motion": 100}
     assert "module errors: RaiseEveryFrame 30" in result.stdout
@@ -147,7 +148,7 @@ def test_sigint_and_sigterm_shut_down_cleanly(concurrent: bool) -> None:
 def run_concurrent_fault(module: str, seconds: str, motion_frames: int) -> subprocess.CompletedProcess:
     return dummy(
         "--concurrent", "--frames", str(motion_frames),
-        "--set", f'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "tests.support.runtime_faults:{module}"]',
+        "--set", f'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "Striker", "tests.support.runtime_faults:{module}"]',
         "--set", f"parameters.{module}.after_frames=20",
         *(["--set", f"parameters.{module}.stall={seconds}"] if module == "StallCognition" else []),
         timeout=120,
@@ -186,7 +187,7 @@ def test_motion_sees_a_stalled_cognition_and_its_return() -> None:
 def test_a_stuck_module_cannot_keep_the_program_from_stopping() -> None:
     process = subprocess.Popen(
         [*TAFEL, "run", "--platform", "dummy", "--no-debug", "--set", "runtime.shutdown_grace_s=1",
-         "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "tests.support.runtime_faults:StuckForever"]'],
+         "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "Striker", "tests.support.runtime_faults:StuckForever"]'],
         cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(REPO)},
     )
     time.sleep(3)  # well inside the stuck frame
@@ -230,7 +231,7 @@ def alive(pid: int) -> bool:
 def test_concurrent_stop_with_a_stuck_cognition_ends_every_process_after_the_grace_period() -> None:
     process = subprocess.Popen(
         [*TAFEL, "run", "--platform", "dummy", "--concurrent", "--frames", "150", "--no-debug", "--set", "runtime.shutdown_grace_s=2",
-         "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "tests.support.runtime_faults:StuckForever"]'],
+         "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "Striker", "tests.support.runtime_faults:StuckForever"]'],
         cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(REPO)},
     )
     time.sleep(1.0)
@@ -296,7 +297,7 @@ def test_a_requirement_nobody_provides_is_a_missing_provider_not_a_platform_gap(
             "platform does") in result.stderr
     assert "on this platform" not in result.stderr
     # what only some platforms provide is still a gap of this platform: pruned, and said so
-    gap = dummy("--frames", "10", "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "BallDetector"]',
+    gap = dummy("--frames", "10", "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "Striker", "BallDetector"]',
                 "--set", "cognition.disabled=[]")
     assert gap.returncode == 0, gap.stderr
     assert "BallDetector disabled: nothing provides CameraImageBottom, CameraImageTop on this platform" in gap.stderr \

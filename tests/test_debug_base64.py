@@ -41,9 +41,19 @@ CALLS: dict[str, dict[str, str]] = {
     "representation:print": {"name": "BallModel", "context": "cognition"},
     "representation:set": {"name": "HeadMotionRequest", "field": "max_speed", "value": "1.5"},
     "stopwatch:list": {},
+    "representation:override": {"name": "MotionRequest", "context": "motion", "fields": "{}"},
+    "representation:release": {"name": "MotionRequest", "context": "motion"},
+    "motion:walk": {"x": "100", "y": "-20", "rotation": "0.1"},
+    "motion:walk_to": {"x": "500", "y": "0", "rotation": "0"},
+    "motion:kick": {"foot": "right", "direction": "0.1"},
+    "motion:stand": {},
+    "motion:sit": {},
+    "motion:release": {},
 }
+#: commands that undo what another did: that one runs before each call
+PRECEDED = {"log:stop": "log:start -file stop.mcap", "representation:release": "motion:stand", "motion:release": "motion:stand"}
 #: answers that change from frame to frame: compared by kind (error or not) only
-VARYING = {"hello", "log:start", "log:status", "log:stop", "modules:list", "plot:get", "representation:get", "stopwatch:list",
+VARYING = {"hello", "log:start", "log:status", "log:stop", "modules:list", "plot:get", "representation:get", "representation:print", "stopwatch:list",
            "drawings:get", "modules:store", "parameter:store"}
 
 
@@ -62,7 +72,7 @@ def program(tmp_path_factory) -> Iterator[Program]:
     folder = tmp_path_factory.mktemp("b64")
     shutil.copytree(REPO / "config", folder / "config", ignore=shutil.ignore_patterns("private"))
     running = Program("--config", str(folder / "config"), "--set",
-                      f'cognition.modules=["KalmanBallModeler", "SimpleBallModeler", "LookAtBallBehavior", "{DEBUG_USER}"]',
+                      f'cognition.modules=["KalmanBallModeler", "SimpleBallModeler", "LookAtBallBehavior", "Striker", "{DEBUG_USER}"]',
                       cwd=folder)
     yield running
     running.stop()
@@ -77,11 +87,13 @@ def test_every_command_is_covered(program: Program) -> None:
 def test_each_argument_in_base64_gives_the_plain_answer(program: Program, name: str) -> None:
     args = CALLS[name]
     with program.client() as client:
-        if name == "log:stop":
-            client.ask("log:start -file stop.mcap")
+        if name in PRECEDED:
+            client.ask(PRECEDED[name])
         plain = client.ask(line(name, args))
         assert not plain.startswith("error:"), plain
         for key in args:
+            if name in PRECEDED:
+                client.ask(PRECEDED[name])
             encoded = client.ask(line(name, args, key))
             assert not encoded.startswith("error:"), f"{name} with +{key}: {encoded}"
             if name not in VARYING:

@@ -179,7 +179,7 @@ def test_debug_data_is_recorded_like_representations(tmp_path) -> None:
     path = tmp_path / "debug.mcap"
     result = tafel("run", "--platform", "dummy", "--frames", "30", "--speed", "max", "--debug-port", "0", "--record", str(path),
                    "--record-reps", "DebugPlots,DebugDrawings",
-                   "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "tests.support.debug_user:DebugUser"]')
+                   "--set", 'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "Striker", "tests.support.debug_user:DebugUser"]')
     assert result.returncode == 0, result.stderr
     contents = read_log(path)
     plots = [deserialize(DebugPlots, m.data) for m in contents.messages if m.topic == "cognition/DebugPlots"]

@@ -79,7 +79,7 @@ def config_dir(tmp_path_factory) -> Path:
 @pytest.fixture(scope="module")
 def program(config_dir: Path) -> Iterator[Program]:
     running = Program("--config", str(config_dir), "--set",
-                      f'cognition.modules=["KalmanBallModeler", "SimpleBallModeler", "LookAtBallBehavior", "{DEBUG_USER}"]',
+                      f'cognition.modules=["KalmanBallModeler", "SimpleBallModeler", "LookAtBallBehavior", "Striker", "{DEBUG_USER}"]',
                       cwd=config_dir.parent)  # recordings go into logs/ there
     yield running
     out, err = running.stop()

@@ -20,9 +20,10 @@ from tests.support.fake_lola import KEY_ORDER, PACKET_SIZE, FakeLola, sensor_pac
 from tests.test_cli_runtime import REPO
 
 LOOK_LEFT = "tests.support.nao_support:LookLeft"
+STAND = "tests.support.motion_requests:ConstantMotionRequest"
 
 
-def run_nao(socket_path: Path, *args: str, modules: str = f'["{LOOK_LEFT}"]') -> subprocess.CompletedProcess:
+def run_nao(socket_path: Path, *args: str, modules: str = f'["{LOOK_LEFT}", "{STAND}"]') -> subprocess.CompletedProcess:
     command = [sys.executable, "-m", "tafel.tools.cli", "run", "--platform", "nao", "--lola", str(socket_path), "--cameras", "off",
                "--no-debug", "--set", f"cognition.modules={modules}", *args]
     return subprocess.run(command, capture_output=True, text=True, timeout=120, cwd=REPO, env={**os.environ, "PYTHONPATH": str(REPO)})
@@ -68,7 +69,7 @@ def test_every_packet_gets_exactly_one_well_formed_answer(lola: FakeLola, tmp_pa
 @pytest.mark.slow
 def test_motion_falls_back_to_a_safe_motion_when_cognition_dies(lola: FakeLola) -> None:
     result = run_nao(lola.path, "--frames", "400", "--set", "parameters.CrashCognitionProcess.after_frames=60",
-                     modules=f'["{LOOK_LEFT}", "tests.support.runtime_faults:CrashCognitionProcess"]')
+                     modules=f'["{LOOK_LEFT}", "{STAND}", "tests.support.runtime_faults:CrashCognitionProcess"]')
     finished(lola)
     assert result.returncode == 0, result.stderr
     assert "cognition process died (exit code 3)" in result.stderr

@@ -13,7 +13,7 @@ from tafel.core.program import plan_program
 from tafel.core.runtime import Limits, LockstepRuntime
 from tafel.representations.behavior import HeadMotionRequest
 from tafel.representations.infrastructure import CognitionStatus, FrameInfo
-from tafel.representations.motion import JointCommand, JointSensorData
+from tafel.representations.motion import BodyJointTargets, HeadJointTargets, JointCommand, JointSensorData
 from tafel.representations.perception import BallPercept
 from tafel.tools.cli import discover_modules
 
@@ -40,10 +40,19 @@ class FullTestPlatform(Platform):
         blackboard.set(FrameInfo(frame_number=frame_number, time_ns=time_ns))
 
 
+@requires(BodyJointTargets, HeadJointTargets)
+@provides(JointCommand)
+class TpCombinator(Module):
+    """The body's targets with the head's: the smallest motion pipeline, for tests of the program's plan."""
+
+    def execute(self) -> None:
+        self.joint_command.position = self.body_joint_targets.position.copy()
+
+
 CONFIG = {
     "cognition": {"modules": ["KalmanBallModeler", "SimpleBallModeler", "LookAtBallBehavior"],
                   "providers": {"BallModel": "KalmanBallModeler"}},
-    "motion": {"modules": ["StandMotion", "HeadMotion", "MotionCombinator"]},
+    "motion": {"modules": ["StandMotion", "HeadMotion", "tests.test_program:TpCombinator"]},
 }
 
 
@@ -61,7 +70,7 @@ def test_a_platform_without_joints_prunes_motion_and_reports_why() -> None:
     assert plans["motion"].pruned == {
         "StandMotion": ["JointSensorData", "FrameInfo"],
         "HeadMotion": ["JointSensorData", "FrameInfo"],
-        "MotionCombinator": ["BodyJointTargets", "HeadJointTargets"],
+        "TpCombinator": ["BodyJointTargets", "HeadJointTargets"],
     }
     assert not plans["motion"].runs and plans["cognition"].runs
     assert plans["cognition"].handover_out == []

@@ -42,7 +42,7 @@ class HeadSweep(Module):
 
 def sweep_errors(engine: str, latency_ms: float, aligned: bool, seconds: float = 6.0, speed: float = 2.5, seed: int = 0) -> list[float]:
     """Relative errors (share of the true distance) of every ball percept while the head turns fast."""
-    modules = '["BallDetector", "BallLocator", "KalmanBallModeler", "SimpleBallModeler", "tests.support.head_sweep:HeadSweep"]'
+    modules = '["BallDetector", "BallLocator", "KalmanBallModeler", "SimpleBallModeler", "tests.support.head_sweep:HeadSweep", "tests.support.motion_requests:ConstantMotionRequest"]'
     sim = Simulation(engine, overrides=[f"cognition.modules={modules}", f"parameters.HeadSweep.speed={speed}",
                                         f"parameters.BallLocator.time_aligned={'true' if aligned else 'false'}"],
                      ball=f"{BALL[0]},{BALL[1]}", camera_latency_ms=latency_ms, seed=seed)
