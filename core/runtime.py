@@ -309,6 +309,10 @@ class LockstepRuntime:
             self.end_reason = "stopped"
         return self.stats()
 
+    #: s the last tick started after its time on the wall clock (0 when on time or unpaced); hooks that do
+    #: optional work (debug commands) do less while the loop is behind
+    behind_s = 0.0
+
     def _run_rate_schedule(self, limits: Limits) -> None:
         """Ticks paced to the wall clock (or as fast as possible) until a limit or a stop."""
         start = time.monotonic()
@@ -324,6 +328,7 @@ class LockstepRuntime:
                     break
                 if limits.speed:
                     delay = start + time_ns * 1e-9 / limits.speed - time.monotonic()
+                    self.behind_s = max(0.0, -delay)
                     if delay > 0:
                         self.idle(delay)
                 self.tick()

@@ -487,17 +487,20 @@ class DebugServer:
         return batch
 
     def process_pending(self, budget_s: float = 0.001, chunk: int = 8) -> int:
-        """Between frames: answer queued commands for at most about ``budget_s``; the rest next frame."""
+        """Between frames: answer queued commands for at most about ``budget_s`` (at least one batch of
+        ``chunk``, so that nobody waits forever); the rest next frame."""
         start = time.perf_counter()
         self.next_frame()
         self._collect()
         answered = 0
-        while time.perf_counter() - start < budget_s:
+        while True:
             batch = self._next_batch(chunk)
             if not batch:
                 break
             self._answer(batch)
             answered += len(batch)
+            if time.perf_counter() - start >= budget_s:
+                break
         return answered
 
     def _answer(self, requests: list[_Request]) -> None:

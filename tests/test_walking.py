@@ -140,10 +140,10 @@ def test_getting_up_from_lying(robot: Robot, side: str) -> None:
 
 
 @pytest.mark.slow
-def test_the_striker_scores_in_the_default_scene() -> None:
-    """The default program and scene in MuJoCo: the ball crosses the opponent goal line within 120 s.
-    (In PyBullet the striker still falls after its first kick: issue 15's note.)"""
-    sim = Simulation("mujoco", scene="default")
+@pytest.mark.parametrize("engine", ENGINES)
+def test_the_striker_scores_in_the_default_scene(engine: str) -> None:
+    """The default program and scene: the ball crosses the opponent goal line within 120 s."""
+    sim = Simulation(engine, scene="default")
     scored: list[float] = []
 
     def goal(s: Simulation) -> None:
