@@ -486,3 +486,36 @@ def test_the_default_simulation_holds_its_rates_under_every_attack_at_once(tmp_p
     assert not report.http_answered, report
     assert victim.read_text() == "precious\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["victim.txt"]  # nothing was written anywhere else
+
+
+# ------------------------------------------------------------------------- configuration, command line
+@pytest.mark.parametrize("args, message", [
+    (["--set", "runtime.motion_hz=abc"], "runtime.motion_hz takes a positive number of Hz"),
+    (["--set", "runtime.motion_hz=nan"], "runtime.motion_hz takes a positive number of Hz"),
+    (["--set", "runtime.motion_hz=inf"], "runtime.motion_hz takes a positive number of Hz"),
+    (["--set", "runtime=5"], "runtime must be a table of settings"),
+    (["--set", "runtime.shutdown_grace_s=abc"], "runtime.shutdown_grace_s takes a positive number of seconds"),
+    (["--seed", "-1"], "--seed takes a whole number from 0 to 4294967295"),
+    (["--seconds", "nan"], "argument --seconds: expected a number greater than zero, got nan"),
+    (["--speed", "nan"], "--speed takes a positive number or 'max'"),
+    (["--set", "runtime.motion_hz=10000"], "above what the runtime supports (1000 Hz at the most)"),
+    (["--set", "parameters.HeadMotoin.max_speed=2"], "unknown module 'HeadMotoin': did you mean 'HeadMotion'"),
+    (["--robot", "nosuch"], "--robot nosuch: no file robot/nosuch.toml"),
+])
+def test_wrong_values_on_the_command_line_exit_2_with_what_would_be_right(tmp_path: Path, args: list[str], message: str) -> None:
+    result = subprocess.run([*TAFEL, "run", "--platform", "dummy", "--no-debug", "--seconds", "0.2", *args], cwd=tmp_path,
+                            capture_output=True, text=True, timeout=60, env={**os.environ, "PYTHONPATH": str(REPO)})
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert message in result.stderr and "Traceback" not in result.stderr, result.stderr
+
+
+@pytest.mark.parametrize("content, message", [
+    (b'a = "\xff\xfe"\n', "not UTF-8 text (byte 5 is 0xff); TOML files must be saved as UTF-8"),
+    (b"a = " + b"[" * 5000 + b"]" * 5000 + b"\n", "nested too deeply to be configuration"),
+])
+def test_a_broken_private_configuration_is_an_error_not_a_traceback(tmp_path: Path, content: bytes, message: str) -> None:
+    (tmp_path / "private").mkdir()
+    (tmp_path / "private" / "private.toml").write_bytes(content)
+    result = tafel("run", "--platform", "dummy", "--no-debug", "--seconds", "0.2", "--config", str(tmp_path))
+    assert result.returncode == 2, result.stderr
+    assert message in result.stderr and "Traceback" not in result.stderr
