@@ -24,7 +24,16 @@ from tafel.modules.motion.motion_selector import MotionSelector
 from tafel.modules.motion.stand_motion import stand_pose
 from tafel.modules.motion.walking_engine import WalkingEngine
 from tafel.representations.modeling import BallModel
-from tafel.representations.motion import JOINT_COUNT, JOINT_INDEX, BodyJointTargets, FsrData, HeadJointTargets, InertialSensorData, JointCommand, JointSensorData
+from tafel.representations.motion import (
+    JOINT_COUNT,
+    JOINT_INDEX,
+    BodyJointTargets,
+    FsrData,
+    HeadJointTargets,
+    InertialSensorData,
+    JointCommand,
+    JointSensorData,
+)
 from tafel.representations.motion_control import (
     FallDirection,
     FallPhase,

@@ -11,7 +11,6 @@ from tafel.core.program import plan_program
 from tafel.core.runtime import LockstepRuntime
 from tafel.tools.cli import DEFAULT_CONFIG, discover_modules
 
-
 #: the behaviour replaced by a robot that stands still: for tests of perception and head motion
 STANDING = ["cognition.modules=[\"BallDetector\", \"BallLocator\", \"KalmanBallModeler\", \"SimpleBallModeler\", "
             "\"LookAtBallBehavior\", \"tests.support.motion_requests:ConstantMotionRequest\"]"]
