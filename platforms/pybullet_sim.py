@@ -15,7 +15,7 @@ import numpy as np
 import pybullet
 
 from tafel.core.platform import PlatformError
-from tafel.platforms.robot_model import BALL_FRICTION, SERVO_TORQUE, STANDING_HEIGHT, FieldPart, field_parts, fsr_sites, urdf
+from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, joint_motor, FieldPart, field_parts, fsr_sites, urdf
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.motion import JOINT_NAMES
 from tafel.representations.nao import ACCELEROMETER_POSITION, CAMERAS, COUPLED_JOINTS, SOLE_BACK, SOLE_FRONT, VERTICAL_FOV
@@ -112,6 +112,7 @@ class PybulletPlatform(SimulatedRobotPlatform):
                  for i in range(pybullet.getNumJoints(self.robot, physicsClientId=c))}
         self.joint_ids = [names[name] for name in JOINT_NAMES]
         self.follower_ids = [(names[follower], JOINT_NAMES.index(leader)) for follower, leader in COUPLED_JOINTS.items()]
+        self.torques = [joint_motor(name)[0] for name in (*JOINT_NAMES, *COUPLED_JOINTS)]
         self.head_link = names["HeadPitch"]
         self.foot_links = {"L": names["LAnkleRoll"], "R": names["RAnkleRoll"]}
         self.base_inertial = np.array(pybullet.getDynamicsInfo(self.robot, -1, physicsClientId=c)[3])
@@ -219,7 +220,7 @@ class PybulletPlatform(SimulatedRobotPlatform):
         strength = list(stiffness) + [stiffness[leader] for _, leader in self.follower_ids]
         pybullet.setJointMotorControlArray(
             self.robot, joints, pybullet.POSITION_CONTROL, targetPositions=goals,
-            forces=[SERVO_TORQUE * s for s in strength], positionGains=[POSITION_GAIN] * len(joints),
+            forces=[torque * s for torque, s in zip(self.torques, strength)], positionGains=[POSITION_GAIN] * len(joints),
             velocityGains=[1.0] * len(joints), physicsClientId=self.client,
         )
 

@@ -39,9 +39,23 @@ from tafel.representations.nao import (
 )
 
 M = 0.001  # mm -> m
-#: servo strength at stiffness 1 (N m / rad) and the torque a joint can give (N m)
+#: servo strength at stiffness 1 (N m / rad)
 SERVO_GAIN = 120.0
-SERVO_TORQUE = 25.0
+#: what each joint's motor can give: (stall torque N m, no-load speed rad/s), the motor's figures times
+#: its gear ratio (Aldebaran's motor tables: legs RE-Max 24, 59.5 mN m and 8000 rpm; arms and head
+#: RE-Max 17, 15.1 mN m and 11 900 rpm; wrists A-max 12, 1.52 mN m and 12 300 rpm; ratios 201.3 or
+#: 130.85 in the legs, 150.27 or 173.22 in the arms and head, 800 at the wrists)
+_LEG_A, _LEG_B = (11.98, 4.16), (7.79, 6.40)  # 201.3: hip yaw-pitch and roll, ankle roll; 130.85: pitch joints
+_ARM_A, _ARM_B = (2.27, 8.29), (2.62, 7.19)  # 150.27: shoulder pitch, elbow yaw, head yaw; 173.22: the others
+_JOINT_MOTORS = {"HipYawPitch": _LEG_A, "HipRoll": _LEG_A, "AnkleRoll": _LEG_A, "HipPitch": _LEG_B, "KneePitch": _LEG_B,
+                 "AnklePitch": _LEG_B, "ShoulderPitch": _ARM_A, "ElbowYaw": _ARM_A, "HeadYaw": _ARM_A, "ShoulderRoll": _ARM_B,
+                 "ElbowRoll": _ARM_B, "HeadPitch": _ARM_B, "WristYaw": (1.22, 1.61), "Hand": (0.5, 2.0)}
+
+
+def joint_motor(name: str) -> tuple[float, float]:
+    """(stall torque N m, no-load speed rad/s) of a joint, by its name with or without the side."""
+    return _JOINT_MOTORS[name[1:] if name[0] in "LR" and name[1:] in _JOINT_MOTORS else name]
+
 JOINT_DAMPING = 0.6
 JOINT_ARMATURE = 0.01
 #: torso height above the ground with straight legs (m): where the robot is placed
@@ -277,7 +291,7 @@ def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002) ->
     ]
     actuated = [j for j in JOINTS if j.name not in COUPLED_JOINTS]
     actuators = [f'<position name="{j.name}" joint="{j.name}" kp="{SERVO_GAIN}" kv="0" ctrlrange="{j.limits[0]:.6g} {j.limits[1]:.6g}" '
-                 f'forcerange="{-SERVO_TORQUE} {SERVO_TORQUE}"/>' for j in actuated]
+                 f'forcerange="{-joint_motor(j.name)[0]} {joint_motor(j.name)[0]}"/>' for j in actuated]
     equalities = [f'<joint joint1="{follower}" joint2="{leader}" polycoef="0 1 0 0 0"/>' for follower, leader in COUPLED_JOINTS.items()]
     sensors = ['<accelerometer name="accelerometer" site="accelerometer"/>', '<gyro name="gyroscope" site="gyroscope"/>']
     sensors += [f'<touch name="{name}" site="{name}"/>' for side in "LR" for name, _ in fsr_sites(side)]
@@ -321,7 +335,7 @@ def urdf() -> str:
         low, high = joint.limits
         out.append(f'  <joint name={quoteattr(joint.name)} type="revolute"><parent link="{joint.parent}"/><child link="{joint.link}"/>'
                    f'<origin xyz="{_vec(np.array(joint.offset) * M)}"/><axis xyz="{_vec(joint.axis)}"/>'
-                   f'<limit lower="{low:.6g}" upper="{high:.6g}" effort="{SERVO_TORQUE}" velocity="8"/>'
+                   f'<limit lower="{low:.6g}" upper="{high:.6g}" effort="{joint_motor(joint.name)[0]}" velocity="{joint_motor(joint.name)[1]}"/>'
                    f'<dynamics damping="{JOINT_DAMPING}"/></joint>')
     out.append("</robot>")
     return "\n".join(out) + "\n"
