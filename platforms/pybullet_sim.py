@@ -15,7 +15,7 @@ import numpy as np
 import pybullet
 
 from tafel.core.platform import PlatformError
-from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, joint_motor, FieldPart, field_parts, fsr_sites, urdf
+from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, FieldPart, field_parts, fsr_sites, joint_motor, urdf
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.motion import JOINT_NAMES
 from tafel.representations.nao import ACCELEROMETER_POSITION, CAMERAS, COUPLED_JOINTS, SOLE_BACK, SOLE_FRONT, VERTICAL_FOV
