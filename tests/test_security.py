@@ -399,11 +399,10 @@ def test_a_dead_cognition_process_shows_in_the_status_line_and_answers_at_once(t
             assert time.monotonic() < deadline, "".join(running.errors)
             time.sleep(0.2)
         with running.client() as client:
-            started = time.monotonic()
             answer = client.ask("representation:print BallModel")
-            waited = time.monotonic() - started
+            # answered from what the supervisor knows, not after the 3 s a stalled process gets
+            # (that answer would be "cognition does not answer (stalled or gone)")
             assert answer == "error: cognition cannot answer: its process died (exit code 3)", answer
-            assert waited < 1.0, waited  # before: three seconds of waiting for a process that is gone
             assert "motion" in client.ask("stopwatch:list")  # motion still answers
     finally:
         out, err = running.stop()
