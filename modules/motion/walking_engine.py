@@ -69,6 +69,8 @@ class WalkingEngine(Module):
         leg_stiffness: float = bounded(0.0, 1.0, 1.0)
         arm_swing: float = bounded(0.0, 1.0, 0.3)
         """rad of shoulder pitch per 100 mm of step"""
+        odometry_scale: float = bounded(0.5, 1.5, 1.0)
+        """share of the feet's planned motion the robot really makes (the feet slip a little); measured per platform"""
         target_gain: float = bounded(0.1, 5.0, 1.5)
         """1/s: walk_to speed per mm (and rad) still to go"""
         target_tolerance: float = bounded(5.0, 300.0, 40.0)
@@ -224,7 +226,7 @@ class WalkingEngine(Module):
     def accumulate_odometry(self, before: np.ndarray, after: np.ndarray) -> None:
         """The torso moves against the support foot: its backward slide is the robot's forward motion."""
         odometry = self.odometry
-        dx, dy, _ = before - after
+        dx, dy, _ = (before - after) * self.parameters.odometry_scale
         c, s = math.cos(odometry.rotation), math.sin(odometry.rotation)
         odometry.x += c * dx - s * dy
         odometry.y += s * dx + c * dy
