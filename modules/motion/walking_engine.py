@@ -126,7 +126,7 @@ class WalkingEngine(Module):
         self.now[swing] = self.start[swing] + (self.goal(swing) - self.start[swing]) * smooth
         self.now[self.support] = self.start[self.support] + (self.goal(self.support) - self.start[self.support]) * phase
         self.accumulate_odometry(support_before, self.now[self.support])
-        lift = p.foot_lift * math.sin(math.pi * phase) if np.any(self.step) or phase < 1.0 else 0.0
+        lift = p.foot_lift * math.sin(math.pi * phase)
         sway = p.sway * math.sin(math.pi * phase) * (1.0 if self.support is Foot.left else -1.0)
         self.set_joints(swing, lift, sway, phase)
         out.support_foot, out.step_phase = self.support, phase
