@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import dataclasses
 import enum
-import math
 import typing
 from collections.abc import Mapping
 from typing import Any
 
 from tafel.core.errors import TafelError
 from tafel.core.naming import did_you_mean
+from tafel.core.validation import ValueCheckError, check_number, declared_range
 
 
 class ParameterError(TafelError, ValueError):
@@ -42,14 +42,11 @@ def coerce(module_name: str, field: dataclasses.Field, hint: Any, value: Any) ->
                 raise ValueError
             if isinstance(value, float) and not value.is_integer():
                 raise ValueError
-            return _within(where, field, int(value))
+            return _within(where, field, int(value), "int")
         if hint is float:
             if isinstance(value, bool):
                 raise ValueError
-            number = float(value)
-            if not math.isfinite(number):
-                raise ParameterError(f"parameter {where} takes a finite number, got {value!r}")
-            return _within(where, field, number)
+            return _within(where, field, float(value), "float")
         if hint is str:
             return str(value)
         if isinstance(hint, type) and issubclass(hint, enum.Enum):
@@ -71,12 +68,12 @@ def coerce(module_name: str, field: dataclasses.Field, hint: Any, value: Any) ->
     return value
 
 
-def _within(where: str, field: dataclasses.Field, number: Any) -> Any:
-    """``number`` if it lies in the field's declared range (``bounded`` or ``metadata={"range": ...}``)."""
-    bounds = field.metadata.get("range")
-    if bounds is not None and not bounds[0] <= number <= bounds[1]:
-        raise ParameterError(f"parameter {where} takes {bounds[0]:g} to {bounds[1]:g}, got {number:g}")
-    return number
+def _within(where: str, field: dataclasses.Field, number: Any, kind: str) -> Any:
+    """``number`` if it is finite and in the field's declared range (``bounded`` or ``metadata={"range": ...}``)."""
+    try:
+        return check_number(number, f"parameter {where}", kind=kind, bounds=declared_range(field))
+    except ValueCheckError as exc:
+        raise ParameterError(str(exc)) from None
 
 
 def make_parameters(module: type, values: Mapping[str, Any] | None = None) -> Any:

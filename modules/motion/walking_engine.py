@@ -27,6 +27,7 @@ from tafel.representations.nao import HIP_OFFSET_Z
 DRAW_STEPS = request("WalkingEngine:draw_steps", "planned footsteps and the walk target on the field canvas")
 WALKING = (MotionType.walk, MotionType.walk_to)
 ARMS = [JOINT_INDEX[n] for n in ("LShoulderPitch", "RShoulderPitch")]
+STAND = stand_pose()  # arms and head while walking; apply_leg_angles copies it
 
 
 @requires(MotionRequest, MotionSelection, FrameInfo, InertialSensorData, FsrData)
@@ -215,7 +216,7 @@ class WalkingEngine(Module):
         prefix = "L" if self.support is Foot.left else "R"
         angles[f"{prefix}AnklePitch"] += p.gyro_pitch_gain * self.gyro[1]
         angles[f"{prefix}AnkleRoll"] += p.gyro_roll_gain * self.gyro[0]
-        position = apply_leg_angles(stand_pose(), angles)
+        position = apply_leg_angles(STAND, angles)
         swing_x = self.now[Foot.left][0] - self.now[Foot.right][0]
         position[ARMS[0]] += p.arm_swing * swing_x / 100.0  # the arm opposite the forward foot swings forward
         position[ARMS[1]] -= p.arm_swing * swing_x / 100.0
