@@ -140,10 +140,11 @@ def test_getting_up_from_lying(robot: Robot, side: str) -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("engine", ENGINES)
-def test_the_striker_scores_in_the_default_scene(engine: str) -> None:
-    """The default program and scene: the ball crosses the opponent goal line within 120 s."""
-    sim = Simulation(engine, scene="default")
+@pytest.mark.parametrize(("engine", "seed"), [("mujoco", 0), ("mujoco", 1), ("mujoco", 2), ("pybullet", 0)])
+def test_the_striker_scores_in_the_default_scene(engine: str, seed: int) -> None:
+    """The default program and scene: the ball crosses the opponent goal line within 120 s, for several
+    seeds of the sensor noise (PyBullet renders slowly: one seed there)."""
+    sim = Simulation(engine, scene="default", seed=str(seed))
     scored: list[float] = []
 
     def goal(s: Simulation) -> None:
