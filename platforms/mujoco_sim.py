@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from tafel.core.platform import PlatformError
-from tafel.platforms.robot_model import SERVO_GAIN, fsr_sites, mjcf
+from tafel.platforms.robot_model import SERVO_GAIN, fsr_sites, joint_motor, mjcf, torque_range
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.motion import JOINT_NAMES
 
@@ -48,6 +48,8 @@ class MujocoPlatform(SimulatedRobotPlatform):
         model = self.model
         self.joint_qpos = np.array([model.jnt_qposadr[model.joint(name).id] for name in JOINT_NAMES])
         self.actuator = np.array([model.actuator(name).id for name in JOINT_NAMES])
+        self.joint_dof = np.array([model.jnt_dofadr[model.joint(name).id] for name in JOINT_NAMES])
+        self.stall_torque, self.no_load_speed = np.array([joint_motor(name) for name in JOINT_NAMES]).T
         self.sensor = {name: model.sensor(name).adr[0] for name in ("accelerometer", "gyroscope")}
         self.fsr = [model.sensor(name).adr[0] for side in "LR" for name, _ in fsr_sites(side)]
         self.torso = model.body("torso").id
@@ -171,6 +173,9 @@ class MujocoPlatform(SimulatedRobotPlatform):
 
     def step_physics(self, steps: int) -> None:
         for _ in range(steps):
+            low, high = torque_range(self.data.qvel[self.joint_dof], self.stall_torque, self.no_load_speed)
+            self.model.actuator_forcerange[self.actuator, 0] = low
+            self.model.actuator_forcerange[self.actuator, 1] = high
             mujoco.mj_step(self.model, self.data)
         self.data.xfrc_applied[self.torso, :3] = 0.0  # a push lasts the steps it was applied for
         if self.viewer is not None and self.viewer.is_running():

@@ -112,7 +112,7 @@ class PybulletPlatform(SimulatedRobotPlatform):
                  for i in range(pybullet.getNumJoints(self.robot, physicsClientId=c))}
         self.joint_ids = [names[name] for name in JOINT_NAMES]
         self.follower_ids = [(names[follower], JOINT_NAMES.index(leader)) for follower, leader in COUPLED_JOINTS.items()]
-        self.torques = [joint_motor(name)[0] for name in (*JOINT_NAMES, *COUPLED_JOINTS)]
+        self.torques, self.speeds = zip(*(joint_motor(name) for name in (*JOINT_NAMES, *COUPLED_JOINTS)))
         self.head_link = names["HeadPitch"]
         self.foot_links = {"L": names["LAnkleRoll"], "R": names["RAnkleRoll"]}
         self.base_inertial = np.array(pybullet.getDynamicsInfo(self.robot, -1, physicsClientId=c)[3])
@@ -125,8 +125,11 @@ class PybulletPlatform(SimulatedRobotPlatform):
             # PyBullet applies the URDF's joint damping explicitly: on the small links (neck, shoulders)
             # one step of it overshoots, and a limp robot blows up. The servos damp instead.
             pybullet.changeDynamics(self.robot, joint, jointDamping=0.0, physicsClientId=c)
-        for link in self.foot_links.values():
-            pybullet.changeDynamics(self.robot, link, lateralFriction=1.0, spinningFriction=0.02, physicsClientId=c)
+        for link in [-1, *all_joints]:
+            # every part grips like MuJoCo's (the robot's geoms and the carpet: 1.0); PyBullet's default
+            # of 0.5 lets hands and seat slide away in a get-up
+            spinning = 0.02 if link in self.foot_links.values() else 0.0
+            pybullet.changeDynamics(self.robot, link, lateralFriction=1.0, spinningFriction=spinning, physicsClientId=c)
         self.move_ball(*self.initial_ball)
 
     def stop(self) -> None:
@@ -218,11 +221,12 @@ class PybulletPlatform(SimulatedRobotPlatform):
         joints = list(self.joint_ids) + [follower for follower, _ in self.follower_ids]
         goals = list(targets) + [targets[leader] for _, leader in self.follower_ids]
         strength = list(stiffness) + [stiffness[leader] for _, leader in self.follower_ids]
-        pybullet.setJointMotorControlArray(
-            self.robot, joints, pybullet.POSITION_CONTROL, targetPositions=goals,
-            forces=[torque * s for torque, s in zip(self.torques, strength)], positionGains=[POSITION_GAIN] * len(joints),
-            velocityGains=[1.0] * len(joints), physicsClientId=self.client,
-        )
+        # one call per joint: only this form takes a speed limit (PyBullet's motors cannot follow the
+        # motors' torque-speed line as MuJoCo's do; the no-load speed as a hard limit comes closest)
+        for joint, goal, torque, speed, share in zip(joints, goals, self.torques, self.speeds, strength):
+            pybullet.setJointMotorControl2(self.robot, joint, pybullet.POSITION_CONTROL, targetPosition=goal, force=torque * share,
+                                           positionGain=POSITION_GAIN, velocityGain=1.0, maxVelocity=speed,
+                                           physicsClientId=self.client)
 
     def torso_pose(self) -> tuple[np.ndarray, np.ndarray]:
         position, orientation = pybullet.getBasePositionAndOrientation(self.robot, physicsClientId=self.client)

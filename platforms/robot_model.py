@@ -56,6 +56,17 @@ def joint_motor(name: str) -> tuple[float, float]:
     """(stall torque N m, no-load speed rad/s) of a joint, by its name with or without the side."""
     return _JOINT_MOTORS[name[1:] if name[0] in "LR" and name[1:] in _JOINT_MOTORS else name]
 
+
+def torque_range(velocity: np.ndarray, stall: np.ndarray, no_load_speed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(lowest, highest) torque (N m) the motors can give at joint ``velocity`` (rad/s).
+
+    A DC motor's torque falls in a straight line from its stall torque at rest to nothing at its
+    no-load speed; against the motion (braking) it gives up to the stall torque. That line is what
+    limits the NAO's joint speeds, so the simulated joints cannot move faster than the real ones.
+    """
+    share = velocity / no_load_speed
+    return -stall * np.clip(1.0 + share, 0.0, 1.0), stall * np.clip(1.0 - share, 0.0, 1.0)
+
 JOINT_DAMPING = 0.6
 JOINT_ARMATURE = 0.01
 #: torso height above the ground with straight legs (m): where the robot is placed

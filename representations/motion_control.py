@@ -162,5 +162,7 @@ class KeyframeOutput:
     motion: str = ""
     #: s into the motion
     time: float = bounded(0.0, 1e6)
-    #: the motion has played to its end
+    #: the motion has played to its end, or was aborted
     done: bool = True
+    #: the motion stopped early: the torso was tilted more than a keyframe's ``abort_if_tilted`` allows
+    aborted: bool = False

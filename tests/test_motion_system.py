@@ -231,14 +231,29 @@ def test_the_combinator_blends_without_a_jump_and_keeps_the_head_to_the_head_mot
 
 # --------------------------------------------------------------------------------- keyframe motions
 def test_every_shipped_motion_file_loads_and_mirrors() -> None:
-    for name in ("kick_left", "kick_right", "getup_front", "sit", "fall_front", "fall_back"):
+    for name in ("kick_left", "kick_right", "getup_front", "getup_back", "getup_sitting", "sit", "fall_front", "fall_back"):
         motion = load_motion(name)
         assert motion.duration > 0 and motion.keyframes
+    shared_end = load_motion("getup_sitting").keyframes
+    for name in ("getup_front", "getup_back"):
+        tail = load_motion(name).keyframes[-len(shared_end):]
+        assert [(k.duration, k.targets) for k in tail] == [(k.duration, k.targets) for k in shared_end]
     left, right = load_motion("kick_left"), load_motion("kick_right")
     swing = left.keyframes[2].targets
     mirrored = right.keyframes[2].targets
     assert mirrored[JOINT_INDEX["RHipPitch"]] == swing[JOINT_INDEX["LHipPitch"]]
     assert mirrored[JOINT_INDEX["RHipRoll"]] == -swing[JOINT_INDEX["LHipRoll"]]
+
+
+def test_then_appends_another_motion_and_a_circle_is_an_error(tmp_path: Path) -> None:
+    (tmp_path / "first.toml").write_text('then = "second"\n[[keyframes]]\nduration = 0.5\njoints = { LKneePitch = 1.0 }\n')
+    (tmp_path / "second.toml").write_text("[[keyframes]]\nduration = 0.25\njoints = { LKneePitch = 0.5 }\n")
+    motion = load_motion("first", str(tmp_path))
+    assert motion.duration == 0.75
+    assert [k.targets[JOINT_INDEX["LKneePitch"]] for k in motion.keyframes] == [1.0, 0.5]
+    (tmp_path / "second.toml").write_text('then = "first"\n[[keyframes]]\nduration = 0.25\n')
+    with pytest.raises(MotionFileError, match="in a circle: first -> second -> first"):
+        load_motion("first", str(tmp_path))
 
 
 @pytest.mark.parametrize("text, message", [
@@ -248,6 +263,7 @@ def test_every_shipped_motion_file_loads_and_mirrors() -> None:
     ("[[keyframes]]\nduration = 1\njoints = { LKneePitch = 3.0 }\n", "outside its limits"),
     ("[[keyframes]]\nduration = 1\nstiffness = 2\n", "stiffness takes values from 0 to 1"),
     ("[[keyframes]\n", "not valid TOML"),
+    ("[[keyframes]]\nduration = 1\nabort_if_tilted = -1\n", "abort_if_tilted takes a tilt in rad"),
 ])
 def test_a_broken_motion_file_is_an_error_naming_the_file_and_what_is_wrong(tmp_path: Path, text: str, message: str) -> None:
     (tmp_path / "broken.toml").write_text(text)
@@ -270,6 +286,42 @@ def test_the_player_starts_from_where_the_joints_are_and_reaches_the_keyframes_i
     assert_close(harness[KeyframeOutput].position[JOINT_INDEX["LHipRoll"]], 0.295, abs=1e-3)
     harness.advance(2.0)
     assert harness[KeyframeOutput].done
+
+
+def test_a_get_up_that_went_wrong_stops_where_it_is_and_starts_again_once_the_robot_lies(tmp_path: Path) -> None:
+    (tmp_path / "getup_front.toml").write_text(
+        "[[keyframes]]\nduration = 0.5\njoints = { LKneePitch = 2.0 }\n"
+        "[[keyframes]]\nduration = 0.5\nabort_if_tilted = 0.9\njoints = { LKneePitch = 0.5 }\n")
+    lying = FallState(phase=FallPhase.lying_front)
+    harness = ModuleHarness(KeyframePlayer, MotionSelection(active=MotionType.getup), lying, JointSensorData(position=stand_pose()),
+                            imu(pitch=1.4), parameters={"motions_dir": str(tmp_path)}, context="motion")
+    harness.execute()
+    assert not harness[KeyframeOutput].aborted  # the first keyframe has no check
+    harness.set(FallState(phase=FallPhase.getting_up))
+    harness.advance(0.6)  # into the second keyframe, still face down
+    out = harness[KeyframeOutput]
+    assert out.aborted and out.done
+    held = out.position[JOINT_INDEX["LKneePitch"]]
+    harness.advance(0.5)
+    assert harness[KeyframeOutput].position[JOINT_INDEX["LKneePitch"]] == held  # holds where it stopped
+    harness.set(lying)  # lying still again: the get-up starts over
+    harness.execute()
+    assert not harness[KeyframeOutput].aborted and harness[KeyframeOutput].time == 0.0
+    harness.set(imu(pitch=0.3))  # this time it comes up: the check passes
+    harness.advance(0.6)
+    assert not harness[KeyframeOutput].aborted
+
+
+def test_an_aborted_get_up_holds_until_the_robot_lies_and_lets_go_once_it_is_upright() -> None:
+    harness = selector(FallState(phase=FallPhase.lying_back), KeyframeOutput(done=True))
+    harness.execute()
+    assert harness[MotionSelection].active is MotionType.getup
+    harness.set(FallState(phase=FallPhase.falling), KeyframeOutput(done=True, aborted=True))
+    harness.execute(frames=5)
+    assert harness[MotionSelection].active is MotionType.getup
+    harness.set(FallState(phase=FallPhase.upright))
+    harness.execute()
+    assert harness[MotionSelection].active is MotionType.stand
 
 
 def test_a_motion_file_that_cannot_be_played_keeps_the_robot_still(tmp_path: Path) -> None:

@@ -7,10 +7,15 @@ import math
 import numpy as np
 import pybullet
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from tafel.modules.perception.ball_detector import BallDetector
 from tafel.platforms.mujoco_sim import MujocoPlatform
 from tafel.platforms.pybullet_sim import PybulletPlatform
+from tafel.platforms.robot_model import joint_motor, torque_range
+from tafel.platforms.simulated import TIMESTEP
+from tafel.representations.motion import JOINT_NAMES
 from tafel.representations.nao import CAMERAS, JOINTS, TORSO_MASS, VERTICAL_FOV
 
 
@@ -85,3 +90,43 @@ def test_both_renderings_show_the_ball_at_the_same_pixel(engines) -> None:
     (mujoco_ball, *_), (bullet_ball, *_) = blobs
     assert math.hypot(mujoco_ball.x - bullet_ball.x, mujoco_ball.y - bullet_ball.y) < 3.0
     assert mujoco_ball.radius == pytest.approx(bullet_ball.radius, abs=1.5)
+
+
+@given(velocity=st.floats(-30.0, 30.0), stall=st.floats(0.1, 20.0), no_load=st.floats(0.5, 20.0))
+def test_the_motor_gives_its_stall_torque_at_rest_and_nothing_forwards_at_its_no_load_speed(
+        velocity: float, stall: float, no_load: float) -> None:
+    low, high = (float(v[0]) for v in torque_range(np.array([velocity]), np.array([stall]), np.array([no_load])))
+    assert -stall <= low <= 0.0 <= high <= stall
+    if velocity >= no_load:
+        assert high == 0.0  # cannot drive it any faster
+    if velocity <= -no_load:
+        assert low == 0.0
+    if velocity == 0.0:
+        assert (low, high) == (-stall, stall)
+    if velocity > 0:
+        assert low == -stall  # braking is always possible
+    faster_high = float(torque_range(np.array([velocity + 1.0]), np.array([stall]), np.array([no_load]))[1][0])
+    assert faster_high <= high
+
+
+@pytest.mark.slow
+def test_no_joint_moves_faster_than_its_motor(engines) -> None:
+    """A 3 rad step in both shoulders: each engine moves them at most at the motor's no-load speed."""
+    names = ["LShoulderPitch", "RShoulderPitch", "HeadYaw"]
+    indices = [JOINT_NAMES.index(name) for name in names]
+    no_load = np.array([joint_motor(name)[1] for name in names])
+    for platform in engines:
+        start = platform.joint_angles()
+        target = start.copy()
+        target[indices] = [-1.5, -1.5, 1.5]
+        previous, fastest = start[indices], np.zeros(len(names))
+        for _ in range(300):  # 0.6 s in 2 ms steps
+            platform.drive(target, np.ones(len(JOINT_NAMES)))
+            platform.step_physics(1)
+            now = platform.joint_angles()[indices]
+            fastest = np.maximum(fastest, np.abs(now - previous) / TIMESTEP)
+            previous = now
+        assert np.all(fastest <= no_load * 1.05), (platform.name, fastest, no_load)
+        assert np.all(fastest >= no_load * 0.25), (platform.name, fastest)  # and the motors do drive
+        platform.drive(start, np.ones(len(JOINT_NAMES)))
+        platform.step_physics(300)

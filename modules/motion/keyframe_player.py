@@ -10,7 +10,7 @@ import numpy as np
 from tafel.core import Module, provides, requires
 from tafel.modules.motion.keyframes import KeyframeMotion, MotionFileError, load_motion
 from tafel.representations.infrastructure import FrameInfo
-from tafel.representations.motion import JointSensorData
+from tafel.representations.motion import InertialSensorData, JointSensorData
 from tafel.representations.motion_control import (
     FallDirection,
     FallPhase,
@@ -25,14 +25,16 @@ from tafel.representations.motion_control import (
 log = logging.getLogger("tafel.motion")
 
 
-@requires(MotionSelection, MotionRequest, FallState, JointSensorData, FrameInfo)
+@requires(MotionSelection, MotionRequest, FallState, JointSensorData, InertialSensorData, FrameInfo)
 @provides(KeyframeOutput)
 class KeyframePlayer(Module):
     """Plays the motion file that fits what motion selected, from where the joints are when it starts.
 
     Which file: ``kick_left``/``kick_right`` by the request's foot, ``getup_front``/``getup_back`` by how
     the robot lies, ``sit``, and ``fall_front``/``fall_back`` by the fall's direction. Files are read
-    once and kept; a file that cannot be played is logged and the robot keeps still instead.
+    once and kept; a file that cannot be played is logged and the robot keeps still instead. A keyframe
+    with ``abort_if_tilted`` that begins with the torso tilted more than that stops the motion where
+    it is (``aborted``); a get-up then starts again once the robot lies still.
     """
 
     @dataclass
@@ -46,6 +48,8 @@ class KeyframePlayer(Module):
         self.start_pose = np.zeros(0)
         self.start_ns = 0
         self.selected = MotionType.stand
+        self.keyframe = -1
+        self.aborted_at: float | None = None
 
     def execute(self) -> None:
         out, active = self.keyframe_output, self.motion_selection.active
@@ -58,14 +62,31 @@ class KeyframePlayer(Module):
             self.playing = self.load(name) if name else None
             self.start_pose = np.array(self.joint_sensor_data.position, dtype=float)
             self.start_ns = now
+            self.keyframe, self.aborted_at = -1, None
         out.motion = self.playing.name if self.playing else ""
+        out.aborted = self.aborted_at is not None
         if self.playing is None:
             out.done, out.time = True, 0.0
             out.position = np.array(self.joint_sensor_data.position, dtype=float)
             return
-        out.time = (now - self.start_ns) * 1e-9
+        out.time = self.aborted_at if self.aborted_at is not None else (now - self.start_ns) * 1e-9
+        if self.aborted_at is None:
+            self.check_tilt(self.playing, out.time)
         out.position, out.stiffness = self.playing.at(out.time, self.start_pose)
-        out.done = out.time >= self.playing.duration
+        out.done = out.aborted or out.time >= self.playing.duration
+
+    def check_tilt(self, motion: KeyframeMotion, time_s: float) -> None:
+        """At the start of each keyframe with ``abort_if_tilted``: stop here if the torso tilts more."""
+        index = motion.keyframe_at(time_s)
+        if index == self.keyframe:
+            return
+        self.keyframe = index
+        limit = motion.keyframes[index].abort_if_tilted
+        tilt = float(np.max(np.abs(self.inertial_sensor_data.angles[:2])))
+        if limit is not None and tilt > limit:
+            self.aborted_at = time_s
+            log.info("KeyframePlayer: %s stopped at keyframe %d: the torso tilts %.2f rad, more than %.2f",
+                     motion.name, index + 1, tilt, limit)
 
     def motion_for(self, active: MotionType) -> str:
         if active is MotionType.kick:

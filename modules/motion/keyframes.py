@@ -3,7 +3,10 @@
 A motion file holds keyframes; each says where the joints go (by name, rad), how long getting there
 takes (s), and with what stiffness (one number for all joints, or a table by joint name). Joints a
 keyframe does not name keep their previous value; before the first keyframe, that is where the joints
-are when the motion starts. ``mirror = "kick_left"`` makes a motion the left-right mirror of another.
+are when the motion starts. ``mirror = "kick_left"`` makes a motion the left-right mirror of another;
+``then = "getup_sitting"`` plays another motion's keyframes after this one's (the get-ups share their end).
+``abort_if_tilted = 0.9`` on a keyframe stops the motion when that keyframe begins with the torso tilted
+more than 0.9 rad (roll or pitch): a get-up that has gone wrong starts again from how the robot lies.
 
     description = "kick with the left foot"
     [[keyframes]]
@@ -39,6 +42,8 @@ class Keyframe:
     duration: float  # s from the previous keyframe
     targets: dict[int, float]  # joint index -> rad
     stiffness: np.ndarray = field(default_factory=lambda: np.ones(JOINT_COUNT))
+    #: rad of torso tilt beyond which the motion stops when this keyframe begins (None: never)
+    abort_if_tilted: float | None = None
 
 
 @dataclass
@@ -52,6 +57,15 @@ class KeyframeMotion:
     @property
     def duration(self) -> float:
         return sum(k.duration for k in self.keyframes)
+
+    def keyframe_at(self, time_s: float) -> int:
+        """The index of the keyframe playing ``time_s`` into the motion (the last one after the end)."""
+        elapsed = 0.0
+        for index, keyframe in enumerate(self.keyframes):
+            elapsed += keyframe.duration
+            if time_s < elapsed:
+                return index
+        return len(self.keyframes) - 1
 
     def at(self, time_s: float, start: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(positions, stiffness) ``time_s`` into the motion that began at the joint positions ``start``."""
@@ -75,9 +89,12 @@ def motions_folder(folder: str = "") -> Path:
     return Path(folder) if folder else SHIPPED_MOTIONS
 
 
-def load_motion(name: str, folder: str = "") -> KeyframeMotion:
-    """Read and check ``NAME.toml``; mirrored motions are built from their original."""
+def load_motion(name: str, folder: str = "", _loading: tuple[str, ...] = ()) -> KeyframeMotion:
+    """Read and check ``NAME.toml``; mirrored motions are built from their original, ``then`` is appended."""
     path = motions_folder(folder) / f"{name}.toml"
+    if name in _loading:
+        raise MotionFileError(f"{path}: motions refer to each other in a circle: {' -> '.join([*_loading, name])}")
+    _loading = (*_loading, name)
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
@@ -88,13 +105,15 @@ def load_motion(name: str, folder: str = "") -> KeyframeMotion:
     except OSError as exc:
         raise MotionFileError(f"{path}: cannot read it ({exc.strerror or exc})") from None
     if "mirror" in data:
-        original = load_motion(str(data["mirror"]), folder)
+        original = load_motion(str(data["mirror"]), folder, _loading)
         return KeyframeMotion(name, str(data.get("description", f"{original.description}, mirrored")),
                               [_mirrored(k) for k in original.keyframes], original.moves_head)
     frames = data.get("keyframes")
     if not isinstance(frames, list) or not frames:
         raise MotionFileError(f"{path}: needs at least one [[keyframes]] table with duration and joints")
     keyframes = [_keyframe(path, i, frame) for i, frame in enumerate(frames)]
+    if "then" in data:
+        keyframes += load_motion(str(data["then"]), folder, _loading).keyframes
     return KeyframeMotion(name, str(data.get("description", "")), keyframes, bool(data.get("moves_head", False)))
 
 
@@ -120,7 +139,11 @@ def _keyframe(path: Path, index: int, frame: object) -> Keyframe:
         if not low - 1e-6 <= angle <= high + 1e-6:
             raise MotionFileError(f"{where}: {name} = {angle} is outside its limits {low:.3f} .. {high:.3f} rad")
         targets[JOINT_INDEX[name]] = float(angle)
-    return Keyframe(float(duration), targets, _stiffness(where, frame.get("stiffness", 1.0)))
+    abort = frame.get("abort_if_tilted")
+    if abort is not None and (isinstance(abort, bool) or not isinstance(abort, (int, float)) or not 0.0 < abort <= math.pi):
+        raise MotionFileError(f"{where}: abort_if_tilted takes a tilt in rad from 0 (exclusive) to pi, got {abort!r}")
+    return Keyframe(float(duration), targets, _stiffness(where, frame.get("stiffness", 1.0)),
+                    None if abort is None else float(abort))
 
 
 def _stiffness(where: str, value: object) -> np.ndarray:
@@ -152,4 +175,4 @@ def _mirrored(keyframe: Keyframe) -> Keyframe:
         base = name[1:] if name[0] in "LR" else name
         targets[JOINT_INDEX[name]] = -angle if base in MIRROR_NEGATED else angle
     stiffness = np.array([keyframe.stiffness[JOINT_INDEX[mirror_name(n)]] for n in JOINT_NAMES])
-    return Keyframe(keyframe.duration, targets, stiffness)
+    return Keyframe(keyframe.duration, targets, stiffness, keyframe.abort_if_tilted)

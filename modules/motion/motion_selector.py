@@ -69,8 +69,8 @@ class MotionSelector(Module):
 
     def choose(self, current: MotionType) -> MotionType:
         fall, keyframe, walk, request = self.fall_state, self.keyframe_output, self.walking_engine_output, self.motion_request
-        if current is MotionType.getup and (not keyframe.done or fall.lying):
-            return MotionType.getup
+        if current is MotionType.getup and (not keyframe.done or fall.lying or (keyframe.aborted and not fall.upright)):
+            return MotionType.getup  # an aborted get-up holds still until the robot lies, then starts again
         if fall.phase is FallPhase.falling and current is not MotionType.getup:
             return MotionType.fall
         if fall.lying:
