@@ -2,9 +2,13 @@
 
 Layout: one channel per context and representation, topic ``<context>/<RepresentationName>``, protobuf
 encoding with the schema as a FileDescriptorSet (so Foxglove and the ``mcap`` tool read it, and a
-reader with only ``mcap`` and ``protobuf`` decodes it), log time = frame time in nanoseconds, sequence
+reader with only ``mcap`` and ``protobuf`` decodes it), publish time = frame time in nanoseconds (what
+replay uses), log time = wall-clock time at recording (ns since the epoch, what viewers show), sequence
 = frame number. Channel metadata says who wrote the representation (``source`` = ``platform`` or
 ``module``), and a ``tafel`` metadata record holds the rates and the platform of the run.
+
+Other channels may ride along (``translate``: Foxglove's well-known messages, computed from the
+representations in the writer thread); their topics start with ``/`` and replay leaves them alone.
 
 The writer never blocks the loop that records: messages go into a bounded queue and a background
 thread writes them; when the queue is full a message is dropped and counted. The thread closes a chunk
@@ -19,7 +23,7 @@ import os
 import queue
 import threading
 import time
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -46,6 +50,10 @@ class LogError(TafelError, RuntimeError):
     """A log file that cannot be written, or read (with the file and the position)."""
 
 
+#: topics of channels that are not representations (Foxglove's) start with this
+EXTRA_TOPIC_PREFIX = "/"
+
+
 @dataclass
 class _Item:
     topic: str
@@ -54,14 +62,54 @@ class _Item:
     sequence: int
     data: bytes
     metadata: Mapping[str, str]
+    wall_ns: int = 0
+
+
+@dataclass
+class ExtraMessage:
+    """A message of a channel that is not a representation, with its schema (written as given)."""
+
+    topic: str
+    schema_name: str
+    schema_encoding: str  # "protobuf" or "jsonschema"
+    schema_data: bytes
+    message_encoding: str  # "protobuf" or "json"
+    data: bytes
+    time_ns: int  # frame time
+    wall_ns: int  # wall-clock time (ns since the epoch)
+
+
+#: what a ``LogWriter`` may be given to add channels: called in the writer thread with every
+#: representation message (topic, class, frame time, wall time, protobuf bytes)
+Translate = Callable[[str, type, int, int, bytes], Iterable[ExtraMessage]]
+
+class _ExtraChannels:
+    """Channels that are not representations in an MCAP writer: registered as their messages come."""
+
+    def __init__(self, writer: Writer) -> None:
+        self.writer = writer
+        self.schemas: dict[tuple[str, str], int] = {}
+        self.channels: dict[str, int] = {}
+
+    def add(self, extra: ExtraMessage) -> None:
+        channel = self.channels.get(extra.topic)
+        if channel is None:
+            key = (extra.schema_name, extra.schema_encoding)
+            if key not in self.schemas:
+                self.schemas[key] = self.writer.register_schema(name=extra.schema_name, encoding=extra.schema_encoding,
+                                                                data=extra.schema_data)
+            channel = self.channels[extra.topic] = self.writer.register_channel(
+                topic=extra.topic, message_encoding=extra.message_encoding, schema_id=self.schemas[key])
+        self.writer.add_message(channel, log_time=extra.wall_ns, data=extra.data, publish_time=extra.time_ns)
 
 
 class LogWriter:
     """Writes representation messages to an MCAP file from a background thread."""
 
     def __init__(self, path: str | Path, *, metadata: Mapping[str, str] | None = None, queue_size: int = 4096,
-                 flush_interval: float = 0.5, chunk_size: int = 4 << 20) -> None:
+                 flush_interval: float = 0.5, chunk_size: int = 4 << 20, translate: Translate | None = None) -> None:
         self.path = Path(path)
+        self.translate = translate
         try:
             self._stream = open(self.path, "wb")  # noqa: SIM115 - closed by close()
         except OSError as exc:
@@ -70,9 +118,10 @@ class LogWriter:
         self._writer.start(profile=PROFILE, library="tafel")
         if metadata:
             self._writer.add_metadata("tafel", dict(metadata))
-        self._queue: queue.Queue[_Item | None] = queue.Queue(maxsize=queue_size)
+        self._queue: queue.Queue[_Item | ExtraMessage | None] = queue.Queue(maxsize=queue_size)
         self._channels: dict[str, int] = {}
         self._schemas: dict[type, int] = {}
+        self._extras = _ExtraChannels(self._writer)
         self.flush_interval = flush_interval
         self.blocking = False
         self.written = 0
@@ -93,12 +142,23 @@ class LogWriter:
         """
         if self._closed or self.failed:
             return False
-        item = _Item(topic, cls, time_ns, sequence, data, metadata or {})
+        item = _Item(topic, cls, time_ns, sequence, data, metadata or {}, time.time_ns())
         try:
             if self.blocking:
                 self._queue.put(item)
             else:
                 self._queue.put_nowait(item)
+            return True
+        except queue.Full:
+            self.dropped += 1
+            return False
+
+    def write_extra(self, extra: ExtraMessage) -> bool:
+        """Queue one message of a channel that is not a representation (any thread; never blocks)."""
+        if self._closed or self.failed:
+            return False
+        try:
+            self._queue.put_nowait(extra)
             return True
         except queue.Full:
             self.dropped += 1
@@ -133,6 +193,9 @@ class LogWriter:
             if item is None:
                 return
             try:
+                if isinstance(item, ExtraMessage):  # a log line, say: written as it comes
+                    self.add_extra(item)
+                    continue
                 # a chunk holds at most CHUNK_SPAN_NS of log time, at any speed, and at most
                 # flush_interval of wall time: a cut-off file loses only its last chunk
                 if item.topic and chunk_start_ns is not None and abs(item.time_ns - chunk_start_ns) >= CHUNK_SPAN_NS:
@@ -140,6 +203,9 @@ class LogWriter:
                     last_flush, chunk_start_ns = time.monotonic(), None
                 if item.topic:
                     self._add(item)
+                    if self.translate is not None:
+                        for extra in self.translate(item.topic, item.cls, item.time_ns, item.wall_ns, item.data):
+                            self.add_extra(extra)
                     chunk_start_ns = item.time_ns if chunk_start_ns is None else chunk_start_ns
                 if time.monotonic() - last_flush >= self.flush_interval:
                     self._writer.flush()
@@ -173,17 +239,26 @@ class LogWriter:
             channel = self._channels[item.topic] = self._writer.register_channel(
                 topic=item.topic, message_encoding="protobuf", schema_id=schema, metadata=dict(item.metadata)
             )
-        self._writer.add_message(channel, log_time=item.time_ns, data=item.data, publish_time=item.time_ns, sequence=item.sequence)
+        self._writer.add_message(channel, log_time=item.wall_ns or item.time_ns, data=item.data, publish_time=item.time_ns,
+                                 sequence=item.sequence)
         self.written += 1
         self.bytes_written += len(item.data)
+
+    def add_extra(self, extra: ExtraMessage) -> None:
+        """Write one message of a channel that is not a representation (writer thread only)."""
+        self._extras.add(extra)
+        self.written += 1
+        self.bytes_written += len(extra.data)
 
 
 @dataclass
 class LogMessage:
     topic: str
-    time_ns: int
+    time_ns: int  # frame time (the publish time)
     sequence: int
     data: bytes
+    #: wall-clock time of the recording (ns since the epoch); logs from before 0.3 hold the frame time here
+    log_time_ns: int = 0
 
 
 @dataclass
@@ -204,6 +279,7 @@ class LogChannel:
     @property
     def representation(self) -> str:
         return self.topic.split("/", 1)[-1]
+
 
 
 @dataclass(frozen=True)
@@ -235,6 +311,8 @@ class LogReader:
             self.close()
             raise LogError(f"{self.path} is not an MCAP log (it does not start with the MCAP magic bytes)")
         self.channels: dict[str, LogChannel] = {}
+        #: channels that are not representations (topic -> schema name), e.g. the Foxglove ones
+        self.extra_channels: dict[str, str] = {}
         self.metadata: dict[str, str] = {}
         self.chunks: list[ChunkInfo] = []
         self.complete = True
@@ -315,9 +393,12 @@ class LogReader:
             self.metadata.update(record.metadata)
 
     def _add_channel(self, record: Channel) -> None:
+        schema = self._schemas.get(record.schema_id)
+        if record.topic.startswith(EXTRA_TOPIC_PREFIX):  # Foxglove's channels: listed, never read as representations
+            self.extra_channels.setdefault(record.topic, schema.name if schema else "")
+            return
         self._topics[record.id] = record.topic
         if record.topic not in self.channels:
-            schema = self._schemas.get(record.schema_id)
             self.channels[record.topic] = LogChannel(record.topic, schema.name if schema else "", _file_of(schema), dict(record.metadata),
                                                      schema_data=bytes(schema.data) if schema else b"")
 
@@ -356,15 +437,15 @@ class LogReader:
             if isinstance(record, Message):
                 topic = self._topics.get(record.channel_id)
                 if topic is not None:
-                    messages.append(LogMessage(topic, record.log_time, record.sequence, record.data))
+                    messages.append(LogMessage(topic, record.publish_time, record.sequence, record.data, record.log_time))
             else:
                 self._register(record)
         return messages
 
     def messages(self, topics: Iterable[str] | None = None, start_ns: int | None = None) -> Iterator[LogMessage]:
-        """Every readable message (of ``topics``, from ``start_ns`` on), chunk by chunk in file order."""
+        """Every readable message (of ``topics``, from frame time ``start_ns`` on), chunk by chunk in file order."""
         wanted = None if topics is None else set(topics)
-        for _number, messages in self.iter_chunks(start_ns):
+        for _number, messages in self.iter_chunks():  # chunks are indexed by log (wall) time, not frame time
             for message in messages:
                 if (wanted is None or message.topic in wanted) and (start_ns is None or message.time_ns >= start_ns):
                     yield message
@@ -394,6 +475,7 @@ class LogReader:
                 for topic, c in sorted(self.channels.items())
             },
             "metadata": dict(self.metadata),
+            "extra_channels": dict(sorted(self.extra_channels.items())),
         }
 
     def close(self) -> None:
@@ -449,13 +531,17 @@ def read_log(path: str | Path) -> LogContents:
 
 
 def write_slice(source: str | Path, target: str | Path, *, representations: Iterable[str] | None = None,
-                start_s: float = 0.0, seconds: float | None = None) -> dict[str, int]:
+                start_s: float = 0.0, seconds: float | None = None, translate: Translate | None = None) -> dict[str, int]:
     """Copy part of a log into a new one: the chosen representations (all without a choice), from
     ``start_s`` after the log's first message for ``seconds``. Schemas, channel metadata and the
     recording's metadata travel along, so the slice replays and decodes like the original.
 
-    Returns messages per topic. Raises ``LogError`` when nothing would be copied.
+    ``translate`` adds channels made from the copied messages (``tafel log convert``: Foxglove's). A log
+    from before wall-clock log times gets them: its frame times moved to end when the file was last
+    written. Returns messages per topic. Raises ``LogError`` when nothing would be copied.
     """
+    from tafel.core.representation import get_representation
+
     wanted = set(representations) if representations else None
     with LogReader(source) as reader:
         topics = [t for t, c in reader.channels.items() if wanted is None or c.representation in wanted]
@@ -470,6 +556,8 @@ def write_slice(source: str | Path, target: str | Path, *, representations: Iter
             raise LogError(f"{source} holds no messages of {', '.join(sorted(wanted or []) or 'any channel')}")
         begin = first.time_ns + int(start_s * 1e9)
         end = None if seconds is None else begin + int(seconds * 1e9)
+        last_ns = max((c.end_ns for c in reader.chunks), default=0)
+        anchor_ns = os.stat(source).st_mtime_ns - last_ns  # for logs whose log times are frame times
         counts: dict[str, int] = {}
         with open(target, "wb") as stream:
             writer = Writer(stream, compression=CompressionType.ZSTD)
@@ -479,6 +567,7 @@ def write_slice(source: str | Path, target: str | Path, *, representations: Iter
                                               "slice_start_s": f"{start_s:g}"})
             schema_ids: dict[str, int] = {}
             channel_ids: dict[str, int] = {}
+            extras = _ExtraChannels(writer)
             for message in reader.messages(topics, start_ns=begin):
                 if message.time_ns < begin or (end is not None and message.time_ns >= end):
                     continue
@@ -490,9 +579,18 @@ def write_slice(source: str | Path, target: str | Path, *, representations: Iter
                     channel_ids[message.topic] = writer.register_channel(
                         topic=message.topic, message_encoding="protobuf", schema_id=schema_ids[channel.schema_name],
                         metadata=dict(channel.metadata))
-                writer.add_message(channel_ids[message.topic], log_time=message.time_ns, data=message.data,
+                wall_ns = message.log_time_ns if message.log_time_ns != message.time_ns else anchor_ns + message.time_ns
+                writer.add_message(channel_ids[message.topic], log_time=wall_ns, data=message.data,
                                    publish_time=message.time_ns, sequence=message.sequence)
                 counts[message.topic] = counts.get(message.topic, 0) + 1
+                if translate is not None:
+                    try:
+                        cls = get_representation(channel.representation)
+                    except KeyError:
+                        continue
+                    for extra in translate(message.topic, cls, message.time_ns, wall_ns, message.data):
+                        extras.add(extra)
+                        counts[extra.topic] = counts.get(extra.topic, 0) + 1
             writer.finish()
     if not counts:
         Path(target).unlink(missing_ok=True)

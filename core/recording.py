@@ -10,13 +10,13 @@ the background.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
 from tafel.core.errors import UnknownModuleError
-from tafel.core.logfile import LogWriter
+from tafel.core.logfile import LogWriter, Translate
 from tafel.core.manager import Blackboard
 from tafel.core.naming import did_you_mean
 from tafel.core.program import ContextPlan
@@ -106,6 +106,8 @@ class Recorder:
         self.gate: Any = None
         #: called with True on start and False on stop
         self.listeners: list[Any] = []
+        #: makes the hook that adds channels to each new file (tools sets it: Foxglove's channels)
+        self.translate_factory: Callable[[], Translate] | None = None
 
     @property
     def recording(self) -> bool:
@@ -125,7 +127,8 @@ class Recorder:
         self.stop()
         if blocking is not None:
             self.blocking = blocking
-        self.writer = LogWriter(path, metadata=self.metadata)
+        self.writer = LogWriter(path, metadata=self.metadata,
+                                translate=self.translate_factory() if self.translate_factory is not None else None)
         self.writer.blocking = self.blocking
         for listener in self.listeners:
             listener(True)
@@ -172,6 +175,8 @@ class Recorder:
         if sink is None or (self.gate is not None and not self.gate()) or (self.writer is not None and self.writer.failed):
             return
         for selection in self.by_context.get(context, ()):
+            if selection.rep not in blackboard:  # debug data of a program without the debug server
+                continue
             try:
                 data = serialize(blackboard[selection.rep])
             except SerializationError as exc:  # report once per topic, keep recording the rest

@@ -237,6 +237,14 @@ class DebugPlots:
     values: list[float] = field(default_factory=list)
 
 
+@representation
+class ModuleTimes:
+    """How long each module of a context ran in one frame: ``names[i]`` took ``milliseconds[i]``."""
+
+    names: list[str] = field(default_factory=list)
+    milliseconds: list[float] = field(default_factory=list)
+
+
 def frame_debug_data(context: str) -> tuple[DebugDrawings, DebugPlots]:
     """This context's last frame of drawings and plots as representations."""
     drawings = DebugDrawings([DebugDrawingPrimitive(**d) for d in STATE.drawings_last.get(context, [])])

@@ -14,6 +14,7 @@ its output buffer is full.
 from __future__ import annotations
 
 import asyncio
+import concurrent.futures
 import hmac
 import logging
 import queue
@@ -319,6 +320,27 @@ class _Connection:
             self.server.connections.discard(self)
 
 
+class _InProcessClient:
+    """A client in this process (the Foxglove bridge): its commands queue with everybody else's and run
+    between frames like theirs; ``ask`` waits for the answer."""
+
+    closed = False
+
+    def __init__(self) -> None:
+        self.waiting: dict[int, concurrent.futures.Future[bytes]] = {}
+        self.next_sequence = 0
+        self.lock = threading.Lock()
+
+    def answered(self) -> None:
+        pass
+
+    def deliver_many(self, answers: list[tuple[int, bytes]]) -> None:
+        for sequence, data in answers:
+            future = self.waiting.pop(sequence, None)
+            if future is not None:
+                future.set_result(data)
+
+
 class DebugServer:
     """The debug server; ``start`` binds and prints nothing, ``address`` says where it listens."""
 
@@ -348,10 +370,32 @@ class DebugServer:
         self._thread: threading.Thread | None = None
         self._ready = threading.Event()
         self._error: BaseException | None = None
+        self._local = _InProcessClient()
 
     @property
     def address(self) -> tuple[str, int]:
         return self.host, self.port
+
+    def ask(self, line: str, timeout: float = 5.0) -> str:
+        """Run one command line for a client in this process (authenticated: it is the program itself)
+        and return its answer as text; ``error: ...`` as any client gets it. Raises ``TimeoutError``."""
+        try:
+            command = parse(line.strip()).as_text()
+        except ParseError as exc:
+            return f"error: {exc}"
+        if command.name in DebugRouter.IMMEDIATE:
+            ((is_error, payload),) = self.router.handle_batch([command])
+            data = self.encode(command, is_error, payload)
+        else:
+            client = self._local
+            future: concurrent.futures.Future[bytes] = concurrent.futures.Future()
+            with client.lock:
+                sequence = client.next_sequence
+                client.next_sequence += 1
+                client.waiting[sequence] = future
+            self.pending.put(_Request(client, sequence, command))  # type: ignore[arg-type]
+            data = future.result(timeout)
+        return data.rstrip(b"\0").decode("utf-8", "replace").rstrip("\n")
 
     def start(self) -> tuple[str, int]:
         self._thread = threading.Thread(target=self._run, name="tafel-debug-server", daemon=True)

@@ -357,9 +357,11 @@ def test_the_tools_package_knows_no_representation_by_name() -> None:
     from tafel.tools.cli import discover_modules
 
     discover_modules()
-    names = set(registered_representations()) - {"DebugDrawings", "DebugPlots"}  # the debug data tools record
+    names = set(registered_representations()) - {"DebugDrawings", "DebugPlots", "ModuleTimes"}  # the debug data tools record
     offenders = []
     for path in (REPO / "tools").glob("*.py"):
+        if path.name == "foxglove_channels.py":  # the one view whose job is to know them: Foxglove's schemas for each
+            continue
         text = path.read_text()
         offenders += [f"{path.name}: {name}" for name in names if re.search(rf"\b{name}\b", text)]
     assert not offenders, offenders

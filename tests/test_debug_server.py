@@ -310,6 +310,7 @@ def test_token_authentication() -> None:
         secured.stop()
 
 
+@pytest.mark.slow
 def test_replay_commands(tmp_path: Path) -> None:
     log = tmp_path / "replay.mcap"
     assert tafel("run", "--platform", "dummy", "--frames", "300", "--speed", "max", "--record", str(log), "--no-debug").returncode == 0

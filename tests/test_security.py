@@ -97,6 +97,7 @@ def often_reporting(tmp_path: Path):
     running.stop()
 
 
+@pytest.mark.slow
 def test_a_client_streaming_bytes_without_newlines_cannot_slow_the_loops(often_reporting: Program) -> None:
     """Before the fix the decoder went byte by byte holding the interpreter lock: loops fell to a fraction."""
     program = often_reporting
@@ -213,6 +214,7 @@ def test_an_empty_token_is_refused_at_start(tmp_path: Path, how: str) -> None:
     assert "empty" in result.stderr and "Traceback" not in result.stderr
 
 
+@pytest.mark.slow
 def test_wrong_tokens_are_slowed_down_and_the_connection_closed_after_twenty(tmp_path: Path) -> None:
     running = Program("--platform", "dummy", "--debug-token", "right", cwd=tmp_path)
     try:
@@ -434,7 +436,7 @@ def test_a_full_disk_stops_recording_cleanly_and_the_run_goes_on(tmp_path: Path)
     info = tafel("log", "info", str(log))
     assert info.returncode == 0, info.stderr  # everything before the failure is readable
     seconds = float(re.search(r"duration\D*([\d.]+)", info.stdout).group(1))
-    assert seconds > 1.0, info.stdout
+    assert seconds > 0.5, info.stdout  # (the Foxglove channels share the 200 kB)
 
 
 @pytest.mark.slow

@@ -14,7 +14,7 @@ import pkgutil
 import sys
 import threading
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from importlib.metadata import version
 from pathlib import Path
 from typing import Any, NoReturn
@@ -48,6 +48,7 @@ from tafel.tools.debugging import (
 DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "config"
 FALLBACK_PLATFORM = "dummy"
 DEFAULT_DEBUG_PORT = 5401
+DEFAULT_FOXGLOVE_PORT = 8765
 
 
 class UsageError(Exception):
@@ -146,6 +147,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--debug-max-connections", type=positive(int), default=32, metavar="N",
                      help="debug connections served at once; more get an error line (default: %(default)s)")
     run.add_argument("--no-debug", action="store_true", help="run without the debug server")
+    run.add_argument("--foxglove", nargs="?", const=f"127.0.0.1:{DEFAULT_FOXGLOVE_PORT}", metavar="[HOST:]PORT",
+                     help=f"serve Foxglove and Lichtblick live over WebSocket (default 127.0.0.1:{DEFAULT_FOXGLOVE_PORT}; "
+                          "with --debug-token clients must give it: ws://HOST:PORT/?token=T)")
 
     from tafel.tools.log_tools import add_log_commands
 
@@ -292,6 +296,8 @@ def print_summary(platform: str, mode: str, stats: dict[str, ContextStats], wall
 
 def command_run(args: argparse.Namespace, extra: Sequence[str]) -> int:
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(name)s %(levelname)s: %(message)s")
+    if args.foxglove is not None:
+        foxglove_address(args.foxglove)  # a wrong address fails before anything starts
     platform, options, plans, config = prepare(args, extra)
     report_pruned(plans)
     recorder = make_recorder(args, plans, config, type(platform).name)
@@ -366,6 +372,41 @@ def listen(args: argparse.Namespace, debug: ProgramDebug | None) -> None:
     print(f"debug server listening on {host}:{port}", flush=True)
 
 
+def foxglove_address(text: str) -> tuple[str, int]:
+    """``--foxglove`` as (host, port): ``PORT`` or ``HOST:PORT``; wrong values exit with status 2."""
+    host, _, port = text.rpartition(":")
+    try:
+        number = int(port)
+    except ValueError:
+        number = -1
+    if not 0 <= number <= 65535:
+        fail(f"--foxglove takes [HOST:]PORT with a port from 0 to 65535, e.g. --foxglove {DEFAULT_FOXGLOVE_PORT}; got {text!r}")
+    return host.strip("[]") or "127.0.0.1", number
+
+
+def start_foxglove(args: argparse.Namespace, debug: ProgramDebug | None, runtime: LockstepRuntime, config: dict[str, Any]) -> Any:
+    """The live Foxglove server with ``--foxglove``, fed after every frame of every context; None without."""
+    if args.foxglove is None:
+        return None
+    from tafel.tools.foxglove_live import FoxgloveLive
+
+    host, port = foxglove_address(args.foxglove)
+    token = debug_token(args)
+    if token is None and not is_loopback(host):
+        print(f"warning: the Foxglove server listens on {host} without a token: anybody on that network can watch and "
+              "steer this program; give one with --debug-token-file F", file=sys.stderr, flush=True)
+    quality = int(config.get("foxglove", {}).get("jpeg_quality", 80))
+    live = FoxgloveLive(host, port, ask=debug.server.ask if debug is not None else None, jpeg_quality=quality, token=token)
+    try:
+        host, port = live.start()
+    except Exception as exc:  # noqa: BLE001 - the SDK reports a taken port as a plain RuntimeError
+        fail(f"Foxglove server: cannot listen on {host}:{port} ({exc}); choose another port with --foxglove PORT (0: a free one)")
+    for runner in runtime.runners.values():
+        runner.after_step.append(lambda r: live.after_frame(r.name, r.manager.blackboard, r.time_ns))
+    print(f"foxglove server listening on ws://{host}:{port}", flush=True)
+    return live
+
+
 def shutdown_grace(config: dict[str, Any]) -> float:
     return float(config.get("runtime", {}).get("shutdown_grace_s", 15.0))
 
@@ -386,8 +427,13 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
         runtime.after_tick.append(lambda rt: debug.server.process_pending(budget_s=0.001 if rt.behind_s < 0.001 else 0.0,
                                                                          chunk=8 if rt.behind_s < 0.001 else 1))
         runtime.idle = debug.server.serve_while_idle
+    elif recorder is not None:  # no server, but recorded debug data (drawings, module times) is still filled in
+        recorded = debug_recorded(recorder)
+        for name, runner in runtime.runners.items():
+            context_debug(name, runner.manager, recorded.get(name, ()))
     install_signal_handlers(runtime.stop, grace_s=shutdown_grace(config))
     listen(args, debug)
+    live = start_foxglove(args, debug, runtime, config)
     started = time.monotonic()
     last = [started]
     line = StatusLine(type(platform).name, config)
@@ -403,6 +449,8 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
     try:
         stats = runtime.run(limits)
     finally:
+        if live is not None:
+            live.stop()
         if debug is not None:
             debug.server.stop()
     print_summary(type(platform).name, "lockstep", stats, runtime.wall_s, runtime.time_ns * 1e-9, runtime.end_reason, simulated=True)
@@ -412,6 +460,9 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
 
 def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[str, Any], plans: dict[str, ContextPlan],
                    config: dict[str, Any], recorder: Recorder | None, limits: Limits) -> int:
+    if args.foxglove is not None:
+        fail(f"--foxglove serves programs in the lockstep runtime (mujoco, pybullet, log, dummy) for now; {args.platform} runs "
+             "concurrently. Record with --record and open the file in Foxglove instead")
     platform.stop()  # each context process makes its own
     platform_class = type(platform)
     debug = start_debug(args, recorder, plans, config)
@@ -488,11 +539,28 @@ def make_recorder(args: argparse.Namespace, plans: dict[str, ContextPlan], confi
                         strict=bool(args.record_reps))
     metadata = {"platform": platform, **{f"{c}_hz": str(p.rate_hz) for c, p in plans.items()}}
     recorder = Recorder(selections, metadata)
+    foxglove = config.get("foxglove", {})
+    if foxglove.get("channels_in_recordings", True):
+        recorder.translate_factory = foxglove_recording(recorder, int(foxglove.get("jpeg_quality", 80)))
     # Without a beat to keep (lockstep at --speed max) recording waits for the writer rather than drop.
     recorder.blocking = args.speed is None and not args.concurrent
     if args.record is not None:
         recorder.start(args.record)
     return recorder
+
+
+def foxglove_recording(recorder: Recorder, jpeg_quality: int) -> Callable[[], Any]:
+    """The hook that gives each recorded file Foxglove's channels; their code loads with the first recording."""
+    channels: list[Any] = []
+
+    def new_file() -> Any:
+        if not channels:
+            from tafel.tools.foxglove_channels import RecordingChannels
+
+            channels.append(RecordingChannels(recorder, jpeg_quality))
+        return channels[0].new_file()
+
+    return new_file
 
 
 def recording_notices(recorder: Recorder | None) -> list[str]:

@@ -26,11 +26,11 @@ from tafel.core.program import ContextPlan
 from tafel.core.recording import Recorder
 from tafel.core.runtime import ContextRunner
 from tafel.debug.commands import CommandError, ContextDebug, argument
-from tafel.debug.concepts import STATE, DebugDrawings, DebugPlots, frame_debug_data
+from tafel.debug.concepts import STATE, DebugDrawings, DebugPlots, ModuleTimes, frame_debug_data
 from tafel.debug.protocol import Command, parse
 from tafel.debug.server import DebugRouter, DebugServer, Executor
 
-DEBUG_REPRESENTATIONS = (DebugDrawings, DebugPlots)
+DEBUG_REPRESENTATIONS = (DebugDrawings, DebugPlots, ModuleTimes)
 INTERNAL_ERROR = "__error__"  # key of a context's answer to an internal question it could not answer
 #: s before a context's next frame when command work stops, so the frame starts on time
 RESERVE = 0.002
@@ -66,6 +66,8 @@ def instrument(context: str, manager: ModuleManager, meter: RateMeter) -> None:
                 manager.blackboard.set(drawings)
             if DebugPlots in manager.blackboard:
                 manager.blackboard.set(plots)
+        if ModuleTimes in manager.blackboard:
+            manager.blackboard.set(ModuleTimes(*manager.last_times_ms()))
 
     manager.after_frame.append(after)
 

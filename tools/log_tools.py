@@ -51,6 +51,12 @@ def add_log_commands(commands: Any) -> None:
     piece.add_argument("--rep", metavar="A,B", help="only these representations (default: all)")
     piece.add_argument("--start", type=float, default=0.0, metavar="S", help="seconds after the log's start (default 0)")
     piece.add_argument("--seconds", type=float, metavar="N", help="how long (default: to the end)")
+    convert = actions.add_parser("convert", help="a copy of a log with Foxglove's channels added (images, scene, series)",
+                                 description="For logs recorded before recordings carried Foxglove's channels: the copy "
+                                             "opens in Foxglove and Lichtblick with images, 3D scene and plots.")
+    convert.add_argument("file", type=Path)
+    convert.add_argument("--out", required=True, type=Path, help="the new log")
+    convert.add_argument("--jpeg-quality", type=int, default=80, metavar="Q", help="JPEG quality of the images, 1 to 100 (default 80)")
 
 
 def run_log_command(args: argparse.Namespace) -> int:
@@ -58,7 +64,7 @@ def run_log_command(args: argparse.Namespace) -> int:
         from tafel.tools.log_compare import run_compare
 
         return run_compare(args)
-    if args.log_command == "slice":
+    if args.log_command in ("slice", "convert"):
         return run_slice(args)
     logging.getLogger("tafel.log").setLevel(logging.ERROR)  # the commands print the problems themselves
     try:
@@ -73,17 +79,31 @@ def run_log_command(args: argparse.Namespace) -> int:
 
 
 def run_slice(args: argparse.Namespace) -> int:
-    if args.start < 0 or not np.isfinite(args.start) or (args.seconds is not None and not (np.isfinite(args.seconds) and args.seconds > 0)):
-        print("tafel log slice: error: --start takes seconds from 0 on, --seconds a positive number", file=sys.stderr)
+    """``tafel log slice`` and ``tafel log convert`` (a whole copy with Foxglove's channels added)."""
+    name = f"tafel log {args.log_command}"
+    converting = args.log_command == "convert"
+    start, seconds = (0.0, None) if converting else (args.start, args.seconds)
+    if start < 0 or not np.isfinite(start) or (seconds is not None and not (np.isfinite(seconds) and seconds > 0)):
+        print(f"{name}: error: --start takes seconds from 0 on, --seconds a positive number", file=sys.stderr)
+        return 2
+    if converting and not 1 <= args.jpeg_quality <= 100:
+        print(f"{name}: error: --jpeg-quality takes 1 to 100, got {args.jpeg_quality}", file=sys.stderr)
         return 2
     if args.out.resolve() == args.file.resolve():
-        print("tafel log slice: error: --out must be another file than the log it slices", file=sys.stderr)
+        print(f"{name}: error: --out must be another file than the log it reads", file=sys.stderr)
         return 2
+    translate = None
+    if converting:
+        from tafel.tools.cli import discover_modules
+        from tafel.tools.foxglove_channels import FoxgloveTranslator
+
+        discover_modules()  # every representation class, to decode what the log holds
+        translate = FoxgloveTranslator(args.jpeg_quality).translate
     try:
-        counts = write_slice(args.file, args.out, representations=args.rep.split(",") if args.rep else None,
-                             start_s=args.start, seconds=args.seconds)
+        counts = write_slice(args.file, args.out, representations=None if converting or not args.rep else args.rep.split(","),
+                             start_s=start, seconds=seconds, translate=translate)
     except LogError as exc:
-        print(f"tafel log slice: error: {exc}", file=sys.stderr)
+        print(f"{name}: error: {exc}", file=sys.stderr)
         return 1
     print(f"wrote {args.out}: {sum(counts.values())} messages in {len(counts)} channels ({_size(args.out.stat().st_size)})")
     return 0
@@ -106,6 +126,8 @@ def print_info(reader: LogReader, as_json: bool) -> int:
     for topic, channel in info["channels"].items():
         source = channel.get("source", "?") + (f" {channel['provider']}" if channel.get("provider") else "")
         print(f"  {topic:<36} {channel['messages']:>7} messages {_size(channel['bytes']):>10}  ({source})")
+    if info["extra_channels"]:
+        print("for Foxglove: " + ", ".join(f"{topic} ({schema})" for topic, schema in info["extra_channels"].items()))
     return 0
 
 

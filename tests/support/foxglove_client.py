@@ -1,0 +1,125 @@
+"""A Foxglove WebSocket client written from the protocol's published specification
+(github.com/foxglove/ws-protocol), with the ``websockets`` package and no ``foxglove-sdk``: what
+Foxglove and Lichtblick do when they connect, for tests and benchmarks. The specification calls the
+subprotocol ``foxglove.websocket.v1``; servers built on foxglove-sdk accept the same protocol only under
+its new name ``foxglove.sdk.v1``, which is what current Foxglove and Lichtblick ask for."""
+
+from __future__ import annotations
+
+import json
+import struct
+import time
+from typing import Any
+
+from websockets.exceptions import ConnectionClosed
+from websockets.sync.client import connect
+
+SUBPROTOCOL = "foxglove.sdk.v1"
+MESSAGE_DATA, SERVICE_CALL_REQUEST, SERVICE_CALL_RESPONSE = 0x01, 0x02, 0x03
+
+
+class FoxgloveClient:
+    def __init__(self, url: str, timeout: float = 10.0, subprotocol: str = SUBPROTOCOL, headers: dict[str, str] | None = None) -> None:
+        self.socket = connect(url, subprotocols=[subprotocol], max_size=None, open_timeout=timeout, additional_headers=headers,
+                              proxy=None, legacy=True)
+        self.timeout = timeout
+        self.channels: dict[int, dict[str, Any]] = {}  # channel id -> its advertisement
+        self.services: dict[str, dict[str, Any]] = {}
+        self.server_info: dict[str, Any] = {}
+        self.subscriptions: dict[int, str] = {}  # subscription id -> topic
+        self.received: dict[str, list[tuple[int, bytes]]] = {}  # topic -> [(timestamp ns, payload)]
+        self.replies: list[dict[str, Any]] = []
+        self.service_answers: dict[int, bytes] = {}
+        self.next_id = 1
+        self.closed = False
+
+    def close(self) -> None:
+        self.socket.close()
+
+    # ------------------------------------------------------------------------------- receiving
+    def pump(self, seconds: float) -> None:
+        """Read whatever the server sends for ``seconds``."""
+        deadline = time.monotonic() + seconds
+        while (left := deadline - time.monotonic()) > 0:
+            try:
+                frame = self.socket.recv(timeout=left)
+            except TimeoutError:
+                return
+            except ConnectionClosed:  # the program ended
+                self.closed = True
+                return
+            self._handle(frame)
+
+    def wait_for(self, what: Any, seconds: float | None = None) -> Any:
+        """Pump until ``what()`` gives something true; returns it."""
+        deadline = time.monotonic() + (seconds or self.timeout)
+        while time.monotonic() < deadline:
+            found = what()
+            if found:
+                return found
+            self.pump(0.05)
+        raise TimeoutError("the Foxglove server did not send what was expected in time")
+
+    def _handle(self, frame: str | bytes) -> None:
+        if isinstance(frame, str):
+            message = json.loads(frame)
+            op = message.get("op")
+            if op == "serverInfo":
+                self.server_info = message
+            elif op == "advertise":
+                for channel in message["channels"]:
+                    self.channels[channel["id"]] = channel
+            elif op == "advertiseServices":
+                for service in message["services"]:
+                    self.services[service["name"]] = service
+            else:
+                self.replies.append(message)
+            return
+        op = frame[0]
+        if op == MESSAGE_DATA:
+            subscription, stamp = struct.unpack_from("<IQ", frame, 1)
+            topic = self.subscriptions.get(subscription)
+            if topic is not None:
+                self.received.setdefault(topic, []).append((stamp, bytes(frame[13:])))
+        elif op == SERVICE_CALL_RESPONSE:
+            _service, call, length = struct.unpack_from("<III", frame, 1)
+            self.service_answers[call] = bytes(frame[13 + length:])
+
+    # --------------------------------------------------------------------------------- asking
+    def topics(self) -> dict[str, dict[str, Any]]:
+        return {c["topic"]: c for c in self.channels.values()}
+
+    def subscribe(self, *topics: str) -> None:
+        by_topic = self.wait_for(lambda: self.topics() if set(topics) <= set(self.topics()) else None)
+        subscriptions = []
+        for topic in topics:
+            self.subscriptions[self.next_id] = topic
+            subscriptions.append({"id": self.next_id, "channelId": by_topic[topic]["id"]})
+            self.next_id += 1
+        self.socket.send(json.dumps({"op": "subscribe", "subscriptions": subscriptions}))
+
+    def unsubscribe_all(self) -> None:
+        self.socket.send(json.dumps({"op": "unsubscribe", "subscriptionIds": list(self.subscriptions)}))
+        self.subscriptions.clear()
+
+    def _request(self, message: dict[str, Any]) -> dict[str, Any]:
+        request_id = f"r{self.next_id}"
+        self.next_id += 1
+        self.socket.send(json.dumps({**message, "id": request_id}))
+        return self.wait_for(lambda: next((r for r in self.replies if r.get("id") == request_id), None))
+
+    def get_parameters(self, *names: str) -> dict[str, Any]:
+        reply = self._request({"op": "getParameters", "parameterNames": list(names)})
+        return {p["name"]: p.get("value") for p in reply["parameters"]}
+
+    def set_parameters(self, values: dict[str, Any]) -> dict[str, Any]:
+        reply = self._request({"op": "setParameters", "parameters": [{"name": k, "value": v} for k, v in values.items()]})
+        return {p["name"]: p.get("value") for p in reply["parameters"]}
+
+    def call_service(self, name: str, payload: bytes, encoding: str = "text") -> bytes:
+        service = self.wait_for(lambda: self.services.get(name))
+        call = self.next_id
+        self.next_id += 1
+        data = encoding.encode()
+        self.socket.send(struct.pack("<BIII", SERVICE_CALL_REQUEST, service["id"], call, len(data)) + data + payload)
+        return self.wait_for(lambda: self.service_answers.get(call))

@@ -1,0 +1,448 @@
+"""What Tafel shows in Foxglove and Lichtblick: representations turned into Foxglove's well-known messages.
+
+The same topics in recordings and live (metres and seconds, as Foxglove wants them):
+
+| topic | schema | from |
+|---|---|---|
+| ``/camera/top``, ``/camera/bottom`` | ``foxglove.CompressedImage`` (JPEG) | ``CameraImageTop/Bottom`` |
+| ``/camera/top/calibration``, ... | ``foxglove.CameraCalibration`` | the image size and field of view |
+| ``/camera/top/annotations``, ... | ``foxglove.ImageAnnotations`` | ``DebugDrawings`` on ``image:top/bottom``, at the image's time |
+| ``/scene`` | ``foxglove.SceneUpdate`` | the field (once), robot, ``BallModel``, ``BallPercept``, ``field`` drawings |
+| ``/tf`` | ``foxglove.FrameTransforms`` | field -> robot (``Odometry``), robot -> torso (``TorsoPose``), torso -> cameras |
+| ``/joints``, ``/imu``, ``/fsr``, ``/timing``, ``/rates`` | JSON by name, for the Plot panel | joints, IMU, foot pressure, ``ModuleTimes``, frame times |
+| ``/log`` | ``foxglove.Log`` | the program's log lines |
+
+A ``FoxgloveTranslator`` is fed every representation as it is recorded (in the writer thread, or in the
+live bridge's thread: never in a loop) and answers with the messages to send. Message timestamps are
+the frame times moved onto the wall clock by one fixed offset, so that an image and its annotations
+share one timestamp and transforms line up with everything else.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import time
+from collections import deque
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import cv2
+import numpy as np
+from foxglove import messages as fm
+
+from tafel.core.logfile import ExtraMessage
+from tafel.core.serialization import deserialize
+from tafel.debug.concepts import DebugDrawings, ModuleTimes
+from tafel.representations import field
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.modeling import BallModel
+from tafel.representations.motion import (
+    JOINT_NAMES,
+    CameraMatrixBottom,
+    CameraMatrixTop,
+    FsrData,
+    InertialSensorData,
+    JointCommand,
+    JointSensorData,
+    TorsoPose,
+)
+from tafel.representations.motion_control import Odometry
+from tafel.representations.perception import BallPercept, CameraImageBottom, CameraImageTop
+
+M = 0.001  # mm -> m
+CAMERAS = {CameraImageTop: "top", CameraImageBottom: "bottom"}
+#: the eight foot pressure sensors in ``FsrData`` order
+FSR_NAMES = tuple(f"{foot}_{where}" for foot in ("left", "right") for where in ("front_left", "front_right", "rear_left", "rear_right"))
+CAMERA_MATRICES = {CameraMatrixTop: "top", CameraMatrixBottom: "bottom"}
+#: every topic, for a client that subscribes to everything and for the layouts
+TOPICS = ("/camera/top", "/camera/bottom", "/camera/top/calibration", "/camera/bottom/calibration", "/camera/top/annotations",
+          "/camera/bottom/annotations", "/scene", "/tf", "/joints", "/imu", "/fsr", "/timing", "/rates", "/log")
+#: which representations each topic is made of: what the live bridge asks the loops for
+NEEDS: dict[str, tuple[type, ...]] = {
+    "/camera/top": (CameraImageTop,), "/camera/bottom": (CameraImageBottom,),
+    "/camera/top/calibration": (CameraImageTop,), "/camera/bottom/calibration": (CameraImageBottom,),
+    "/camera/top/annotations": (CameraImageTop, DebugDrawings), "/camera/bottom/annotations": (CameraImageBottom, DebugDrawings),
+    "/scene": (BallModel, BallPercept, DebugDrawings, FrameInfo), "/tf": (Odometry, TorsoPose, CameraMatrixTop, CameraMatrixBottom),
+    "/joints": (JointSensorData, JointCommand), "/imu": (InertialSensorData,), "/fsr": (FsrData,), "/timing": (ModuleTimes,),
+    "/rates": (FrameInfo,), "/log": (),
+}
+#: every representation some topic is made of; the others are not even decoded
+USED = frozenset(rep for reps in NEEDS.values() for rep in reps) | frozenset(CAMERA_MATRICES)
+COLORS = {"black": (0, 0, 0), "white": (1, 1, 1), "red": (1, 0, 0), "green": (0, 0.6, 0), "blue": (0, 0, 1), "yellow": (1, 1, 0),
+          "orange": (1, 0.55, 0), "gray": (0.5, 0.5, 0.5), "grey": (0.5, 0.5, 0.5), "cyan": (0, 1, 1), "magenta": (1, 0, 1),
+          "purple": (0.5, 0, 0.5), "pink": (1, 0.75, 0.8), "brown": (0.6, 0.3, 0.1)}
+JSON_SCHEMA = json.dumps({"type": "object", "additionalProperties": True}).encode()
+
+
+@dataclass
+class Outgoing:
+    """One message for Foxglove: ``message`` is a ``foxglove.messages`` object or, on JSON topics, a dict."""
+
+    topic: str
+    message: Any
+    time_ns: int  # frame time
+    wall_ns: int  # when Foxglove shows it
+
+    def encoded(self) -> ExtraMessage:
+        """The message as bytes with its schema, for an MCAP file."""
+        if isinstance(self.message, dict):
+            return ExtraMessage(self.topic, f"tafel.foxglove{self.topic.replace('/', '.')}", "jsonschema", JSON_SCHEMA,
+                                "json", json.dumps(self.message, separators=(",", ":")).encode(), self.time_ns, self.wall_ns)
+        schema = self.message.get_schema()
+        return ExtraMessage(self.topic, schema.name, schema.encoding, schema.data, "protobuf", self.message.encode(),
+                            self.time_ns, self.wall_ns)
+
+
+def color(name: str, alpha: float = 1.0) -> fm.Color:
+    """A drawing colour (``orange``, ``#ff8800``) as Foxglove's; unknown names are black."""
+    if name.startswith("#") and len(name) == 7:
+        try:
+            r, g, b = (int(name[i:i + 2], 16) / 255 for i in (1, 3, 5))
+            return fm.Color(r=r, g=g, b=b, a=alpha)
+        except ValueError:
+            pass
+    r, g, b = COLORS.get(name.lower(), (0, 0, 0))
+    return fm.Color(r=r, g=g, b=b, a=alpha)
+
+
+def named(values: Iterable[float]) -> dict[str, float]:
+    """Per-joint values by joint name (``JOINT_NAMES`` order)."""
+    return {name: float(v) for name, v in zip(JOINT_NAMES, values)}
+
+
+def timestamp(ns: int) -> fm.Timestamp:
+    return fm.Timestamp(sec=ns // 1_000_000_000, nsec=ns % 1_000_000_000)
+
+
+def quaternion(rotation: np.ndarray) -> fm.Quaternion:
+    """A rotation matrix as a unit quaternion."""
+    m = np.asarray(rotation, dtype=float)
+    w = math.sqrt(max(0.0, 1.0 + m[0, 0] + m[1, 1] + m[2, 2])) / 2
+    x = math.copysign(math.sqrt(max(0.0, 1.0 + m[0, 0] - m[1, 1] - m[2, 2])) / 2, m[2, 1] - m[1, 2])
+    y = math.copysign(math.sqrt(max(0.0, 1.0 - m[0, 0] + m[1, 1] - m[2, 2])) / 2, m[0, 2] - m[2, 0])
+    z = math.copysign(math.sqrt(max(0.0, 1.0 - m[0, 0] - m[1, 1] + m[2, 2])) / 2, m[1, 0] - m[0, 1])
+    return fm.Quaternion(x=x, y=y, z=z, w=w)
+
+
+def yaw_quaternion(angle: float) -> fm.Quaternion:
+    return fm.Quaternion(x=0.0, y=0.0, z=math.sin(angle / 2), w=math.cos(angle / 2))
+
+
+def pose(x: float = 0.0, y: float = 0.0, z: float = 0.0, orientation: fm.Quaternion | None = None) -> fm.Pose:
+    """A pose from metres (and an orientation, none: unrotated)."""
+    return fm.Pose(position=fm.Vector3(x=x, y=y, z=z), orientation=orientation or fm.Quaternion(x=0, y=0, z=0, w=1))
+
+
+#: the optical frame (z along the view, x right, y down in the image) in Tafel's camera frame (x along
+#: the view, y left, z up): what Foxglove expects of an image's frame
+OPTICAL = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+
+
+def field_lines() -> list[tuple[float, float, float, float]]:
+    """The SPL field's lines as segments (mm, field frame)."""
+    half_x, half_y = field.LENGTH / 2, field.WIDTH / 2
+    lines = [(-half_x, -half_y, half_x, -half_y), (half_x, -half_y, half_x, half_y), (half_x, half_y, -half_x, half_y),
+             (-half_x, half_y, -half_x, -half_y), (0, -half_y, 0, half_y)]
+    for side in (-1, 1):
+        for length, width in ((field.PENALTY_AREA_LENGTH, field.PENALTY_AREA_WIDTH), (field.GOAL_AREA_LENGTH, field.GOAL_AREA_WIDTH)):
+            inner = side * (half_x - length)
+            lines += [(side * half_x, width / 2, inner, width / 2), (inner, width / 2, inner, -width / 2),
+                      (inner, -width / 2, side * half_x, -width / 2)]
+        mark = side * (half_x - field.PENALTY_MARK_DISTANCE)
+        lines += [(mark - 50, 0, mark + 50, 0), (mark, -50, mark, 50)]
+    radius = field.CENTER_CIRCLE_DIAMETER / 2
+    corners = [(radius * math.cos(a), radius * math.sin(a)) for a in np.linspace(0, math.tau, 49)]
+    lines += [(*a, *b) for a, b in zip(corners, corners[1:])]
+    return lines
+
+
+def field_entity(now: fm.Timestamp) -> fm.SceneEntity:
+    """The carpet, the lines and both goals (white posts and crossbar)."""
+    points = [fm.Point3(x=v[0] * M, y=v[1] * M, z=0.001) for line in field_lines() for v in (line[:2], line[2:])]
+    carpet = fm.CubePrimitive(pose=pose(z=-0.005), size=fm.Vector3(x=(field.LENGTH + 2 * field.BORDER_STRIP) * M,
+                                                                       y=(field.WIDTH + 2 * field.BORDER_STRIP) * M, z=0.01),
+                              color=fm.Color(r=0.1, g=0.5, b=0.15, a=1.0))
+    posts = []
+    post = field.GOAL_POST_DIAMETER * M
+    for side in (-1, 1):
+        x = side * (field.LENGTH / 2 + field.GOAL_POST_DIAMETER / 2) * M
+        for y in (-1, 1):
+            posts.append(fm.CylinderPrimitive(pose=pose(x, y * (field.GOAL_INNER_WIDTH + field.GOAL_POST_DIAMETER) / 2 * M,
+                                                        field.GOAL_HEIGHT / 2 * M),
+                                              size=fm.Vector3(x=post, y=post, z=field.GOAL_HEIGHT * M), color=color("white")))
+        posts.append(fm.CubePrimitive(pose=pose(x, 0, field.GOAL_HEIGHT * M),
+                                      size=fm.Vector3(x=post, y=(field.GOAL_INNER_WIDTH + 2 * field.GOAL_POST_DIAMETER) * M, z=post),
+                                      color=color("white")))
+    return fm.SceneEntity(timestamp=now, frame_id="field", id="field", frame_locked=True,
+                          lines=[fm.LinePrimitive(type=fm.LinePrimitiveLineType.LineList, pose=pose(), thickness=0.05,
+                                                  scale_invariant=False, points=points, color=color("white"))],
+                          cubes=[carpet, *[p for p in posts if isinstance(p, fm.CubePrimitive)]],
+                          cylinders=[p for p in posts if isinstance(p, fm.CylinderPrimitive)])
+
+
+def robot_entity(now: fm.Timestamp) -> list[fm.SceneEntity]:
+    """The robot: its torso and head (torso frame) and its feet (robot frame, on the ground)."""
+    grey = fm.Color(r=0.85, g=0.85, b=0.88, a=1.0)
+    torso = fm.SceneEntity(timestamp=now, frame_id="torso", id="robot/torso", frame_locked=True,
+                           cubes=[fm.CubePrimitive(pose=pose(-0.01, 0, 0.06), size=fm.Vector3(x=0.1, y=0.15, z=0.16), color=grey)],
+                           spheres=[fm.SpherePrimitive(pose=pose(0, 0, 0.2), size=fm.Vector3(x=0.12, y=0.12, z=0.12), color=grey)])
+    feet = fm.SceneEntity(timestamp=now, frame_id="robot", id="robot/feet", frame_locked=True,
+                          cubes=[fm.CubePrimitive(pose=pose(0.02, side * 0.05, 0.01), size=fm.Vector3(x=0.16, y=0.09, z=0.02), color=grey)
+                                 for side in (-1, 1)])
+    return [torso, feet]
+
+
+def ball_entity(now: fm.Timestamp, entity_id: str, positions: Iterable[tuple[float, float]], rgba: fm.Color) -> fm.SceneEntity:
+    """Balls (robot frame, mm) as spheres on the ground."""
+    size = 2 * field.BALL_RADIUS * M
+    return fm.SceneEntity(timestamp=now, frame_id="robot", id=entity_id, frame_locked=True,
+                          spheres=[fm.SpherePrimitive(pose=pose(x * M, y * M, field.BALL_RADIUS * M), size=fm.Vector3(x=size, y=size, z=size),
+                                                      color=rgba) for x, y in positions])
+
+
+def field_drawings_entity(now: fm.Timestamp, context: str, primitives: Iterable[Any]) -> fm.SceneEntity:
+    """The ``field`` canvas: lines, rectangles, circles, robot poses as lines; texts as text (field frame, mm)."""
+    lines, texts = [], []
+    for p in primitives:
+        points = _outline(p.kind, p.points)
+        if points:
+            lines.append(fm.LinePrimitive(type=fm.LinePrimitiveLineType.LineStrip, pose=pose(), thickness=max(0.01, p.width * 0.01),
+                                          scale_invariant=False, points=[fm.Point3(x=x * M, y=y * M, z=0.02) for x, y in points],
+                                          color=color(p.color)))
+        elif p.kind == "text" and len(p.points) >= 2:
+            texts.append(fm.TextPrimitive(pose=pose(p.points[0] * M, p.points[1] * M, 0.05), billboard=True, font_size=p.width or 12.0,
+                                          scale_invariant=True, color=color(p.color), text=p.text))
+    return fm.SceneEntity(timestamp=now, frame_id="field", id=f"drawings/{context}", frame_locked=True, lines=lines, texts=texts)
+
+
+def _outline(kind: str, points: list[float]) -> list[tuple[float, float]]:
+    """The points of one drawing's outline; empty for texts and what cannot be drawn."""
+    if kind == "line" and len(points) >= 4:
+        return [(points[0], points[1]), (points[2], points[3])]
+    if kind == "rectangle" and len(points) >= 4:
+        x1, y1, x2, y2 = points[:4]
+        return [(x1, y1), (x2, y1), (x2, y2), (x1, y2), (x1, y1)]
+    if kind == "circle" and len(points) >= 3:
+        x, y, r = points[:3]
+        return [(x + r * math.cos(a), y + r * math.sin(a)) for a in np.linspace(0, math.tau, 25)]
+    if kind == "robot_pose" and len(points) >= 3:
+        x, y, rotation = points[:3]
+        c, s = math.cos(rotation), math.sin(rotation)
+        return [(x - 100 * c + 80 * s, y - 100 * s - 80 * c), (x + 150 * c, y + 150 * s), (x - 100 * c - 80 * s, y - 100 * s + 80 * c),
+                (x - 100 * c + 80 * s, y - 100 * s - 80 * c)]
+    return []
+
+
+def image_annotations(stamp: fm.Timestamp, primitives: Iterable[Any]) -> fm.ImageAnnotations:
+    """One image canvas (px) as Foxglove's image annotations."""
+    circles, points, texts = [], [], []
+    for p in primitives:
+        if p.kind == "circle" and len(p.points) >= 3:
+            circles.append(fm.CircleAnnotation(timestamp=stamp, position=fm.Point2(x=p.points[0], y=p.points[1]), diameter=2 * p.points[2],
+                                               thickness=p.width, fill_color=color(p.color, 0.0), outline_color=color(p.color)))
+        elif p.kind == "text" and len(p.points) >= 2:
+            texts.append(fm.TextAnnotation(timestamp=stamp, position=fm.Point2(x=p.points[0], y=p.points[1]), text=p.text,
+                                           font_size=p.width or 12.0, text_color=color(p.color), background_color=color("black", 0.0)))
+        elif outline := _outline(p.kind, p.points):
+            points.append(fm.PointsAnnotation(timestamp=stamp, type=fm.PointsAnnotationType.LineStrip, thickness=p.width,
+                                              points=[fm.Point2(x=x, y=y) for x, y in outline], outline_color=color(p.color)))
+    return fm.ImageAnnotations(circles=circles, points=points, texts=texts)
+
+
+def calibration(stamp: fm.Timestamp, camera: str, width: int, height: int, horizontal_fov: float, vertical_fov: float) -> fm.CameraCalibration:
+    """A pinhole model from the image size and the field of view (the simulators' cameras have no distortion)."""
+    fx = width / 2 / math.tan(horizontal_fov / 2) if horizontal_fov > 0 else float(width)
+    fy = height / 2 / math.tan(vertical_fov / 2) if vertical_fov > 0 else fx
+    cx, cy = width / 2, height / 2
+    return fm.CameraCalibration(timestamp=stamp, frame_id=f"camera_{camera}_optical", width=width, height=height,
+                                distortion_model="plumb_bob", D=[0.0] * 5, K=[fx, 0, cx, 0, fy, cy, 0, 0, 1],
+                                R=[1, 0, 0, 0, 1, 0, 0, 0, 1], P=[fx, 0, cx, 0, 0, fy, cy, 0, 0, 0, 1, 0])
+
+
+class FoxgloveTranslator:
+    """Turns representations, one at a time as they are recorded, into Foxglove messages.
+
+    ``wanted`` says which topics to make (all when None; the live bridge passes those with
+    subscribers), so that nothing is encoded for a topic nobody looks at.
+    """
+
+    def __init__(self, jpeg_quality: int = 80, wanted: Callable[[str], bool] | None = None) -> None:
+        self.jpeg_quality = jpeg_quality
+        self.wanted = wanted or (lambda _topic: True)
+        self.offset_ns: int | None = None  # wall clock - frame time, fixed at the first message
+        self.field_sent = False
+        self.images: dict[str, tuple[int, int, int]] = {}  # camera -> (time ns, width, height) of its last image
+        self.image_context = ""  # the context the images come to: its drawings annotate them
+        self.torso = (np.eye(3), np.array([0.0, 0.0, 300.0]))
+        self.cameras: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        self.frame_times: dict[str, deque[int]] = {}
+        self.joints: dict[str, dict[str, float]] = {}
+
+    def resend_field(self) -> None:
+        """Send the field again with the next scene (a client subscribed to the scene anew)."""
+        self.field_sent = False
+
+    # ------------------------------------------------------------------------------- entry points
+    def translate(self, topic: str, cls: type, time_ns: int, wall_ns: int, data: bytes) -> list[ExtraMessage]:
+        """``LogWriter``'s hook: one recorded representation (protobuf bytes) to encoded messages."""
+        if cls not in USED:
+            return []
+        return [out.encoded() for out in self.feed(topic.split("/", 1)[0], deserialize(cls, data), time_ns, wall_ns)]
+
+    def feed(self, context: str, value: Any, time_ns: int, wall_ns: int | None = None) -> list[Outgoing]:
+        """One representation of ``context`` at frame time ``time_ns``: the messages it makes."""
+        wall = wall_ns if wall_ns is not None else time.time_ns()
+        if self.offset_ns is None:
+            self.offset_ns = wall - time_ns
+        return list(self._messages(context, value, time_ns, wall))
+
+    def log_record(self, record: logging.LogRecord, time_ns: int) -> Outgoing | None:
+        """A log line as ``foxglove.Log`` (at the wall-clock time it was logged)."""
+        if not self.wanted("/log"):
+            return None
+        level = {logging.DEBUG: fm.LogLevel.Debug, logging.INFO: fm.LogLevel.Info, logging.WARNING: fm.LogLevel.Warning,
+                 logging.ERROR: fm.LogLevel.Error, logging.CRITICAL: fm.LogLevel.Fatal}.get(record.levelno, fm.LogLevel.Info)
+        wall = int(record.created * 1e9)
+        message = fm.Log(timestamp=timestamp(wall), level=level, message=record.getMessage(), name=record.name,
+                         file=record.pathname, line=record.lineno)
+        return Outgoing("/log", message, time_ns, wall)
+
+    # ----------------------------------------------------------------------------- translation
+    def _stamp(self, time_ns: int) -> fm.Timestamp:
+        """A frame time as a message timestamp: on the wall clock, by the offset of the first message."""
+        return timestamp(time_ns + (self.offset_ns or 0))
+
+    def _messages(self, context: str, value: Any, time_ns: int, wall: int) -> Iterator[Outgoing]:
+        stamp = self._stamp(time_ns)
+        kind = type(value)
+        if kind in CAMERAS:
+            self.image_context = context
+            yield from self._image(CAMERAS[kind], value, time_ns, wall)
+        elif kind is DebugDrawings:
+            yield from self._drawings(context, value, time_ns, wall, stamp)
+        elif kind in CAMERA_MATRICES:
+            self.cameras[CAMERA_MATRICES[kind]] = (np.asarray(value.rotation, float), np.asarray(value.translation, float))
+        elif kind is TorsoPose:
+            self.torso = (np.asarray(value.rotation, float), np.asarray(value.translation, float))
+        elif kind is Odometry and self.wanted("/tf"):
+            yield Outgoing("/tf", self._transforms(value, stamp), time_ns, wall)
+        elif kind is BallModel and self.wanted("/scene"):
+            yield Outgoing("/scene", self._scene(value, stamp), time_ns, wall)
+        elif kind is BallPercept and self.wanted("/scene"):
+            seen = [(value.x, value.y)] if value.seen else []
+            yield Outgoing("/scene", fm.SceneUpdate(entities=[ball_entity(stamp, "ball/percept", seen, color("yellow", 0.6))]), time_ns, wall)
+        elif kind is JointSensorData:
+            self.joints = {"position": named(value.position), "temperature": named(value.temperature)}
+        elif kind is JointCommand and self.wanted("/joints"):  # once per motion frame, with the last measurement
+            yield Outgoing("/joints", {**self.joints, "command": named(value.position), "stiffness": named(value.stiffness)}, time_ns, wall)
+        elif kind is InertialSensorData and self.wanted("/imu"):
+            yield Outgoing("/imu", {"accelerometer": dict(zip("xyz", map(float, value.accelerometer))),
+                                    "gyroscope": dict(zip("xyz", map(float, value.gyroscope))),
+                                    "angles": {"roll": float(value.angles[0]), "pitch": float(value.angles[1])}}, time_ns, wall)
+        elif kind is FsrData and self.wanted("/fsr"):
+            yield Outgoing("/fsr", dict(zip(FSR_NAMES, map(float, value.pressure))), time_ns, wall)
+        elif kind is ModuleTimes and self.wanted("/timing"):
+            yield Outgoing("/timing", {context: dict(zip(value.names, value.milliseconds))}, time_ns, wall)
+        elif kind is FrameInfo:
+            yield from self._rates(context, time_ns, wall)
+
+    def _image(self, camera: str, value: Any, time_ns: int, wall: int) -> Iterator[Outgoing]:
+        image = np.asarray(value.image)
+        if image.ndim != 3 or not image.size:
+            return
+        height, width = image.shape[:2]
+        taken = value.time_ns or time_ns
+        self.images[camera] = (taken, width, height)
+        stamp = self._stamp(taken)
+        frame_id = f"camera_{camera}_optical"
+        if self.wanted(f"/camera/{camera}"):
+            ok, jpeg = cv2.imencode(".jpg", cv2.cvtColor(image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, self.jpeg_quality])
+            if ok:
+                yield Outgoing(f"/camera/{camera}", fm.CompressedImage(timestamp=stamp, frame_id=frame_id, data=jpeg.tobytes(), format="jpeg"),
+                               time_ns, wall)
+        if self.wanted(f"/camera/{camera}/calibration"):
+            yield Outgoing(f"/camera/{camera}/calibration",
+                           calibration(stamp, camera, width, height, value.horizontal_fov, value.vertical_fov), time_ns, wall)
+
+    def _drawings(self, context: str, value: Any, time_ns: int, wall: int, stamp: fm.Timestamp) -> Iterator[Outgoing]:
+        by_canvas: dict[str, list[Any]] = {}
+        for primitive in value.primitives:
+            by_canvas.setdefault(primitive.canvas, []).append(primitive)
+        for camera in ("top", "bottom"):
+            topic = f"/camera/{camera}/annotations"
+            if camera in self.images and context == self.image_context and self.wanted(topic):
+                image_stamp = self._stamp(self.images[camera][0])  # the image's timestamp: the panel pairs them
+                yield Outgoing(topic, image_annotations(image_stamp, by_canvas.get(f"image:{camera}", [])), time_ns, wall)
+        if self.wanted("/scene"):  # every frame, also when empty: yesterday's drawings disappear
+            yield Outgoing("/scene", fm.SceneUpdate(entities=[field_drawings_entity(stamp, context, by_canvas.get("field", []))]),
+                           time_ns, wall)
+
+    def _scene(self, ball: Any, stamp: fm.Timestamp) -> fm.SceneUpdate:
+        entities = robot_entity(stamp)
+        if not self.field_sent:
+            entities.append(field_entity(stamp))
+            self.field_sent = True
+        entities.append(ball_entity(stamp, "ball/model", [(ball.x, ball.y)] if ball.valid else [], color("orange")))
+        return fm.SceneUpdate(entities=entities)
+
+    def _transforms(self, odometry: Any, stamp: fm.Timestamp) -> fm.FrameTransforms:
+        rotation, translation = self.torso
+        transforms = [
+            fm.FrameTransform(timestamp=stamp, parent_frame_id="field", child_frame_id="robot",
+                              translation=fm.Vector3(x=odometry.x * M, y=odometry.y * M, z=0.0), rotation=yaw_quaternion(odometry.rotation)),
+            fm.FrameTransform(timestamp=stamp, parent_frame_id="robot", child_frame_id="torso",
+                              translation=fm.Vector3(x=translation[0] * M, y=translation[1] * M, z=translation[2] * M),
+                              rotation=quaternion(rotation)),
+        ]
+        for camera, (cam_rotation, cam_translation) in self.cameras.items():
+            # the camera matrices are in the robot frame: relative to the torso they are torso^-1 * camera
+            relative_rotation = rotation.T @ cam_rotation
+            relative_translation = rotation.T @ (cam_translation - translation)
+            transforms.append(fm.FrameTransform(timestamp=stamp, parent_frame_id="torso", child_frame_id=f"camera_{camera}",
+                                                translation=fm.Vector3(x=relative_translation[0] * M, y=relative_translation[1] * M,
+                                                                       z=relative_translation[2] * M),
+                                                rotation=quaternion(relative_rotation)))
+            transforms.append(fm.FrameTransform(timestamp=stamp, parent_frame_id=f"camera_{camera}", child_frame_id=f"camera_{camera}_optical",
+                                                translation=fm.Vector3(x=0, y=0, z=0), rotation=quaternion(OPTICAL)))
+        return fm.FrameTransforms(transforms=transforms)
+
+    def _rates(self, context: str, time_ns: int, wall: int) -> Iterator[Outgoing]:
+        """Frames per second of each context over the last second of frame time."""
+        times = self.frame_times.setdefault(context, deque())
+        times.append(time_ns)
+        while times[0] < time_ns - 1_000_000_000:
+            times.popleft()
+        if len(times) > 1 and time_ns > times[0] and self.wanted("/rates"):
+            yield Outgoing("/rates", {context: (len(times) - 1) * 1e9 / (time_ns - times[0])}, time_ns, wall)
+
+
+class RecordingChannels(logging.Handler):
+    """Foxglove's channels in every file a ``Recorder`` writes: the translation hook for the
+    representations, and the program's log lines (``tafel`` loggers) while a recording runs."""
+
+    def __init__(self, recorder: Any, jpeg_quality: int = 80) -> None:
+        super().__init__(logging.INFO)
+        self.recorder = recorder
+        self.jpeg_quality = jpeg_quality
+        self.translator = FoxgloveTranslator(jpeg_quality)
+        recorder.listeners.append(self.switch)
+
+    def new_file(self) -> Callable[[str, type, int, int, bytes], list[ExtraMessage]]:
+        self.translator = FoxgloveTranslator(self.jpeg_quality)  # the field again, a new time offset
+        return self.translator.translate
+
+    def switch(self, recording: bool) -> None:
+        logger = logging.getLogger("tafel")
+        if recording:
+            logger.addHandler(self)
+        else:
+            logger.removeHandler(self)
+
+    def emit(self, record: logging.LogRecord) -> None:
+        writer = self.recorder.writer
+        message = self.translator.log_record(record, int(record.created * 1e9) - (self.translator.offset_ns or 0))
+        if writer is not None and message is not None:
+            writer.write_extra(message.encoded())
