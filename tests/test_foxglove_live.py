@@ -119,3 +119,18 @@ def test_with_a_debug_token_a_client_needs_it_too(tmp_path) -> None:
         old_name.close()
     finally:
         program.stop()
+
+
+@pytest.mark.slow
+def test_contexts_in_their_own_processes_are_served_too() -> None:
+    """The concurrent runtime (as on the robot): the context processes hand over what clients subscribe to."""
+    program = Program("--platform", "dummy", "--concurrent", "--foxglove", "0")
+    try:
+        client = FoxgloveClient(foxglove_url(program))
+        client.subscribe("/joints", "/scene", "/rates")
+        client.wait_for(lambda: len(client.received.get("/joints", [])) >= 50 and client.received.get("/scene"), 20)
+        assert client.set_parameters({"/Striker/search_turn": 0.5}) == {"/Striker/search_turn": pytest.approx(0.5)}
+        assert "search_turn = 0.5" in program.ask("parameter:get -module Striker")
+        client.close()
+    finally:
+        program.stop()

@@ -9,8 +9,10 @@ import importlib
 import ipaddress
 import logging
 import math
+import multiprocessing
 import os
 import pkgutil
+import queue
 import sys
 import threading
 import time
@@ -42,6 +44,7 @@ from tafel.tools.debugging import (
     context_debug,
     handovers_of,
     worker_debug_setup,
+    worker_setups,
 )
 
 #: the default configuration, shipped inside the package (the repository's config/ folder)
@@ -384,8 +387,8 @@ def foxglove_address(text: str) -> tuple[str, int]:
     return host.strip("[]") or "127.0.0.1", number
 
 
-def start_foxglove(args: argparse.Namespace, debug: ProgramDebug | None, runtime: LockstepRuntime, config: dict[str, Any]) -> Any:
-    """The live Foxglove server with ``--foxglove``, fed after every frame of every context; None without."""
+def start_foxglove(args: argparse.Namespace, debug: ProgramDebug | None, config: dict[str, Any], flags: Any = None) -> Any:
+    """The live Foxglove server with ``--foxglove``, listening; None without. The caller feeds it."""
     if args.foxglove is None:
         return None
     from tafel.tools.foxglove_live import FoxgloveLive
@@ -396,15 +399,35 @@ def start_foxglove(args: argparse.Namespace, debug: ProgramDebug | None, runtime
         print(f"warning: the Foxglove server listens on {host} without a token: anybody on that network can watch and "
               "steer this program; give one with --debug-token-file F", file=sys.stderr, flush=True)
     quality = int(config.get("foxglove", {}).get("jpeg_quality", 80))
-    live = FoxgloveLive(host, port, ask=debug.server.ask if debug is not None else None, jpeg_quality=quality, token=token)
+    live = FoxgloveLive(host, port, ask=debug.server.ask if debug is not None else None, jpeg_quality=quality, token=token,
+                        flags=flags)
     try:
         host, port = live.start()
     except Exception as exc:  # noqa: BLE001 - the SDK reports a taken port as a plain RuntimeError
         fail(f"Foxglove server: cannot listen on {host}:{port} ({exc}); choose another port with --foxglove PORT (0: a free one)")
-    for runner in runtime.runners.values():
-        runner.after_step.append(lambda r: live.after_frame(r.name, r.manager.blackboard, r.time_ns))
     print(f"foxglove server listening on ws://{host}:{port}", flush=True)
     return live
+
+
+def concurrent_foxglove(args: argparse.Namespace) -> tuple[Any, Any]:
+    """For contexts in other processes: (the shared flags of what to hand over, the queue it comes through)."""
+    if args.foxglove is None:
+        return None, None
+    from tafel.tools.foxglove_live import FED, QUEUE_SIZE
+
+    spawn = multiprocessing.get_context("spawn")
+    return spawn.Array("b", len(FED), lock=False), spawn.Queue(maxsize=QUEUE_SIZE)
+
+
+def forward_foxglove(live: Any, feed: Any, stop: Any) -> None:
+    """Supervisor thread: what the context processes handed over, to the bridge."""
+    while not stop.is_set():
+        try:
+            live.take(feed.get(timeout=0.2))
+        except queue.Empty:
+            continue
+        except (EOFError, OSError):
+            return
 
 
 def shutdown_grace(config: dict[str, Any]) -> float:
@@ -433,7 +456,10 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
             context_debug(name, runner.manager, recorded.get(name, ()))
     install_signal_handlers(runtime.stop, grace_s=shutdown_grace(config))
     listen(args, debug)
-    live = start_foxglove(args, debug, runtime, config)
+    live = start_foxglove(args, debug, config)
+    if live is not None:
+        for runner in runtime.runners.values():
+            runner.after_step.append(lambda r: live.after_frame(r.name, r.manager.blackboard, r.time_ns))
     started = time.monotonic()
     last = [started]
     line = StatusLine(type(platform).name, config)
@@ -460,19 +486,22 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
 
 def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[str, Any], plans: dict[str, ContextPlan],
                    config: dict[str, Any], recorder: Recorder | None, limits: Limits) -> int:
-    if args.foxglove is not None:
-        fail(f"--foxglove serves programs in the lockstep runtime (mujoco, pybullet, log, dummy) for now; {args.platform} runs "
-             "concurrently. Record with --record and open the file in Foxglove instead")
     platform.stop()  # each context process makes its own
     platform_class = type(platform)
     debug = start_debug(args, recorder, plans, config)
-    setup = None
+    setups: list[tuple[Callable[..., None], dict[str, Any]]] = []
     if debug is not None:
         running = [name for name, plan in plans.items() if plan.runs]
         ours, theirs = concurrent_pipes(running)
-        setup = (worker_debug_setup, {"connections": theirs, "recorded": debug_recorded(recorder)})
+        setups.append((worker_debug_setup, {"connections": theirs, "recorded": debug_recorded(recorder)}))
         for name in running:
             debug.add_context(name, RemoteExecutor(name, ours[name]), plans[name])
+    flags, feed = concurrent_foxglove(args)
+    if feed is not None:
+        from tafel.tools.foxglove_live import worker_feed_setup
+
+        setups.append((worker_feed_setup, {"flags": flags, "queue": feed}))
+    setup = (worker_setups, setups) if setups else None
     stall = float(config.get("runtime", {}).get("stall_timeout_s", 1.0))
     runtime = ConcurrentRuntime(plans, platform_class, options, strict=args.strict, stall_timeout_s=stall,
                                 recorder=recorder, worker_setup=setup, grace_s=shutdown_grace(config))
@@ -497,9 +526,14 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
     if debug is not None:
         listen(args, debug)
         threading.Thread(target=debug.server.dispatch_forever, args=(runtime.stop,), name="tafel-debug-dispatch", daemon=True).start()
+    live = start_foxglove(args, debug, config, flags)
+    if live is not None:
+        threading.Thread(target=forward_foxglove, args=(live, feed, runtime.stop), name="tafel-foxglove-forward", daemon=True).start()
     try:
         stats = runtime.run(limits)
     finally:
+        if live is not None:
+            live.stop()
         if debug is not None:
             debug.server.stop()
     realtime = stats.get("motion", ContextStats("motion")).realtime

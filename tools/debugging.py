@@ -182,6 +182,12 @@ class RemoteExecutor(Executor):
         return answers
 
 
+def worker_setups(runner: ContextRunner, steps: Sequence[tuple[Callable[..., None], Any]]) -> None:
+    """Runs in a context process: every set-up the supervisor asked for (debug, Foxglove), in order."""
+    for function, arguments in steps:
+        function(runner, arguments)
+
+
 def worker_debug_setup(runner: ContextRunner, args: Mapping[str, Any]) -> None:
     """Runs in a context process: answer the supervisor's commands between frames."""
     connection = args["connections"].get(runner.name)

@@ -44,6 +44,30 @@ COMMAND_SERVICE = "/tafel/command"
 QUEUE_SIZE = 64  # representations waiting for the bridge's thread; beyond that a frame's data is dropped
 
 
+#: every representation the bridge may ask the loops for, in one fixed order (flags across processes)
+FED: tuple[type, ...] = tuple(sorted({rep for reps in NEEDS.values() for rep in reps}, key=lambda rep: rep.__name__))
+
+
+def hand_over(context: str, blackboard: Any, time_ns: int, wanted: Callable[[int], bool], put: Callable[[Any], None]) -> int:
+    """After a frame: a copy of each wanted representation (by index in ``FED``) to ``put``; returns how
+    many did not fit (``put`` raises ``queue.Full``)."""
+    wall, dropped = time.time_ns(), 0
+    for index, rep in enumerate(FED):
+        if wanted(index) and rep in blackboard:
+            try:
+                put((context, snapshot(blackboard[rep]), time_ns, wall))
+            except queue.Full:
+                dropped += 1
+    return dropped
+
+
+def worker_feed_setup(runner: Any, args: dict[str, Any]) -> None:
+    """Runs in a context process of the concurrent runtime: after each frame, hand the bridge in the main
+    process what its clients' subscriptions need (``flags``, shared), through a queue that drops."""
+    flags, feed = args["flags"], args["queue"]
+    runner.after_step.append(lambda r: hand_over(r.name, r.manager.blackboard, r.time_ns, flags.__getitem__, feed.put_nowait))
+
+
 def snapshot(value: Any) -> Any:
     """A copy of a representation that the loop may go on changing: arrays and lists copied, cheaply."""
     clone = copy.copy(value)
@@ -60,8 +84,10 @@ class FoxgloveLive(logging.Handler):
     """The live Foxglove server of one program (lockstep runtime: the loops run in this process)."""
 
     def __init__(self, host: str, port: int, *, ask: Callable[[str], str] | None, jpeg_quality: int = 80,
-                 token: str | None = None) -> None:
+                 token: str | None = None, flags: Any = None) -> None:
         super().__init__(logging.INFO)
+        #: with contexts in other processes: which of ``FED`` they hand over (a shared array)
+        self.flags = flags
         self.host, self.port = host, port
         self.token = token
         self.gate: TokenGate | None = None
@@ -121,15 +147,15 @@ class FoxgloveLive(logging.Handler):
     def after_frame(self, context: str, blackboard: Any, time_ns: int) -> None:
         """In the loop, after each frame: copies of what subscribed topics need; never waits."""
         needed = self.needed
-        if not needed:
-            return
-        wall = time.time_ns()
-        for rep in needed:
-            if rep in blackboard:
-                try:
-                    self.queue.put_nowait((context, snapshot(blackboard[rep]), time_ns, wall))
-                except queue.Full:
-                    self.dropped += 1
+        if needed:
+            self.dropped += hand_over(context, blackboard, time_ns, lambda index: FED[index] in needed, self.queue.put_nowait)
+
+    def take(self, item: tuple[str, Any, int, int]) -> None:
+        """What a context process handed over (the concurrent runtime's forwarding thread)."""
+        try:
+            self.queue.put_nowait(item)
+        except queue.Full:
+            self.dropped += 1
 
     # ------------------------------------------------------------------------------- the thread
     def _work(self) -> None:
@@ -171,6 +197,9 @@ class FoxgloveLive(logging.Handler):
 
     def _update_needed(self) -> None:
         self.needed = frozenset(rep for topic, count in self.subscribers.items() if count for rep in NEEDS.get(topic, ()))
+        if self.flags is not None:
+            for index, rep in enumerate(FED):
+                self.flags[index] = rep in self.needed
 
     def on_get_parameters(self, client: Client, param_names: list[str], request_id: str | None = None) -> list[Parameter]:
         parameters = self._parameters()
