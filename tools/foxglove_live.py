@@ -81,7 +81,8 @@ def snapshot(value: Any) -> Any:
 
 
 class FoxgloveLive(logging.Handler):
-    """The live Foxglove server of one program (lockstep runtime: the loops run in this process)."""
+    """The live Foxglove server of one program, fed by ``after_frame`` (loops in this process) or by
+    ``take`` (what context processes handed over)."""
 
     def __init__(self, host: str, port: int, *, ask: Callable[[str], str] | None, jpeg_quality: int = 80,
                  token: str | None = None, flags: Any = None) -> None:
@@ -134,7 +135,10 @@ class FoxgloveLive(logging.Handler):
     def stop(self) -> None:
         logging.getLogger("tafel").removeHandler(self)
         if self.thread.is_alive():
-            self.queue.put(None)
+            try:
+                self.queue.put(None, timeout=5)
+            except queue.Full:  # the thread is stuck; it is a daemon and ends with the program
+                pass
             self.thread.join(timeout=5)
         if self.gate is not None:
             self.gate.stop()
