@@ -336,6 +336,18 @@ def imu(roll: float = 0.0, pitch: float = 0.0, rate: float = 0.0) -> InertialSen
     return InertialSensorData(angles=np.array([roll, pitch]), gyroscope=np.array([0.0, rate, 0.0]))
 
 
+@pytest.mark.parametrize(("gravity_x", "side"), [(9.8, FallPhase.lying_back), (-9.8, FallPhase.lying_front)])
+def test_lying_flat_is_told_apart_by_gravity_where_roll_means_nothing(gravity_x: float, side: FallPhase) -> None:
+    """At a pitch near 90 degrees the IMU's roll jumps between -pi and pi; the accelerometer decides."""
+    rolls = [3.14, -3.14, 1.6, -0.4] * 30
+    flat = [InertialSensorData(angles=np.array([roll, math.copysign(1.55, -gravity_x)]), accelerometer=np.array([gravity_x, 0.0, 0.3]),
+                               gyroscope=np.zeros(3)) for roll in rolls]
+    harness = ModuleHarness(FallDetector, context="motion")
+    harness.feed({InertialSensorData: flat})
+    harness.execute()
+    assert harness[FallState].phase is side
+
+
 def test_a_fall_forwards_is_seen_before_the_impact_and_then_the_robot_lies_on_its_front() -> None:
     tilt = [imu(pitch=0.02 * i, rate=1.5) for i in range(40)] + [imu(pitch=1.45)] * 80
     harness = ModuleHarness(FallDetector, context="motion")

@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from tafel.core import Module, bounded, provides, requires, uses
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import InertialSensorData
@@ -51,14 +53,14 @@ class FallDetector(Module):
         elif tilt >= p.lying_angle and rate < 0.5:
             self.still_since = now if self.still_since is None else self.still_since
             settled = (now - self.still_since) * 1e-9 >= p.settle
-            lying = FallPhase.lying_front if pitch > p.lying_angle * 0.7 else FallPhase.lying_back \
-                if pitch < -p.lying_angle * 0.7 else FallPhase.lying_side
+            direction = _direction(roll, pitch, imu.accelerometer)
+            lying = {FallDirection.front: FallPhase.lying_front, FallDirection.back: FallPhase.lying_back}.get(
+                direction, FallPhase.lying_side)
             phase = lying if settled else FallPhase.falling
-            direction = _direction(roll, pitch)
         elif tilt >= p.fall_angle or (tilt >= p.fall_angle / 2 and rate >= p.fall_rate and _growing(roll, pitch, imu)):
-            phase, direction = FallPhase.falling, _direction(roll, pitch)
+            phase, direction = FallPhase.falling, _direction(roll, pitch, imu.accelerometer)
         elif tilt >= p.stagger_angle:
-            phase, direction = FallPhase.staggering, _direction(roll, pitch)
+            phase, direction = FallPhase.staggering, _direction(roll, pitch, imu.accelerometer)
         else:
             phase, direction = FallPhase.upright, FallDirection.none
         if tilt < p.lying_angle or rate >= 0.5:
@@ -69,8 +71,19 @@ class FallDetector(Module):
         state.duration = max(0.0, (now - self.phase_since) * 1e-9)
 
 
-def _direction(roll: float, pitch: float) -> FallDirection:
-    """Forward lean is positive pitch; leaning left is negative roll (the robot turns about +x to the right)."""
+def _direction(roll: float, pitch: float, accelerometer: np.ndarray) -> FallDirection:
+    """Which way the torso leans: forward lean is positive pitch, leaning left negative roll (the robot
+    turns about +x to the right).
+
+    Near lying, roll and pitch lose their meaning (at a pitch of 90 degrees the roll is anything), so
+    there the accelerometer decides, when it measures about gravity: the torso's x axis pointing down
+    (face down) reads negative, its y axis pointing down (lying on the left) negative.
+    """
+    ax, ay, az = (float(v) for v in accelerometer[:3])
+    if max(abs(roll), abs(pitch)) > 1.0 and 5.0 < math.sqrt(ax * ax + ay * ay + az * az) < 15.0:
+        if abs(ax) >= abs(ay):
+            return FallDirection.front if ax < 0 else FallDirection.back
+        return FallDirection.left if ay < 0 else FallDirection.right
     if abs(pitch) >= abs(roll):
         return FallDirection.front if pitch > 0 else FallDirection.back
     return FallDirection.right if roll > 0 else FallDirection.left
