@@ -205,3 +205,11 @@ def test_the_programs_log_lines_are_recorded_as_foxglove_logs(tmp_path: Path) ->
         lines = [log_class.FromString(m.data) for _, _, m in make_reader(stream).iter_messages(topics=["/log"])]
     assert [(line.message, line.name) for line in lines] == [("the left knee is hot: 71 deg C", "tafel.motion")]
     assert lines[0].level == log_class.Level.Value("WARNING")
+
+
+@pytest.mark.parametrize("value", ["abc", "500", "0"])
+def test_a_wrong_jpeg_quality_is_refused_before_the_run(tmp_path: Path, value: str) -> None:
+    result = tafel("run", "--platform", "dummy", "--seconds", "0.2", "--no-debug", "--record", str(tmp_path / "x.mcap"),
+                   "--set", f"foxglove.jpeg_quality={value}")
+    assert result.returncode == 2 and "foxglove.jpeg_quality takes a whole number from 1 to 100" in result.stderr
+    assert "Traceback" not in result.stderr

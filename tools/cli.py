@@ -398,8 +398,7 @@ def start_foxglove(args: argparse.Namespace, debug: ProgramDebug | None, config:
     if token is None and not is_loopback(host):
         print(f"warning: the Foxglove server listens on {host} without a token: anybody on that network can watch and "
               "steer this program; give one with --debug-token-file F", file=sys.stderr, flush=True)
-    quality = int(config.get("foxglove", {}).get("jpeg_quality", 80))
-    live = FoxgloveLive(host, port, ask=debug.server.ask if debug is not None else None, jpeg_quality=quality, token=token,
+    live = FoxgloveLive(host, port, ask=debug.server.ask if debug is not None else None, jpeg_quality=jpeg_quality(config), token=token,
                         flags=flags)
     try:
         host, port = live.start()
@@ -575,7 +574,7 @@ def make_recorder(args: argparse.Namespace, plans: dict[str, ContextPlan], confi
     recorder = Recorder(selections, metadata)
     foxglove = config.get("foxglove", {})
     if foxglove.get("channels_in_recordings", True):
-        recorder.translate_factory = foxglove_recording(recorder, int(foxglove.get("jpeg_quality", 80)))
+        recorder.translate_factory = foxglove_recording(recorder, jpeg_quality(config))
     # Without a beat to keep (lockstep at --speed max) recording waits for the writer rather than drop.
     recorder.blocking = args.speed is None and not args.concurrent
     if args.record is not None:
@@ -583,7 +582,15 @@ def make_recorder(args: argparse.Namespace, plans: dict[str, ContextPlan], confi
     return recorder
 
 
-def foxglove_recording(recorder: Recorder, jpeg_quality: int) -> Callable[[], Any]:
+def jpeg_quality(config: dict[str, Any]) -> int:
+    """``[foxglove] jpeg_quality`` (1 to 100); anything else exits with status 2 and says so."""
+    value = config.get("foxglove", {}).get("jpeg_quality", 80)
+    if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 100:
+        fail(f"foxglove.jpeg_quality takes a whole number from 1 to 100 (JPEG quality of the images), got {value!r}")
+    return value
+
+
+def foxglove_recording(recorder: Recorder, quality: int) -> Callable[[], Any]:
     """The hook that gives each recorded file Foxglove's channels; their code loads with the first recording."""
     channels: list[Any] = []
 
@@ -591,7 +598,7 @@ def foxglove_recording(recorder: Recorder, jpeg_quality: int) -> Callable[[], An
         if not channels:
             from tafel.tools.foxglove_channels import RecordingChannels
 
-            channels.append(RecordingChannels(recorder, jpeg_quality))
+            channels.append(RecordingChannels(recorder, quality))
         return channels[0].new_file()
 
     return new_file
