@@ -37,6 +37,7 @@ def test_dummy_run_gives_frame_counts_matching_the_rates() -> None:
     assert "platform dummy (lockstep): ran 10.000 s of platform time" in result.stdout
 
 
+@pytest.mark.slow
 def test_dummy_runs_are_deterministic() -> None:
     first = dummy("--frames", "500", "--speed", "max", "--seed", "3")
     second = dummy("--frames", "500", "--speed", "max", "--seed", "3")

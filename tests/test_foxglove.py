@@ -151,6 +151,7 @@ def test_log_convert_adds_the_channels_to_a_log_recorded_without_them(tmp_path: 
     assert tafel("log", "compare", str(plain), str(converted)).returncode == 0  # the representations are untouched
 
 
+@pytest.mark.slow
 def test_log_convert_gives_an_old_log_wall_clock_times_and_refuses_bad_input(tmp_path: Path) -> None:
     converted = tmp_path / "converted.mcap"
     old = REPO / "tests" / "data" / "ball_situation.mcap"  # recorded when log times were frame times
@@ -207,6 +208,7 @@ def test_the_programs_log_lines_are_recorded_as_foxglove_logs(tmp_path: Path) ->
     assert lines[0].level == log_class.Level.Value("WARNING")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("value", ["abc", "500", "0"])
 def test_a_wrong_jpeg_quality_is_refused_before_the_run(tmp_path: Path, value: str) -> None:
     result = tafel("run", "--platform", "dummy", "--seconds", "0.2", "--no-debug", "--record", str(tmp_path / "x.mcap"),

@@ -100,6 +100,7 @@ def test_log_info_summarises_the_recording(recorded: Path) -> None:
     assert info["channels"]["cognition/BallModel"]["messages"] == 180 and info["duration_s"] == pytest.approx(5.99)
 
 
+@pytest.mark.slow
 def test_replay_reproduces_every_cognition_output_frame_by_frame(recorded: Path, tmp_path: Path) -> None:
     replayed = tmp_path / "replayed.mcap"
     result = tafel("run", "--platform", "log", "--no-debug", "--log", str(recorded), "--speed", "max", "--record", str(replayed))
@@ -112,6 +113,7 @@ def test_replay_reproduces_every_cognition_output_frame_by_frame(recorded: Path,
         assert first == second, topic
 
 
+@pytest.mark.slow
 def test_replace_feeds_a_recorded_representation_instead_of_its_module(recorded: Path, tmp_path: Path) -> None:
     modules = tafel("modules", "--platform", "log", "--log", str(recorded), "--replace", "BallModel")
     assert "replaced: KalmanBallModeler (the platform provides BallModel)" in modules.stdout
@@ -272,6 +274,7 @@ def test_good_magic_and_garbage_after_is_an_error_naming_file_and_byte(tmp_path:
     assert replay.returncode != 0 and "garbage.mcap" in replay.stderr and "Traceback" not in replay.stderr
 
 
+@pytest.mark.slow
 def test_a_damaged_chunk_in_the_middle_is_skipped_and_the_rest_is_read(recorded: Path, tmp_path: Path) -> None:
     from tafel.core.logfile import LogReader
 

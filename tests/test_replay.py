@@ -33,6 +33,7 @@ def record_and_replay(tmp_path: Path, *run_args: str, reps: str = "all", replay_
     return original, replayed, fingerprint(live.stdout), fingerprint(again.stdout)
 
 
+@pytest.mark.slow
 def test_replay_feeds_only_sensor_data_so_stateful_modules_reproduce(tmp_path: Path) -> None:
     """The inertial filter and the ball model keep state in their own outputs: replay must not overwrite them."""
     original, replayed, live, again = record_and_replay(tmp_path, "--platform", "dummy", "--frames", "500", "--seed", "5",
@@ -43,6 +44,7 @@ def test_replay_feeds_only_sensor_data_so_stateful_modules_reproduce(tmp_path: P
     assert live == again
 
 
+@pytest.mark.slow
 def test_compare_finds_the_first_difference_after_a_parameter_change(tmp_path: Path) -> None:
     original, replayed, live, again = record_and_replay(
         tmp_path, "--platform", "dummy", "--frames", "300", reps=FEEDBACK_REPS,
@@ -58,6 +60,7 @@ def test_compare_finds_the_first_difference_after_a_parameter_change(tmp_path: P
     assert ball["differing"] > 0 and ball["fields"] and report["motion/InertialModel"]["differing"] == 0
 
 
+@pytest.mark.slow
 def test_compare_errors_name_what_is_wrong(tmp_path: Path) -> None:
     original, _replayed, _live, _again = record_and_replay(tmp_path, "--platform", "dummy", "--frames", "50", reps="BallModel")
     missing = tafel("log", "compare", str(original), str(tmp_path / "nope.mcap"))

@@ -235,6 +235,7 @@ def test_wrong_tokens_are_slowed_down_and_the_connection_closed_after_twenty(tmp
         running.stop()
 
 
+@pytest.mark.slow
 def test_listening_beyond_loopback_without_a_token_warns(tmp_path: Path) -> None:
     running = Program("--platform", "dummy", "--debug-host", "0.0.0.0", cwd=tmp_path)
     try:
