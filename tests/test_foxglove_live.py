@@ -6,6 +6,7 @@ from __future__ import annotations
 import re
 import time
 from collections.abc import Iterator
+from typing import Any
 
 import cv2
 import numpy as np
@@ -38,6 +39,18 @@ def live() -> Iterator[tuple[Program, str]]:
         program.stop()
 
 
+@pytest.fixture
+def clients(live: tuple[Program, str]) -> Iterator[tuple[FoxgloveClient, Any]]:
+    """A Foxglove client of the live program, and a debug client to check what changed."""
+    program, url = live
+    client, debug = FoxgloveClient(url), program.client()
+    try:
+        yield client, debug
+    finally:
+        client.close()
+        debug.close()
+
+
 @pytest.mark.slow
 def test_a_client_receives_and_decodes_the_top_image_and_the_scene(live: tuple[Program, str]) -> None:
     _, url = live
@@ -55,9 +68,8 @@ def test_a_client_receives_and_decodes_the_top_image_and_the_scene(live: tuple[P
 
 
 @pytest.mark.slow
-def test_parameters_and_debug_requests_are_set_through_the_protocol(live: tuple[Program, str]) -> None:
-    program, url = live
-    client, debug = FoxgloveClient(url), program.client()
+def test_parameters_and_debug_requests_are_set_through_the_protocol(clients: tuple[FoxgloveClient, Any]) -> None:
+    client, debug = clients
     try:
         listed = client.get_parameters()
         assert listed["/Striker/search_turn"] == pytest.approx(0.6)
@@ -70,44 +82,32 @@ def test_parameters_and_debug_requests_are_set_through_the_protocol(live: tuple[
         assert refused["/Striker/search_turn"] == pytest.approx(0.45)
     finally:
         client.set_parameters({"/Striker/search_turn": 0.6, "/debug_request/BallDetector:draw_candidates": False})
-        client.close()
-        debug.close()
 
 
 @pytest.mark.slow
-def test_the_command_service_answers_as_the_console_would(live: tuple[Program, str]) -> None:
-    program, url = live
-    client, debug = FoxgloveClient(url), program.client()
-    try:
-        assert client.call_service("/tafel/command", b"ping") == b"pong"
-        assert client.call_service("/tafel/command", b"modules:list").decode() .startswith(debug.ask("modules:list")[:20])
-        assert client.call_service("/tafel/command", b"no:such").decode().startswith("error: unknown command")
-    finally:
-        client.close()
-        debug.close()
+def test_the_command_service_answers_as_the_console_would(clients: tuple[FoxgloveClient, Any]) -> None:
+    client, debug = clients
+    assert client.call_service("/tafel/command", b"ping") == b"pong"
+    assert client.call_service("/tafel/command", b"modules:list").decode().startswith(debug.ask("modules:list")[:20])
+    assert client.call_service("/tafel/command", b"no:such").decode().startswith("error: unknown command")
 
 
 @pytest.mark.slow
-def test_with_everything_subscribed_the_loops_keep_their_rates(live: tuple[Program, str]) -> None:
-    program, url = live
-    client, debug = FoxgloveClient(url), program.client()
-    try:
-        client.subscribe(*sorted(client.wait_for(client.topics)))
-        client.pump(1.0)
+def test_with_everything_subscribed_the_loops_keep_their_rates(clients: tuple[FoxgloveClient, Any]) -> None:
+    client, debug = clients
+    client.subscribe(*sorted(client.wait_for(client.topics)))
+    client.pump(1.0)
 
-        def frames() -> tuple[float, dict[str, int]]:
-            counts = re.findall(r"\[(\w+)\]\nloop: [\d.]+ Hz, frame (\d+)", debug.ask("stopwatch:list"))
-            return time.monotonic(), {context: int(frame) for context, frame in counts}
+    def frames() -> tuple[float, dict[str, int]]:
+        counts = re.findall(r"\[(\w+)\]\nloop: [\d.]+ Hz, frame (\d+)", debug.ask("stopwatch:list"))
+        return time.monotonic(), {context: int(frame) for context, frame in counts}
 
-        start, first = frames()
-        client.pump(6.0)
-        end, last = frames()
-        rates = {context: (last[context] - first[context]) / (end - start) for context in first}
-        assert rates["motion"] == pytest.approx(100, rel=0.03) and rates["cognition"] == pytest.approx(30, rel=0.05), rates
-        assert len(client.received["/camera/top"]) >= 150  # about 30 a second arrived
-    finally:
-        client.close()
-        debug.close()
+    start, first = frames()
+    client.pump(6.0)
+    end, last = frames()
+    rates = {context: (last[context] - first[context]) / (end - start) for context in first}
+    assert rates["motion"] == pytest.approx(100, rel=0.03) and rates["cognition"] == pytest.approx(30, rel=0.05), rates
+    assert len(client.received["/camera/top"]) >= 150  # about 30 a second arrived
 
 
 @pytest.mark.slow
