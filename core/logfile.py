@@ -140,25 +140,20 @@ class LogWriter:
 
         With ``blocking`` set (a run without a beat to keep, ``--speed max``) it waits for room instead.
         """
-        if self._closed or self.failed:
-            return False
-        item = _Item(topic, cls, time_ns, sequence, data, metadata or {}, time.time_ns())
-        try:
-            if self.blocking:
-                self._queue.put(item)
-            else:
-                self._queue.put_nowait(item)
-            return True
-        except queue.Full:
-            self.dropped += 1
-            return False
+        return self._queue_item(_Item(topic, cls, time_ns, sequence, data, metadata or {}, time.time_ns()), self.blocking)
 
     def write_extra(self, extra: ExtraMessage) -> bool:
         """Queue one message of a channel that is not a representation (any thread; never blocks)."""
+        return self._queue_item(extra, False)
+
+    def _queue_item(self, item: _Item | ExtraMessage, wait: bool) -> bool:
         if self._closed or self.failed:
             return False
         try:
-            self._queue.put_nowait(extra)
+            if wait:
+                self._queue.put(item)
+            else:
+                self._queue.put_nowait(item)
             return True
         except queue.Full:
             self.dropped += 1
