@@ -153,16 +153,16 @@ def _check_missing(
     problems = []
     for m in active:
         req = declared[m]
-        for kind, reps in (("requires", req.requires), ("uses", req.uses)):  # type: ignore[attr-defined]
-            for rep in reps:
-                if rep in provider:
-                    continue
-                off = [o.__name__ for o in modules if o.__name__ in disabled and rep in declared[o].provides]  # type: ignore[attr-defined]
-                hint = f" ({', '.join(off)} would, but is disabled)" if off else ""
-                problems.append(
-                    f"{m.__name__} {kind} {rep.__name__}, but no module provides it{hint} and it is not "
-                    "provided from outside"
-                )
+        # what a module only uses may be missing: it then reads the representation's defaults
+        for rep in req.requires:  # type: ignore[attr-defined]
+            if rep in provider:
+                continue
+            off = [o.__name__ for o in modules if o.__name__ in disabled and rep in declared[o].provides]  # type: ignore[attr-defined]
+            hint = f" ({', '.join(off)} would, but is disabled)" if off else ""
+            problems.append(
+                f"{m.__name__} requires {rep.__name__}, but no module provides it{hint} and it is not "
+                "provided from outside"
+            )
     if problems:
         raise MissingProviderError(
             "; ".join(problems)

@@ -210,7 +210,8 @@ def _route(plans: Mapping[str, ContextPlan]) -> None:
         for context in plans:
             available = local[context] | computed[_other(context)]
             for module in remaining[context]:
-                missing = [r.__name__ for r in module.requirements().reads() if r not in available]
+                # only what a module requires prunes it; what it uses keeps its defaults when missing
+                missing = [r.__name__ for r in module.requirements().requires if r not in available]
                 if missing:
                     pruned[context][module.__name__] = missing
                     changed = True

@@ -17,6 +17,7 @@ import numpy as np
 from tafel.core.manager import Blackboard
 from tafel.core.platform import Platform, seed_number
 from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.modeling import RobotPose
 from tafel.representations.motion import HEAD_YAW, JOINT_COUNT, FsrData, InertialSensorData, JointCommand, JointSensorData
 from tafel.representations.perception import BallPercept
 
@@ -25,11 +26,11 @@ GRAVITY = 9.81
 
 class DummyPlatform(Platform):
     name = "dummy"
-    description = "deterministic clock, synthetic joints, IMU and ball percepts, no physics"
+    description = "deterministic clock, synthetic joints, IMU, ball percepts and pose, no physics"
     clock = "simulated"
     provides: ClassVar[Mapping[str, tuple[type, ...]]] = {
         "motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData),
-        "cognition": (FrameInfo, BallPercept),
+        "cognition": (FrameInfo, BallPercept, RobotPose),
     }
     consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {"motion": (JointCommand,)}
 
@@ -37,6 +38,8 @@ class DummyPlatform(Platform):
     SERVO_TIME_CONSTANT = 0.05
     #: rad, half the horizontal field of view in which the ball counts as seen
     HALF_FIELD_OF_VIEW = math.radians(28.0)
+    #: mm, mm, rad on the field: in its own half, facing the opponent goal
+    POSE = (-1500.0, 0.0, 0.0)
 
     def __init__(self, options: Mapping[str, Any] | None = None) -> None:
         super().__init__(options)
@@ -88,6 +91,9 @@ class DummyPlatform(Platform):
             noise = self.rng.normal(0.0, 20.0, 2)
             percept.x, percept.y = (float(x + noise[0]), float(y + noise[1])) if percept.seen else (0.0, 0.0)
             percept.camera = "top" if percept.seen else ""
+            pose = blackboard[RobotPose]  # the robot never moves: it stands where the simulators start it
+            pose.valid, pose.lost, pose.deviation, pose.rotation_deviation = True, False, 0.0, 0.0
+            pose.x, pose.y, pose.rotation = self.POSE
 
     def act(self, context: str, blackboard: Blackboard) -> None:
         if context == "motion":

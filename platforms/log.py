@@ -180,8 +180,10 @@ class LogPlatform(Platform):
 
     def config_layers(self) -> list[str]:
         """The recording platform's layer first, so that replay runs the program that was recorded."""
+        layers = [layer for layer in self.reader.metadata.get("config_layers", "").split(",") if layer]
         recorded = self.reader.metadata.get("platform", "")
-        return [recorded, self.name] if recorded and recorded != self.name else [self.name]
+        layers = layers or ([recorded] if recorded else [])
+        return [layer for layer in layers if layer != self.name] + [self.name]
 
     def rates(self) -> Mapping[str, float] | None:
         rates = {}

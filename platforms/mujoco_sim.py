@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from tafel.core.platform import PlatformError
-from tafel.platforms.robot_model import SERVO_GAIN, fsr_sites, joint_motor, mjcf, torque_range
+from tafel.platforms.robot_model import SERVO_GAIN, fsr_sites, joint_motor, mjcf, mjcf_assets, torque_range
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.motion import JOINT_NAMES
 
@@ -33,7 +33,7 @@ import mujoco  # noqa: E402 - MUJOCO_GL must be set before mujoco is imported
 class MujocoPlatform(SimulatedRobotPlatform):
     name = "mujoco"
     engine = "MuJoCo"
-    description = "MuJoCo physics: NAO V6-like robot, SPL field, orange ball, rendered cameras"
+    description = "MuJoCo physics: NAO V6-like robot, SPL field and ball, rendered cameras"
 
     def __init__(self, options: dict[str, Any] | None = None) -> None:
         super().__init__(options)
@@ -43,7 +43,8 @@ class MujocoPlatform(SimulatedRobotPlatform):
         self.viewer: Any = None
 
     def build(self, contexts: frozenset[str], viewer: bool) -> None:
-        self.model = mujoco.MjModel.from_xml_string(mjcf(offscreen=(max(self.width, 640), max(self.height, 480)), timestep=TIMESTEP))
+        xml = mjcf(offscreen=(max(self.width, 640), max(self.height, 480)), timestep=TIMESTEP, ball_color=self.ball_color)
+        self.model = mujoco.MjModel.from_xml_string(xml, mjcf_assets(self.ball_color))
         self.data = mujoco.MjData(self.model)
         model = self.model
         self.joint_qpos = np.array([model.jnt_qposadr[model.joint(name).id] for name in JOINT_NAMES])
@@ -54,6 +55,7 @@ class MujocoPlatform(SimulatedRobotPlatform):
         self.fsr = [model.sensor(name).adr[0] for side in "LR" for name, _ in fsr_sites(side)]
         self.torso = model.body("torso").id
         self.ball_qpos = model.jnt_qposadr[model.joint("ball").id]
+        self.ball_body = model.body("ball").id
         self.ball_qvel = model.jnt_dofadr[model.joint("ball").id]
         self.root_qpos = model.jnt_qposadr[model.joint("root").id]
         self.root_qvel = model.jnt_dofadr[model.joint("root").id]
@@ -119,6 +121,22 @@ class MujocoPlatform(SimulatedRobotPlatform):
         renderer = self.renderers[camera]
         renderer.update_scene(self.data, camera=f"{camera}_camera")
         return renderer.render().copy()
+
+    def pose_joints(self, angles: np.ndarray) -> None:
+        self.data.qpos[self.joint_qpos] = angles
+        self.data.qvel[self.joint_dof] = 0.0
+        mujoco.mj_forward(self.model, self.data)
+
+    def ball_mask(self, camera: str) -> np.ndarray:
+        renderer = self.renderers[camera]
+        renderer.enable_segmentation_rendering()
+        try:
+            renderer.update_scene(self.data, camera=f"{camera}_camera")
+            segments = renderer.render()
+        finally:
+            renderer.disable_segmentation_rendering()
+        ball_geoms = [g for g in range(self.model.ngeom) if self.model.geom_bodyid[g] == self.ball_body]
+        return (segments[:, :, 1] == mujoco.mjtObj.mjOBJ_GEOM) & np.isin(segments[:, :, 0], ball_geoms)
 
     def world_state(self) -> np.ndarray:
         return self.data.qpos.copy()

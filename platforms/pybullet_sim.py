@@ -11,11 +11,13 @@ import os
 import tempfile
 from typing import Any
 
+import cv2
 import numpy as np
 import pybullet
 
 from tafel.core.platform import PlatformError
-from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, FieldPart, field_parts, fsr_sites, joint_motor, urdf
+from tafel.platforms.field_world import FieldPart, ball_mesh, ball_texture, field_parts
+from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, fsr_sites, joint_motor, urdf
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.motion import JOINT_NAMES
 from tafel.representations.nao import ACCELEROMETER_POSITION, CAMERAS, COUPLED_JOINTS, SOLE_BACK, SOLE_FRONT, VERTICAL_FOV
@@ -54,7 +56,7 @@ class PybulletPlatform(SimulatedRobotPlatform):
         pybullet.setPhysicsEngineParameter(numSolverIterations=50, deterministicOverlappingPairs=1, physicsClientId=c)
         self.bodies: dict[str, int] = {}
         ball = (self.initial_ball[0] * M, self.initial_ball[1] * M)
-        for part in field_parts(ball):
+        for part in field_parts(ball, self.ball_color):
             self.bodies[part.name] = self._field_body(part)
         self._load_robot()
         self.previous_velocity = np.zeros(3)
@@ -79,7 +81,12 @@ class PybulletPlatform(SimulatedRobotPlatform):
             # PyBullet capsules lie along z: tip z over onto the direction
             orientation = pybullet.getQuaternionFromEuler([0.0, math.atan2(math.hypot(direction[0], direction[1]), direction[2]),
                                                            math.atan2(direction[1], direction[0])])
-        if part.kind == "plane":
+        if part.texture:
+            vertices, normals, uvs, triangles = ball_mesh(part.size[0])
+            visual = pybullet.createVisualShape(pybullet.GEOM_MESH, vertices=vertices.tolist(), normals=normals.tolist(),
+                                                uvs=uvs.tolist(), indices=triangles.ravel().tolist(), rgbaColor=part.rgba,
+                                                physicsClientId=c)
+        elif part.kind == "plane":
             visual = pybullet.createVisualShape(pybullet.GEOM_BOX, halfExtents=[part.size[0], part.size[1], 0.0005],
                                                 rgbaColor=part.rgba, visualFramePosition=[0, 0, -0.0005], physicsClientId=c)
         else:
@@ -91,6 +98,8 @@ class PybulletPlatform(SimulatedRobotPlatform):
             collision = -1
         body = pybullet.createMultiBody(baseMass=part.mass, baseCollisionShapeIndex=collision, baseVisualShapeIndex=visual,
                                         basePosition=position, baseOrientation=orientation, physicsClientId=c)
+        if part.texture:
+            pybullet.changeVisualShape(body, -1, textureUniqueId=self._ball_texture(), physicsClientId=c)
         if part.name == "ball":
             sliding, spinning, rolling = (float(v) for v in BALL_FRICTION.split())
             pybullet.changeDynamics(body, -1, lateralFriction=sliding, spinningFriction=spinning, rollingFriction=rolling,
@@ -98,6 +107,15 @@ class PybulletPlatform(SimulatedRobotPlatform):
         elif part.kind == "plane":
             pybullet.changeDynamics(body, -1, lateralFriction=1.0, physicsClientId=c)
         return body
+
+    def _ball_texture(self) -> int:
+        """The SPL ball's pattern, through a temporary PNG (PyBullet loads textures only from files)."""
+        with tempfile.NamedTemporaryFile(suffix=".png", delete=False) as handle:
+            handle.write(cv2.imencode(".png", cv2.cvtColor(ball_texture(), cv2.COLOR_RGB2BGR))[1].tobytes())
+        try:
+            return pybullet.loadTexture(handle.name, physicsClientId=self.client)
+        finally:
+            os.unlink(handle.name)
 
     def _load_robot(self) -> None:
         c = self.client
@@ -188,6 +206,10 @@ class PybulletPlatform(SimulatedRobotPlatform):
         return forces
 
     def render(self, camera: str) -> np.ndarray:
+        rgba, _ = self._camera_image(camera, segmentation=False)
+        return np.asarray(rgba, dtype=np.uint8).reshape(self.height, self.width, 4)[:, :, :3].copy()
+
+    def _camera_image(self, camera: str, segmentation: bool) -> tuple[Any, Any]:
         mount = next(m for m in CAMERAS if m.name == camera)
         state = pybullet.getLinkState(self.robot, self.head_link, computeForwardKinematics=True, physicsClientId=self.client)
         head_position, head_rotation = np.array(state[4]), _matrix(state[5])
@@ -197,10 +219,24 @@ class PybulletPlatform(SimulatedRobotPlatform):
         axes = head_rotation @ tilt
         view = pybullet.computeViewMatrix(eye.tolist(), (eye + axes[:, 0]).tolist(), axes[:, 2].tolist())
         projection = pybullet.computeProjectionMatrixFOV(math.degrees(VERTICAL_FOV), self.width / self.height, 0.01, 30.0)
-        _, _, rgba, _, _ = pybullet.getCameraImage(self.width, self.height, view, projection, renderer=pybullet.ER_TINY_RENDERER,
-                                                   flags=pybullet.ER_NO_SEGMENTATION_MASK, shadow=0,
-                                                   lightDirection=[0.3, 0.2, 1.0], physicsClientId=self.client)
-        return np.asarray(rgba, dtype=np.uint8).reshape(self.height, self.width, 4)[:, :, :3].copy()
+        # lit from behind the camera and from above, like MuJoCo's headlight and sun: posts look alike
+        light = -axes[:, 0] + np.array([0.0, 0.0, 1.0])
+        flags = pybullet.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX if segmentation else pybullet.ER_NO_SEGMENTATION_MASK
+        _, _, rgba, _, segments = pybullet.getCameraImage(self.width, self.height, view, projection, renderer=pybullet.ER_TINY_RENDERER,
+                                                          flags=flags, shadow=0, lightDirection=light.tolist(),
+                                                          lightAmbientCoeff=0.55, lightDiffuseCoeff=0.5, lightSpecularCoeff=0.0,
+                                                          physicsClientId=self.client)
+        return rgba, segments
+
+    def pose_joints(self, angles: np.ndarray) -> None:
+        for joint, angle in zip(self.joint_ids, angles):
+            pybullet.resetJointState(self.robot, joint, float(angle), 0.0, physicsClientId=self.client)
+        for follower, leader in self.follower_ids:
+            pybullet.resetJointState(self.robot, follower, float(angles[leader]), 0.0, physicsClientId=self.client)
+
+    def ball_mask(self, camera: str) -> np.ndarray:
+        _, segments = self._camera_image(camera, segmentation=True)
+        return (np.asarray(segments).reshape(self.height, self.width) & ((1 << 24) - 1)) == self.bodies["ball"]
 
     def world_state(self) -> int:
         return pybullet.saveState(physicsClientId=self.client)

@@ -12,8 +12,10 @@ import math
 from dataclasses import dataclass
 from xml.sax.saxutils import quoteattr
 
+import cv2
 import numpy as np
 
+from tafel.platforms.field_world import ball_mesh, ball_texture, field_parts
 from tafel.representations import field
 from tafel.representations.nao import (
     ACCELEROMETER_POSITION,
@@ -202,69 +204,14 @@ def _body_xml(link: str, children: dict[str, list], indent: str) -> list[str]:
     return lines
 
 
-@dataclass(frozen=True)
-class FieldPart:
-    """One piece of the field world (m). ``kind``: plane, box (size = half extents, turned by ``yaw``),
-    cylinder (radius, half height), capsule (radius; from ``start`` to ``end``), or sphere (the ball)."""
-
-    name: str
-    kind: str
-    position: tuple[float, float, float]
-    size: tuple[float, ...]
-    rgba: tuple[float, float, float, float]
-    collides: bool = True
-    yaw: float = 0.0
-    end: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    mass: float = 0.0  # > 0: a free body (the ball)
-
-
-CARPET_RGBA = (0.18, 0.55, 0.2, 1.0)
-WHITE = (1.0, 1.0, 1.0, 1.0)
-BALL_RGBA = (1.0, 0.42, 0.0, 1.0)
-
-
-def field_parts(ball: tuple[float, float] = (1.0, 0.0)) -> list[FieldPart]:
-    """Carpet, lines (visual only), goals and the ball at ``ball`` (m), from ``representations.field``."""
-    half_x, half_y = field.LENGTH / 2 * M, field.WIDTH / 2 * M
-    carpet = (half_x + field.BORDER_STRIP * M, half_y + field.BORDER_STRIP * M, 0.1)
-    parts = [FieldPart("carpet", "plane", (0.0, 0.0, 0.0), carpet, CARPET_RGBA)]
-    w = field.LINE_WIDTH / 2 * M
-    segments: list[tuple[float, float, float, float]] = [
-        (-half_x, -half_y, half_x, -half_y), (-half_x, half_y, half_x, half_y),
-        (-half_x, -half_y, -half_x, half_y), (half_x, -half_y, half_x, half_y), (0.0, -half_y, 0.0, half_y),
-    ]
-    for sign in (-1.0, 1.0):
-        for depth, width in ((field.PENALTY_AREA_LENGTH, field.PENALTY_AREA_WIDTH), (field.GOAL_AREA_LENGTH, field.GOAL_AREA_WIDTH)):
-            x_inner, y = sign * (half_x - depth * M), width / 2 * M
-            segments += [(sign * half_x, -y, x_inner, -y), (sign * half_x, y, x_inner, y), (x_inner, -y, x_inner, y)]
-    radius = field.CENTER_CIRCLE_DIAMETER / 2 * M
-    steps = 32
-    for i in range(steps):
-        a, b = 2 * math.pi * i / steps, 2 * math.pi * (i + 1) / steps
-        segments.append((radius * math.cos(a), radius * math.sin(a), radius * math.cos(b), radius * math.sin(b)))
-    for i, (x1, y1, x2, y2) in enumerate(segments):
-        length = math.hypot(x2 - x1, y2 - y1)
-        parts.append(FieldPart(f"line{i}", "box", ((x1 + x2) / 2, (y1 + y2) / 2, 0.0005), (length / 2 + w, w, 0.0005),
-                               WHITE, collides=False, yaw=math.atan2(y2 - y1, x2 - x1)))
-    for sign, side in ((1.0, "opponent"), (-1.0, "own")):
-        x = sign * (half_x + field.GOAL_POST_DIAMETER / 2 * M)
-        y = (field.GOAL_INNER_WIDTH + field.GOAL_POST_DIAMETER) / 2 * M
-        r, h = field.GOAL_POST_DIAMETER / 2 * M, field.GOAL_HEIGHT * M
-        for post, py in (("left", y), ("right", -y)):
-            parts.append(FieldPart(f"goal_{side}_{post}", "cylinder", (x, py, h / 2), (r, h / 2), WHITE))
-        parts.append(FieldPart(f"goal_{side}_bar", "capsule", (x, -y, h), (r,), WHITE, collides=False, end=(x, y, h)))
-    ball_r = field.BALL_RADIUS * M
-    parts.append(FieldPart("ball", "sphere", (ball[0], ball[1], ball_r), (ball_r,), BALL_RGBA, mass=field.BALL_MASS))
-    return parts
-
-
-def _field_xml() -> list[str]:
+def _field_xml(ball_color: str) -> list[str]:
     lines = []
-    for part in field_parts():
+    for part in field_parts(ball_color=ball_color):
         rgba = _vec(part.rgba)
         groups = f'contype="{WORLD_GROUP}" conaffinity="{WORLD_GROUP | ROBOT_GROUP}"' if part.collides else 'contype="0" conaffinity="0"'
         if part.kind == "plane":
-            lines.append(f'<geom name="{part.name}" type="plane" size="{_vec(part.size)}" rgba="{rgba}" {groups} friction="1.0 0.02 0.002"/>')
+            lines.append(f'<geom name="{part.name}" type="plane" size="{_vec(part.size)}" pos="{_vec(part.position)}" rgba="{rgba}" '
+                         f'{groups} friction="1.0 0.02 0.002"/>')
         elif part.kind == "box":
             lines.append(f'<geom name="{part.name}" type="box" size="{_vec(part.size)}" pos="{_vec(part.position)}" '
                          f'euler="0 0 {part.yaw:.6g}" rgba="{rgba}" {groups}/>')
@@ -273,18 +220,47 @@ def _field_xml() -> list[str]:
         elif part.kind == "capsule":
             lines.append(f'<geom name="{part.name}" type="capsule" size="{_vec(part.size)}" fromto="{_vec(part.position)} {_vec(part.end)}" rgba="{rgba}" {groups}/>')
         elif part.kind == "sphere":
+            # with a texture the sphere only collides; a textured mesh of the same size shows the ball
+            shown = "0 0 0 0" if part.texture else rgba
             lines += [f'<body name="{part.name}" pos="{_vec(part.position)}">', f'  <freejoint name="{part.name}"/>',
-                      f'  <geom name="{part.name}" type="sphere" size="{_vec(part.size)}" mass="{part.mass}" rgba="{rgba}" '
-                      f'{groups} condim="6" friction="{BALL_FRICTION}"/>', "</body>"]
+                      f'  <geom name="{part.name}" type="sphere" size="{_vec(part.size)}" mass="{part.mass}" rgba="{shown}" '
+                      f'{groups} condim="6" friction="{BALL_FRICTION}"/>']
+            if part.texture:
+                lines.append(f'  <geom name="{part.name}_look" type="mesh" mesh="{part.name}" material="{part.name}" density="0" '
+                             'contype="0" conaffinity="0"/>')
+            lines.append("</body>")
     return lines
+
+
+def _ball_assets(ball_color: str) -> list[str]:
+    """The textured ball's mesh, texture and material (the texture's pixels come with ``mjcf_assets``)."""
+    if ball_color != "spl":
+        return []
+    vertices, normals, uvs, triangles = ball_mesh(field.BALL_RADIUS * M)
+    return [f'<mesh name="ball" vertex="{_vec(vertices.ravel())}" normal="{_vec(normals.ravel())}" '
+            f'texcoord="{_vec(uvs.ravel())}" face="{" ".join(map(str, triangles.ravel()))}"/>',
+            f'<texture name="ball" type="2d" file="{BALL_TEXTURE_FILE}"/>',
+            '<material name="ball" texture="ball" specular="0.1" shininess="0.1"/>']
+
+
+BALL_TEXTURE_FILE = "spl_ball.png"
+
+
+def mjcf_assets(ball_color: str = "spl") -> dict[str, bytes]:
+    """The files ``mjcf`` refers to, for ``MjModel.from_xml_string(xml, assets)``: made here, never read from disk."""
+    if ball_color != "spl":
+        return {}
+    ok, png = cv2.imencode(".png", cv2.cvtColor(ball_texture(), cv2.COLOR_RGB2BGR))
+    assert ok, "OpenCV could not encode the ball texture"
+    return {BALL_TEXTURE_FILE: png.tobytes()}
 
 
 #: sliding, torsional and rolling friction of the ball (MuJoCo's three coefficients)
 BALL_FRICTION = "0.6 0.01 0.002"
 
 
-def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002) -> str:
-    """MuJoCo XML of the robot on the field with the ball."""
+def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002, ball_color: str = "spl") -> str:
+    """MuJoCo XML of the robot on the field with the ball (``ball_color`` spl or orange; see ``mjcf_assets``)."""
     children: dict[str, list] = {}
     for joint in JOINTS:
         children.setdefault(joint.parent, []).append(joint)
@@ -313,9 +289,10 @@ def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002) ->
         '  <compiler angle="radian" autolimits="true"/>',
         f'  <visual><global offwidth="{width}" offheight="{height}"/><quality shadowsize="0"/>'
         '<headlight ambient="0.45 0.45 0.45" diffuse="0.5 0.5 0.5" specular="0 0 0"/></visual>',
+        "  <asset>", *("    " + a for a in _ball_assets(ball_color)), "  </asset>",
         "  <worldbody>",
         '    <light name="sun" pos="0 0 6" dir="0 0 -1" directional="true" diffuse="0.6 0.6 0.6" castshadow="false"/>',
-        *("    " + line for line in _field_xml()),
+        *("    " + line for line in _field_xml(ball_color)),
         *("    " + line for line in robot),
         "  </worldbody>",
         "  <equality>", *("    " + e for e in equalities), "  </equality>",

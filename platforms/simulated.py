@@ -20,6 +20,7 @@ import numpy as np
 from tafel.core.manager import Blackboard
 from tafel.core.platform import Platform, PlatformOptionError, seed_number
 from tafel.platforms.actuators import ActuatorGuard
+from tafel.platforms.field_world import BALL_COLORS
 from tafel.platforms.robot_model import STANDING_HEIGHT
 from tafel.representations import field
 from tafel.representations.infrastructure import FrameInfo
@@ -111,6 +112,9 @@ class SimulatedRobotPlatform(Platform):
         self.cameras = str(self.options.get("cameras", "on")).lower() not in ("off", "false", "0", "no")
         self.width, self.height = parse_resolution(self.options.get("resolution") or "320x240")
         self.initial_ball = parse_pair(self.options.get("ball") or DEFAULT_BALL, "--ball")
+        self.ball_color = str(self.options.get("ball_color") or "spl").lower()
+        if self.ball_color not in BALL_COLORS:
+            raise PlatformOptionError(f"--ball-color takes {' or '.join(BALL_COLORS)}, got {self.options.get('ball_color')!r}")
         self.initial_pose = parse_pose(self.options.get("start") or DEFAULT_START)
         self.viewer_requested = bool(self.options.get("viewer"))
         self.rng = np.random.default_rng(self.seed)
@@ -135,11 +139,17 @@ class SimulatedRobotPlatform(Platform):
         parser.add_argument("--cameras", choices=["on", "off"], default="on", help=f"{name}: render the cameras")
         parser.add_argument("--resolution", default="320x240", help=f"{name}: camera image size WIDTHxHEIGHT")
         parser.add_argument("--ball", default=DEFAULT_BALL, help=f"{name}: ball start X,Y in mm on the field (default: the centre spot)")
+        parser.add_argument("--ball-color", choices=BALL_COLORS, default="spl",
+                            help=f"{name}: spl (white with black patches, the default) or orange (the ball before 2016)")
         parser.add_argument("--start", default=DEFAULT_START, metavar="X,Y,ROT",
                             help=f"{name}: robot start pose, mm on the field and rad (default: {DEFAULT_START}, in its own half facing the opponent goal)")
         parser.add_argument("--viewer", action="store_true", help=f"{name}: open the {cls.engine} viewer (needs a display)")
         parser.add_argument("--camera-latency-ms", type=float, default=0.0, metavar="MS",
                             help=f"{name}: images are rendered at time t and delivered MS later, as on the NAO (30 to 40)")
+
+    def config_layers(self) -> list[str]:
+        """The engine's layer, then ``orange_ball`` with ``--ball-color orange`` (it picks the orange detector)."""
+        return [self.name, *(["orange_ball"] if self.ball_color == "orange" else [])]
 
     # ------------------------------------------------------------------ what an engine implements
     def build(self, contexts: frozenset[str], viewer: bool) -> None:
@@ -198,6 +208,15 @@ class SimulatedRobotPlatform(Platform):
 
     def place_robot(self, position_m: np.ndarray, quaternion_wxyz: np.ndarray) -> None:
         """Put the torso at ``position_m`` turned by ``quaternion_wxyz``, at rest."""
+        raise NotImplementedError
+
+    def pose_joints(self, angles: np.ndarray) -> None:
+        """Set the joints to ``angles`` (rad, ``JOINT_NAMES`` order) at once, at rest: for rendering posed
+        scenes (``tools.scene_frames``), not for moving the robot physically."""
+        raise NotImplementedError
+
+    def ball_mask(self, camera: str) -> np.ndarray:
+        """Which pixels of ``camera``'s image show the ball (height x width bool): ground truth for detectors."""
         raise NotImplementedError
 
     def apply_push(self, force_n: np.ndarray) -> None:

@@ -3,6 +3,8 @@ opponent goal, y left). Shared by modules and the simulated worlds."""
 
 from __future__ import annotations
 
+import math
+
 LENGTH = 9000.0
 WIDTH = 6000.0
 LINE_WIDTH = 50.0
@@ -19,3 +21,47 @@ GOAL_HEIGHT = 800.0
 GOAL_DEPTH = 500.0
 BALL_RADIUS = 50.0
 BALL_MASS = 0.044  # kg
+MARK_SIZE = 100.0  # the penalty marks and the centre mark are crosses this long and LINE_WIDTH wide
+
+
+def line_segments() -> list[tuple[float, float, float, float]]:
+    """The field's straight lines as (x1, y1, x2, y2) in mm, centre lines of the painted lines."""
+    half_x, half_y = LENGTH / 2, WIDTH / 2
+    segments = [(-half_x, -half_y, half_x, -half_y), (-half_x, half_y, half_x, half_y),
+                (-half_x, -half_y, -half_x, half_y), (half_x, -half_y, half_x, half_y), (0.0, -half_y, 0.0, half_y)]
+    for sign in (-1.0, 1.0):
+        for depth, width in ((PENALTY_AREA_LENGTH, PENALTY_AREA_WIDTH), (GOAL_AREA_LENGTH, GOAL_AREA_WIDTH)):
+            x_inner, y = sign * (half_x - depth), width / 2
+            segments += [(sign * half_x, -y, x_inner, -y), (sign * half_x, y, x_inner, y), (x_inner, -y, x_inner, y)]
+    return segments
+
+
+def mark_centres() -> list[tuple[float, float]]:
+    """The centre mark and both penalty marks (mm)."""
+    mark = LENGTH / 2 - PENALTY_MARK_DISTANCE
+    return [(0.0, 0.0), (-mark, 0.0), (mark, 0.0)]
+
+
+def goal_post_positions() -> list[tuple[float, float]]:
+    """The centres of the four goal posts (mm): opponent left, opponent right, own left, own right."""
+    x = LENGTH / 2 + GOAL_POST_DIAMETER / 2
+    y = (GOAL_INNER_WIDTH + GOAL_POST_DIAMETER) / 2
+    return [(x, y), (x, -y), (-x, y), (-x, -y)]
+
+
+def mark_segments() -> list[tuple[float, float, float, float]]:
+    """Both strokes of every mark's cross as (x1, y1, x2, y2) in mm."""
+    half = MARK_SIZE / 2
+    return [s for x, y in mark_centres() for s in ((x - half, y, x + half, y), (x, y - half, x, y + half))]
+
+
+def circle_segments(steps: int = 32) -> list[tuple[float, float, float, float]]:
+    """The centre circle as ``steps`` chords (mm)."""
+    radius = CENTER_CIRCLE_DIAMETER / 2
+    corners = [(radius * math.cos(2 * math.pi * i / steps), radius * math.sin(2 * math.pi * i / steps)) for i in range(steps + 1)]
+    return [(*a, *b) for a, b in zip(corners, corners[1:])]
+
+
+def all_markings() -> list[tuple[float, float, float, float]]:
+    """Everything painted on the field, as segments (mm): lines, the circle's chords and the marks."""
+    return line_segments() + circle_segments() + mark_segments()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from tafel.core import bounded, representation
 
 
@@ -28,3 +30,39 @@ class BallModel:
         if not self.valid:
             return "ball not seen"
         return f"ball {'seen' if self.seen else 'remembered'} at x={self.x:.0f} y={self.y:.0f} mm"
+
+    def field_position(self, pose: RobotPose) -> tuple[float, float]:
+        """The ball on the field (mm), through the robot's pose; only as good as that pose."""
+        return pose.to_field(self.x, self.y)
+
+
+@representation
+class RobotPose:
+    """Where the robot is on the field (field frame of the README): ``x``, ``y`` in mm, ``rotation`` in
+    rad (0: facing the opponent goal). ``valid`` once the localization trusts it; ``lost`` while it has
+    lost track and relocalizes (``valid`` is then false). ``deviation`` is the position's standard
+    deviation (mm), ``rotation_deviation`` the rotation's (rad)."""
+
+    valid: bool = False
+    lost: bool = False
+    x: float = bounded(-15000.0, 15000.0)
+    y: float = bounded(-15000.0, 15000.0)
+    rotation: float = bounded(-math.pi, math.pi)
+    deviation: float = bounded(0.0, 1e6, 1e6)
+    rotation_deviation: float = bounded(0.0, 10.0, math.pi)
+
+    def to_field(self, x: float, y: float) -> tuple[float, float]:
+        """A point in the robot frame (mm) on the field (mm)."""
+        c, s = math.cos(self.rotation), math.sin(self.rotation)
+        return self.x + c * x - s * y, self.y + s * x + c * y
+
+    def to_robot(self, x: float, y: float) -> tuple[float, float]:
+        """A point on the field (mm) in the robot frame (mm)."""
+        dx, dy = x - self.x, y - self.y
+        c, s = math.cos(self.rotation), math.sin(self.rotation)
+        return c * dx + s * dy, -s * dx + c * dy
+
+    def status_text(self) -> str:
+        if not self.valid:
+            return "pose lost" if self.lost else "pose unknown"
+        return f"pose x={self.x:.0f} y={self.y:.0f} mm {math.degrees(self.rotation):.0f} deg"

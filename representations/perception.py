@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 
 from tafel.core import array, bounded, representation
@@ -71,3 +72,103 @@ class BallImagePercept:
     """Ball candidates found in this frame's images, largest first (image positions only)."""
 
     candidates: list[BallCandidate]
+
+
+@representation
+class FieldColor:
+    """The field's green, estimated from the images each frame (OpenCV HSV: hue 0..180, saturation and
+    value 0..255), so that a change of light moves it rather than breaking every detector."""
+
+    valid: bool = False
+    hue: float = 60.0
+    hue_tolerance: float = 12.0
+    saturation_min: float = 60.0
+    value_min: float = 40.0
+
+    def mask(self, hsv: np.ndarray) -> np.ndarray:
+        """Which pixels of an HSV image (h x w x 3 uint8) are field green (h x w bool)."""
+        low, high = self.hue - self.hue_tolerance, self.hue + self.hue_tolerance
+        mask = cv2.inRange(hsv, (max(0.0, low), self.saturation_min, self.value_min), (min(179.0, high), 255, 255))
+        if low < 0 or high > 179:  # the range wraps round red
+            wrapped = (low + 180, 179.0) if low < 0 else (0.0, high - 180)
+            mask |= cv2.inRange(hsv, (wrapped[0], self.saturation_min, self.value_min), (wrapped[1], 255, 255))
+        return mask > 0
+
+
+@representation
+class SegmentedImage:
+    """Both images in HSV with their field-green masks, computed once per frame for every detector."""
+
+    top_hsv: np.ndarray = array((None, None, 3), np.uint8)
+    top_green: np.ndarray = array((None, None), np.bool_)
+    bottom_hsv: np.ndarray = array((None, None, 3), np.uint8)
+    bottom_green: np.ndarray = array((None, None), np.bool_)
+
+    def hsv(self, camera: str) -> np.ndarray:
+        return self.top_hsv if camera == "top" else self.bottom_hsv
+
+    def green(self, camera: str) -> np.ndarray:
+        return self.top_green if camera == "top" else self.bottom_green
+
+
+@representation
+class FieldBoundary:
+    """Where the field ends in each image: for every pixel column the row (px) of the field's upper
+    edge; the field is below it. A row of 0 means field up to the top, the image height no field."""
+
+    top: np.ndarray = array((None,), np.float32)
+    bottom: np.ndarray = array((None,), np.float32)
+
+    def rows(self, camera: str) -> np.ndarray:
+        return self.top if camera == "top" else self.bottom
+
+    def inside(self, camera: str, x: float, y: float) -> bool:
+        """Whether the pixel (x, y) lies on the field (below the boundary)."""
+        rows = self.rows(camera)
+        if rows.size == 0:
+            return False
+        return y >= float(rows[int(min(max(x, 0), rows.size - 1))])
+
+
+@dataclass
+class LineSegment:
+    """A field line seen on the ground, as its centre line from (x1, y1) to (x2, y2) (mm, robot frame)."""
+
+    x1: float = 0.0
+    y1: float = 0.0
+    x2: float = 0.0
+    y2: float = 0.0
+
+    @property
+    def length(self) -> float:
+        return float(np.hypot(self.x2 - self.x1, self.y2 - self.y1))
+
+
+@representation
+class LinePercept:
+    """Field lines seen in this frame (robot frame, mm): straight segments, and the centre circle's
+    centre if enough of it was seen. ``points`` are the line points found (N x 2, mm), what the
+    localization weighs."""
+
+    segments: list[LineSegment]
+    circle_seen: bool = False
+    circle_x: float = 0.0
+    circle_y: float = 0.0
+    points: np.ndarray = array((None, 2), np.float32)
+
+
+@dataclass
+class GoalPost:
+    """One goal post's foot on the ground (mm, robot frame), with the image column (px) it was found at."""
+
+    x: float = 0.0
+    y: float = 0.0
+    camera: str = ""
+    image_x: float = 0.0
+
+
+@representation
+class GoalPostPercept:
+    """Goal posts seen in this frame, nearest first."""
+
+    posts: list[GoalPost]

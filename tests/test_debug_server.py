@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import base64
+import dataclasses
 import json
 import os
 import random
@@ -21,6 +22,7 @@ import pytest
 from tafel.core.logfile import read_log
 from tafel.core.serialization import deserialize
 from tafel.debug.client import DebugClient
+from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler
 from tafel.representations.modeling import BallModel
 from tests.test_cli_runtime import REPO, tafel
 
@@ -194,7 +196,7 @@ def test_parameters_list_get_set_store(program: Program, config_dir: Path) -> No
         "error: parameter KalmanBallModeler.friction takes float, got 'fast'")
     assert program.ask("parameter:set -module KalmanBallModeler -name frcition -value 1").startswith(
         "error: KalmanBallModeler has no parameter 'frcition'; did you mean 'friction'")
-    assert program.ask("parameter:store -module KalmanBallModeler").startswith("stored 8 parameters of KalmanBallModeler")
+    assert program.ask("parameter:store -module KalmanBallModeler").startswith(f"stored {len(dataclasses.fields(KalmanBallModeler.Parameters))} parameters of KalmanBallModeler")
     assert "friction = 0.25" in (config_dir / "private" / "private.toml").read_text()
 
 

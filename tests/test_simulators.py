@@ -113,7 +113,7 @@ def _tracks(sim: Simulation) -> None:
 )
 @pytest.mark.slow
 def test_detector_finds_the_ball_in_rendered_images(engine: str, ball: tuple[float, float], camera: str) -> None:
-    sim = simulation(engine, ball=f"{ball[0]},{ball[1]}")
+    sim = simulation(engine, ball=f"{ball[0]},{ball[1]}", ball_color="orange")
     try:
         sim.run(1.5)  # stand up first, so the cameras are where the stand puts them
         sim.platform.move_ball(*ball)

@@ -303,7 +303,7 @@ def command_run(args: argparse.Namespace, extra: Sequence[str]) -> int:
         foxglove_address(args.foxglove)  # a wrong address fails before anything starts
     platform, options, plans, config = prepare(args, extra)
     report_pruned(plans)
-    recorder = make_recorder(args, plans, config, type(platform).name)
+    recorder = make_recorder(args, plans, config, platform)
     limits = Limits(frames=args.frames, seconds=args.seconds, speed=args.speed)
     if args.concurrent or type(platform).clock == "own":
         return run_concurrent(args, platform, options, plans, config, recorder, limits)
@@ -558,7 +558,7 @@ def status_print(text: str) -> None:
         pass
 
 
-def make_recorder(args: argparse.Namespace, plans: dict[str, ContextPlan], config: dict[str, Any], platform: str) -> Recorder | None:
+def make_recorder(args: argparse.Namespace, plans: dict[str, ContextPlan], config: dict[str, Any], platform: Platform) -> Recorder | None:
     """The recorder of this run, started with --record; ready for log:start when the debug server runs."""
     if args.record is None and args.no_debug:
         if args.record_reps:
@@ -570,7 +570,9 @@ def make_recorder(args: argparse.Namespace, plans: dict[str, ContextPlan], confi
     )
     selections = select(plans, names, extra=DEBUG_REPRESENTATIONS,
                         strict=bool(args.record_reps))
-    metadata = {"platform": platform, **{f"{c}_hz": str(p.rate_hz) for c, p in plans.items()}}
+    # the layers, so that a replay runs the program that was recorded (an orange ball's detector, say)
+    metadata = {"platform": type(platform).name, "config_layers": ",".join(platform.config_layers()),
+                **{f"{c}_hz": str(p.rate_hz) for c, p in plans.items()}}
     recorder = Recorder(selections, metadata)
     foxglove = config.get("foxglove", {})
     if foxglove.get("channels_in_recordings", True):

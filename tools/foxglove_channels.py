@@ -7,8 +7,8 @@ The same topics in recordings and live (metres and seconds, as Foxglove wants th
 | ``/camera/top``, ``/camera/bottom`` | ``foxglove.CompressedImage`` (JPEG) | ``CameraImageTop/Bottom`` |
 | ``/camera/top/calibration``, ... | ``foxglove.CameraCalibration`` | the image size and field of view |
 | ``/camera/top/annotations``, ... | ``foxglove.ImageAnnotations`` | ``DebugDrawings`` on ``image:top/bottom``, at the image's time |
-| ``/scene`` | ``foxglove.SceneUpdate`` | the field (once), robot, ``BallModel``, ``BallPercept``, ``field`` drawings |
-| ``/tf`` | ``foxglove.FrameTransforms`` | field -> robot (``Odometry``), robot -> torso (``TorsoPose``), torso -> cameras |
+| ``/scene`` | ``foxglove.SceneUpdate`` | the field (once), robot, ``BallModel``, ``BallPercept``, ``field`` and ``robot`` drawings |
+| ``/tf`` | ``foxglove.FrameTransforms`` | field -> robot (``RobotPose`` while valid, else ``Odometry``), robot -> torso (``TorsoPose``), torso -> cameras |
 | ``/joints``, ``/imu``, ``/fsr``, ``/timing``, ``/rates`` | JSON by name, for the Plot panel | joints, IMU, foot pressure, ``ModuleTimes``, frame times |
 | ``/log`` | ``foxglove.Log`` | the program's log lines |
 
@@ -38,7 +38,7 @@ from tafel.core.serialization import deserialize
 from tafel.debug.concepts import DebugDrawings, ModuleTimes
 from tafel.representations import field
 from tafel.representations.infrastructure import FrameInfo
-from tafel.representations.modeling import BallModel
+from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion import (
     JOINT_NAMES,
     CameraMatrixBottom,
@@ -70,7 +70,7 @@ NEEDS: dict[str, tuple[type, ...]] = {
     "/rates": (FrameInfo,), "/log": (),
 }
 #: every representation some topic is made of; the others are not even decoded
-USED = frozenset(rep for reps in NEEDS.values() for rep in reps) | frozenset(CAMERA_MATRICES)
+USED = frozenset(rep for reps in NEEDS.values() for rep in reps) | frozenset(CAMERA_MATRICES) | {RobotPose}
 COLORS = {"black": (0, 0, 0), "white": (1, 1, 1), "red": (1, 0, 0), "green": (0, 0.6, 0), "blue": (0, 0, 1), "yellow": (1, 1, 0),
           "orange": (1, 0.55, 0), "gray": (0.5, 0.5, 0.5), "grey": (0.5, 0.5, 0.5), "cyan": (0, 1, 1), "magenta": (1, 0, 1),
           "purple": (0.5, 0, 0.5), "pink": (1, 0.75, 0.8), "brown": (0.6, 0.3, 0.1)}
@@ -141,27 +141,9 @@ def pose(x: float = 0.0, y: float = 0.0, z: float = 0.0, orientation: fm.Quatern
 OPTICAL = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
 
 
-def field_lines() -> list[tuple[float, float, float, float]]:
-    """The SPL field's lines as segments (mm, field frame)."""
-    half_x, half_y = field.LENGTH / 2, field.WIDTH / 2
-    lines = [(-half_x, -half_y, half_x, -half_y), (half_x, -half_y, half_x, half_y), (half_x, half_y, -half_x, half_y),
-             (-half_x, half_y, -half_x, -half_y), (0, -half_y, 0, half_y)]
-    for side in (-1, 1):
-        for length, width in ((field.PENALTY_AREA_LENGTH, field.PENALTY_AREA_WIDTH), (field.GOAL_AREA_LENGTH, field.GOAL_AREA_WIDTH)):
-            inner = side * (half_x - length)
-            lines += [(side * half_x, width / 2, inner, width / 2), (inner, width / 2, inner, -width / 2),
-                      (inner, -width / 2, side * half_x, -width / 2)]
-        mark = side * (half_x - field.PENALTY_MARK_DISTANCE)
-        lines += [(mark - 50, 0, mark + 50, 0), (mark, -50, mark, 50)]
-    radius = field.CENTER_CIRCLE_DIAMETER / 2
-    corners = [(radius * math.cos(a), radius * math.sin(a)) for a in np.linspace(0, math.tau, 49)]
-    lines += [(*a, *b) for a, b in zip(corners, corners[1:])]
-    return lines
-
-
 def field_entity(now: fm.Timestamp) -> fm.SceneEntity:
     """The carpet, the lines and both goals (white posts and crossbar)."""
-    points = [fm.Point3(x=v[0] * M, y=v[1] * M, z=0.001) for line in field_lines() for v in (line[:2], line[2:])]
+    points = [fm.Point3(x=v[0] * M, y=v[1] * M, z=0.001) for line in field.all_markings() for v in (line[:2], line[2:])]
     carpet = fm.CubePrimitive(pose=pose(z=-0.005), size=fm.Vector3(x=(field.LENGTH + 2 * field.BORDER_STRIP) * M,
                                                                        y=(field.WIDTH + 2 * field.BORDER_STRIP) * M, z=0.01),
                               color=fm.Color(r=0.1, g=0.5, b=0.15, a=1.0))
@@ -203,8 +185,9 @@ def ball_entity(now: fm.Timestamp, entity_id: str, positions: Iterable[tuple[flo
                                                       color=rgba) for x, y in positions])
 
 
-def field_drawings_entity(now: fm.Timestamp, context: str, primitives: Iterable[Any]) -> fm.SceneEntity:
-    """The ``field`` canvas: lines, rectangles, circles, robot poses as lines; texts as text (field frame, mm)."""
+def drawings_entity(now: fm.Timestamp, context: str, canvas: str, primitives: Iterable[Any]) -> fm.SceneEntity:
+    """The ``field`` canvas (field frame, mm) or the ``robot`` canvas (robot frame, mm): lines, rectangles,
+    circles, robot poses as lines; texts as text."""
     lines, texts = [], []
     for p in primitives:
         points = _outline(p.kind, p.points)
@@ -215,7 +198,8 @@ def field_drawings_entity(now: fm.Timestamp, context: str, primitives: Iterable[
         elif p.kind == "text" and len(p.points) >= 2:
             texts.append(fm.TextPrimitive(pose=pose(p.points[0] * M, p.points[1] * M, 0.05), billboard=True, font_size=p.width or 12.0,
                                           scale_invariant=True, color=color(p.color), text=p.text))
-    return fm.SceneEntity(timestamp=now, frame_id="field", id=f"drawings/{context}", frame_locked=True, lines=lines, texts=texts)
+    suffix = "" if canvas == "field" else f"/{canvas}"
+    return fm.SceneEntity(timestamp=now, frame_id=canvas, id=f"drawings/{context}{suffix}", frame_locked=True, lines=lines, texts=texts)
 
 
 def _outline(kind: str, points: list[float]) -> list[tuple[float, float]]:
@@ -280,6 +264,7 @@ class FoxgloveTranslator:
         self.cameras: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self.frame_times: dict[str, deque[int]] = {}
         self.joints: dict[str, dict[str, float]] = {}
+        self.pose: Any = None  # the last valid RobotPose
 
     def resend_field(self) -> None:
         """Send the field again with the next scene (a client subscribed to the scene anew)."""
@@ -327,6 +312,8 @@ class FoxgloveTranslator:
             self.cameras[CAMERA_MATRICES[kind]] = (np.asarray(value.rotation, float), np.asarray(value.translation, float))
         elif kind is TorsoPose:
             self.torso = (np.asarray(value.rotation, float), np.asarray(value.translation, float))
+        elif kind is RobotPose:
+            self.pose = value if value.valid else None
         elif kind is Odometry and self.wanted("/tf"):
             yield Outgoing("/tf", self._transforms(value, stamp), time_ns, wall)
         elif kind is BallModel and self.wanted("/scene"):
@@ -377,8 +364,8 @@ class FoxgloveTranslator:
                 image_stamp = self._stamp(self.images[camera][0])  # the image's timestamp: the panel pairs them
                 yield Outgoing(topic, image_annotations(image_stamp, by_canvas.get(f"image:{camera}", [])), time_ns, wall)
         if self.wanted("/scene"):  # every frame, also when empty: yesterday's drawings disappear
-            yield Outgoing("/scene", fm.SceneUpdate(entities=[field_drawings_entity(stamp, context, by_canvas.get("field", []))]),
-                           time_ns, wall)
+            entities = [drawings_entity(stamp, context, canvas, by_canvas.get(canvas, [])) for canvas in ("field", "robot")]
+            yield Outgoing("/scene", fm.SceneUpdate(entities=entities), time_ns, wall)
 
     def _scene(self, ball: Any, stamp: fm.Timestamp) -> fm.SceneUpdate:
         entities = robot_entity(stamp)
@@ -390,9 +377,10 @@ class FoxgloveTranslator:
 
     def _transforms(self, odometry: Any, stamp: fm.Timestamp) -> fm.FrameTransforms:
         rotation, translation = self.torso
+        where = self.pose or odometry  # the localization's pose while it is valid, else odometry from the start
         transforms = [
             fm.FrameTransform(timestamp=stamp, parent_frame_id="field", child_frame_id="robot",
-                              translation=fm.Vector3(x=odometry.x * M, y=odometry.y * M, z=0.0), rotation=yaw_quaternion(odometry.rotation)),
+                              translation=fm.Vector3(x=where.x * M, y=where.y * M, z=0.0), rotation=yaw_quaternion(where.rotation)),
             fm.FrameTransform(timestamp=stamp, parent_frame_id="robot", child_frame_id="torso",
                               translation=fm.Vector3(x=translation[0] * M, y=translation[1] * M, z=translation[2] * M),
                               rotation=quaternion(rotation)),

@@ -1,24 +1,27 @@
-"""Striker: find the ball, walk behind it, kick it the way the robot faced at the start, follow it, repeat."""
+"""Striker: find the ball, walk behind it, kick it towards the opponent goal, follow it, repeat."""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 
-from tafel.core import Module, bounded, provides, requires
+from tafel.core import Module, bounded, provides, requires, uses
 from tafel.debug import drawing, request
+from tafel.representations import field
 from tafel.representations.infrastructure import FrameInfo
-from tafel.representations.modeling import BallModel
+from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import Foot, MotionInfo, MotionRequest, MotionType, Odometry
 
-DRAW = request("Striker:draw_target", "where the striker wants to stand, on the field canvas (robot frame)")
+DRAW = request("Striker:draw_target", "where the striker wants to stand, on the robot canvas")
 
 
 @requires(BallModel, Odometry, MotionInfo, FrameInfo)
+@uses(RobotPose)
 @provides(MotionRequest)
 class Striker(Module):
-    """Without localization the kick direction is the robot's heading at the start (by odometry): in
-    the default scene, the opponent goal.
+    """The kick goes from the ball to the opponent goal's centre, through ``RobotPose``, from anywhere
+    on the field. While the pose is not valid (before the first fix, or lost) it goes the way the robot
+    faced at the start, by odometry: in the default scene, the opponent goal as well.
 
     - No ball: turn on the spot (the head searches meanwhile).
     - Ball: walk to the point ``behind`` mm behind it on the line of the kick, the kicking foot in line
@@ -49,7 +52,7 @@ class Striker(Module):
             out.motion, out.walk_x, out.walk_y = MotionType.walk, 0.0, 0.0
             out.walk_rotation = p.search_turn
             return
-        kick_direction = math.remainder(-self.odometry.rotation, math.tau)  # the start heading, in the robot frame
+        kick_direction = self.kick_direction(ball.x, ball.y)
         foot = Foot.left if ball.y >= 0 else Foot.right
         side = p.foot_offset if foot is Foot.left else -p.foot_offset
         c, s = math.cos(kick_direction), math.sin(kick_direction)
@@ -57,7 +60,7 @@ class Striker(Module):
         target_x = ball.x - c * p.behind + s * side
         target_y = ball.y - s * p.behind - c * side
         if DRAW:
-            drawing("field").robot_pose(target_x, target_y, kick_direction, color="orange")
+            drawing("robot").robot_pose(target_x, target_y, kick_direction, color="orange")
         # the ball as the kicking foot sees it, in the kick's frame
         along = c * ball.x + s * ball.y
         across = -s * ball.x + c * ball.y - side
@@ -66,3 +69,11 @@ class Striker(Module):
             return
         out.motion = MotionType.walk_to
         out.target_x, out.target_y, out.target_rotation = target_x, target_y, kick_direction
+
+    def kick_direction(self, ball_x: float, ball_y: float) -> float:
+        """rad in the robot frame: from the ball to the goal's centre, or the start heading without a pose."""
+        pose = self.robot_pose
+        if not pose.valid:
+            return math.remainder(-self.odometry.rotation, math.tau)
+        goal_x, goal_y = pose.to_robot(field.LENGTH / 2 + field.GOAL_DEPTH / 2, 0.0)
+        return math.atan2(goal_y - ball_y, goal_x - ball_x)

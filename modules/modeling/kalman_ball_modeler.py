@@ -5,9 +5,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from tafel.core import Module, provides, requires
+from tafel.core import Module, provides, requires, uses
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel
+from tafel.representations.motion_control import Odometry
 from tafel.representations.perception import BallPercept
 
 
@@ -32,6 +33,10 @@ class AxisFilter:
         self.pv = decay * (pv + dt * vv) + q * dt**3 / 2
         self.vv = decay * decay * vv + q * dt * dt
 
+    def moved(self, p: float, v: float, pp: float, vv: float) -> None:
+        """Take a new position and velocity (and their variances) after the frame turned under them."""
+        self.p, self.v, self.pp, self.vv = p, v, pp, vv
+
     def innovation(self, measured: float, r: float) -> tuple[float, float]:
         """(measured - predicted position, its variance)."""
         return measured - self.p, self.pp + r
@@ -47,13 +52,17 @@ class AxisFilter:
 
 
 @requires(BallPercept, FrameInfo)
+@uses(Odometry)
 @provides(BallModel)
 class KalmanBallModeler(Module):
-    """A constant-velocity Kalman filter with rolling friction over the state (x, y, vx, vy).
+    """A constant-velocity Kalman filter with rolling friction over the state (x, y, vx, vy), in the
+    robot frame.
 
-    Measurement noise grows with distance, because the ground position of a far ball is less certain.
-    A percept far outside the predicted uncertainty (the ball was moved, or the model was wrong)
-    restarts the filter at the percept instead of dragging the estimate across the field.
+    - The robot's own motion (``Odometry`` since the last frame) moves the ball the other way, so the
+      model stays right while the robot walks and turns without seeing it.
+    - Measurement noise grows with distance, because the ground position of a far ball is less certain.
+    - A percept far outside the predicted uncertainty is an outlier and ignored; only several in a row
+      that agree with each other (the ball was really moved) restart the filter there.
     """
 
     @dataclass
@@ -69,7 +78,11 @@ class KalmanBallModeler(Module):
         initial_velocity_std: float = 500.0
         """mm/s, uncertainty of the velocity when the ball is first seen"""
         restart_gate: float = 40.0
-        """squared Mahalanobis distance above which a percept restarts the filter"""
+        """squared Mahalanobis distance above which a percept is an outlier"""
+        restart_after: int = 3
+        """outliers in a row, each within ``outlier_agreement`` of the last, that restart the filter"""
+        outlier_agreement: float = 400.0
+        """mm"""
         forget_after: float = 3.0
         """s without a percept after which the model is no longer valid"""
         nominal_dt: float = 1.0 / 30.0
@@ -79,6 +92,8 @@ class KalmanBallModeler(Module):
         self.axes: tuple[AxisFilter, AxisFilter] | None = None
         self.last_time_ns: int | None = None
         self.last_seen_ns: int | None = None
+        self.last_odometry: tuple[float, float, float] | None = None
+        self.outliers: list[tuple[float, float]] = []  # recent outliers in a row, in this frame's coordinates
 
     def execute(self) -> None:
         now_ns = self.frame_info.time_ns
@@ -87,6 +102,7 @@ class KalmanBallModeler(Module):
             dt = (now_ns - self.last_time_ns) * 1e-9
         self.last_time_ns = now_ns
         p = self.parameters
+        self.follow_robot()
         if self.axes is not None:
             decay, q = math.exp(-p.friction * dt), p.acceleration_noise**2
             for axis in self.axes:
@@ -97,6 +113,28 @@ class KalmanBallModeler(Module):
             self.last_seen_ns = now_ns
         self.publish(now_ns, percept.seen)
 
+    def follow_robot(self) -> None:
+        """Move the model by the inverse of the robot's motion since the last frame."""
+        odometry = self.odometry
+        now = (odometry.x, odometry.y, odometry.rotation)
+        previous, self.last_odometry = self.last_odometry, now
+        if previous is None or self.axes is None:
+            return
+        c, s = math.cos(previous[2]), math.sin(previous[2])
+        dx, dy = now[0] - previous[0], now[1] - previous[1]
+        forward, left = c * dx + s * dy, -s * dx + c * dy
+        turn = math.remainder(now[2] - previous[2], math.tau)
+        c, s = math.cos(turn), math.sin(turn)
+        ax, ay = self.axes
+        x, y = ax.p - forward, ay.p - left
+        # the axes turn by -turn; their variances mix (the filter keeps no x-y covariance: per frame the
+        # turn is small and the two variances nearly equal, so little is lost)
+        new_x = (c * x + s * y, c * ax.v + s * ay.v, c * c * ax.pp + s * s * ay.pp, c * c * ax.vv + s * s * ay.vv)
+        new_y = (-s * x + c * y, -s * ax.v + c * ay.v, s * s * ax.pp + c * c * ay.pp, s * s * ax.vv + c * c * ay.vv)
+        ax.moved(*new_x)
+        ay.moved(*new_y)
+        self.outliers = [(c * ox + s * oy - forward, -s * ox + c * oy - left) for ox, oy in self.outliers]
+
     def update(self, x: float, y: float) -> None:
         p = self.parameters
         std = p.measurement_std + p.measurement_std_per_m * math.hypot(x, y) / 1000.0
@@ -105,9 +143,16 @@ class KalmanBallModeler(Module):
             innovations = [axis.innovation(measured, r) for axis, measured in zip(self.axes, (x, y))]
             distance = sum(residual * residual / s for residual, s in innovations)
             if distance <= p.restart_gate:
+                self.outliers = []
                 for axis, (residual, s) in zip(self.axes, innovations):
                     axis.update(residual, s)
                 return
+            if self.outliers and math.dist(self.outliers[-1], (x, y)) > p.outlier_agreement:
+                self.outliers = []
+            self.outliers.append((x, y))
+            if len(self.outliers) < p.restart_after:
+                return  # a single wrong percept (a false detection, a wrong camera matrix) changes nothing
+        self.outliers = []
         v = p.initial_velocity_std**2
         self.axes = (AxisFilter(x, 0.0, r, 0.0, v), AxisFilter(y, 0.0, r, 0.0, v))
 

@@ -24,7 +24,7 @@ from tafel.representations.motion import JOINT_COUNT, JOINT_INDEX, FsrData, Iner
 from tafel.representations.motion_control import Foot, MotionRequest, MotionSelection, MotionType, Odometry, WalkingEngineOutput
 from tafel.representations.nao import HIP_OFFSET_Z
 
-DRAW_STEPS = request("WalkingEngine:draw_steps", "planned footsteps and the walk target on the field canvas")
+DRAW_STEPS = request("WalkingEngine:draw_steps", "planned footsteps and the walk target on the robot canvas")
 WALKING = (MotionType.walk, MotionType.walk_to)
 ARMS = [JOINT_INDEX[n] for n in ("LShoulderPitch", "RShoulderPitch")]
 STAND = stand_pose()  # arms and head while walking; apply_leg_angles copies it
@@ -164,7 +164,7 @@ class WalkingEngine(Module):
         x, y = c * dx - s * dy, s * dx + c * dy
         turn = math.remainder(self.target[2] - odometry.rotation, math.tau)
         if DRAW_STEPS:
-            drawing("field").robot_pose(float(self.target[0]), float(self.target[1]), float(self.target[2]), color="yellow")
+            drawing("robot").robot_pose(float(self.target[0]), float(self.target[1]), float(self.target[2]), color="yellow")
         if math.hypot(x, y) < p.target_tolerance and abs(turn) < p.target_tolerance / 400:
             return np.zeros(3), True
         far = math.hypot(x, y) > 400.0  # far away: face the target first, then turn to its rotation
@@ -193,7 +193,7 @@ class WalkingEngine(Module):
         self.step = wanted
         if DRAW_STEPS:
             goal = self.goal(swing)
-            drawing("field").rectangle(float(goal[0]) - 50, float(goal[1]) - 25 + side * 50, float(goal[0]) + 100,
+            drawing("robot").rectangle(float(goal[0]) - 50, float(goal[1]) - 25 + side * 50, float(goal[0]) + 100,
                                        float(goal[1]) + 25 + side * 50, color="white")
 
     def goal(self, foot: Foot) -> np.ndarray:

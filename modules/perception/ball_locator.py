@@ -14,27 +14,12 @@ import numpy as np
 
 from tafel.core import Module, provides, requires
 from tafel.debug import drawing, plot, request
+from tafel.modules.perception.image_geometry import focal_lengths, ground_point, pixel_ray
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import CameraMatrix, CameraMatrixBuffer
 from tafel.representations.perception import BallCandidate, BallImagePercept, BallPercept
 
-DRAW_PERCEPT = request("BallLocator:draw_percept", "the located ball in its image and on the field")
-
-
-def pixel_ray(x: float, y: float, width: int, height: int, horizontal_fov: float, vertical_fov: float) -> np.ndarray:
-    """The direction of a pixel in the camera frame (x along the optical axis, y left, z up)."""
-    fx = (width / 2) / math.tan(horizontal_fov / 2)
-    fy = (height / 2) / math.tan(vertical_fov / 2)
-    return np.array([1.0, -(x - width / 2) / fx, -(y - height / 2) / fy])
-
-
-def ground_point(ray_camera: np.ndarray, rotation: np.ndarray, translation: np.ndarray, height: float) -> np.ndarray | None:
-    """Where a camera ray meets the plane ``z = height`` in the robot frame (mm), None above the horizon."""
-    direction = np.asarray(rotation) @ ray_camera
-    if direction[2] >= -1e-6:
-        return None
-    scale = (height - translation[2]) / direction[2]
-    return np.asarray(translation) + scale * direction
+DRAW_PERCEPT = request("BallLocator:draw_percept", "the located ball in its image and on the robot canvas")
 
 
 @requires(BallImagePercept, CameraMatrixBuffer)
@@ -66,7 +51,7 @@ class BallLocator(Module):
             plot("BallLocator:distance", math.hypot(percept.x, percept.y))
             if DRAW_PERCEPT:
                 drawing(f"image:{candidate.camera}").circle(candidate.x, candidate.y, candidate.radius, color="blue", width=2)
-                drawing("field").circle(percept.x, percept.y, BALL_RADIUS, color="orange")
+                drawing("robot").circle(percept.x, percept.y, BALL_RADIUS, color="orange")
             return
 
     def locate(self, candidate: BallCandidate, matrix: CameraMatrix) -> np.ndarray | None:
@@ -79,7 +64,7 @@ class BallLocator(Module):
         if position is None:
             return None
         distance = float(np.linalg.norm(position - np.asarray(matrix.translation)))
-        focal = (candidate.image_width / 2) / math.tan(candidate.horizontal_fov / 2)
+        focal, _ = focal_lengths(candidate.image_width, candidate.image_height, candidate.horizontal_fov, candidate.vertical_fov)
         expected = focal * BALL_RADIUS / distance
         if abs(candidate.radius - expected) > self.parameters.size_tolerance * expected + 1.0:
             return None

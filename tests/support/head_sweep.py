@@ -5,6 +5,7 @@ Shared by the camera-latency test and ``benchmarks/camera_latency.py``.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 
@@ -15,7 +16,7 @@ from tafel.representations.behavior import HeadMotionRequest
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import HEAD_YAW, JointSensorData
 from tafel.representations.perception import BallPercept
-from tests.support.simulation import Simulation
+from tests.support.simulation import PERCEPTION, Simulation
 
 BALL = (1200.0, 0.0)  # mm on the field; the robot stands at the centre facing +x
 
@@ -42,10 +43,10 @@ class HeadSweep(Module):
 
 def sweep_errors(engine: str, latency_ms: float, aligned: bool, seconds: float = 6.0, speed: float = 2.5, seed: int = 0) -> list[float]:
     """Relative errors (share of the true distance) of every ball percept while the head turns fast."""
-    modules = '["BallDetector", "BallLocator", "KalmanBallModeler", "SimpleBallModeler", "tests.support.head_sweep:HeadSweep", "tests.support.motion_requests:ConstantMotionRequest"]'
+    modules = json.dumps([*PERCEPTION, "tests.support.head_sweep:HeadSweep", "tests.support.motion_requests:ConstantMotionRequest"])
     sim = Simulation(engine, overrides=[f"cognition.modules={modules}", f"parameters.HeadSweep.speed={speed}",
                                         f"parameters.BallLocator.time_aligned={'true' if aligned else 'false'}"],
-                     ball=f"{BALL[0]},{BALL[1]}", camera_latency_ms=latency_ms, seed=seed)
+                     ball=f"{BALL[0]},{BALL[1]}", camera_latency_ms=latency_ms, seed=seed, ball_color="orange")
     errors: list[float] = []
     last_frame = [0]
     try:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable
 from typing import Any
 
@@ -12,8 +13,9 @@ from tafel.core.runtime import LockstepRuntime
 from tafel.tools.cli import DEFAULT_CONFIG, discover_modules
 
 #: the behaviour replaced by a robot that stands still: for tests of perception and head motion
-STANDING = ["cognition.modules=[\"BallDetector\", \"BallLocator\", \"KalmanBallModeler\", \"SimpleBallModeler\", "
-            "\"LookAtBallBehavior\", \"tests.support.motion_requests:ConstantMotionRequest\"]"]
+PERCEPTION = ["FieldColorProvider", "FieldBoundaryDetector", "SPLBallDetector", "BallDetector", "BallLocator", "LineDetector",
+              "GoalPostDetector", "SelfLocator", "KalmanBallModeler", "SimpleBallModeler"]
+STANDING = ["cognition.modules=" + json.dumps([*PERCEPTION, "LookAtBallBehavior", "tests.support.motion_requests:ConstantMotionRequest"])]
 
 
 class Simulation:
@@ -30,7 +32,7 @@ class Simulation:
             options = {"start": "0,0,0", "ball": "1000,300", **options}
             overrides = [*STANDING, *(overrides or [])]
         self.platform = load_platform(platform)(options)
-        self.plans = plan_program(load_config(DEFAULT_CONFIG, platform, overrides=overrides or []), self.platform)
+        self.plans = plan_program(load_config(DEFAULT_CONFIG, self.platform.config_layers(), overrides=overrides or []), self.platform)
         self.runtime = LockstepRuntime(self.plans, self.platform)
         self.runtime.open()
 

@@ -1,0 +1,236 @@
+"""SelfLocator: where the robot is on the field, by a particle filter over (x, y, rotation)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tafel.core import Module, bounded, provides, requires, uses
+from tafel.debug import drawing, plot, request
+from tafel.modules.modeling.field_model import FIELD_MODEL, OWN_HALF, mirror
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.modeling import RobotPose
+from tafel.representations.motion_control import FallState, Odometry
+from tafel.representations.perception import GoalPostPercept, LinePercept
+
+DRAW_PARTICLES = request("SelfLocator:draw_particles", "every particle and the estimate on the field canvas")
+
+
+@requires(Odometry, LinePercept, GoalPostPercept, FrameInfo)
+@uses(FallState)
+@provides(RobotPose)
+class SelfLocator(Module):
+    """Monte Carlo localization.
+
+    - Motion: each particle moves by the odometry since the last frame, with noise that grows with
+      the motion (and much more rotation noise after a fall).
+    - Sensing: line points are weighed by their distance to the nearest painted line (a precomputed
+      distance map), goal posts by their distance to the nearest post, the centre circle's centre by
+      its distance to the centre spot. Noise grows with the distance of what was seen.
+    - The field looks the same turned by 180 degrees. Particles start in the own half (the robot
+      enters the field there), and every particle made anew is put on the side nearer to the last
+      estimate: continuity decides.
+    - Lost: when the measurements keep fitting much worse than they used to (the robot was carried
+      or slipped), part of the particles are made anew from what is seen (sensor resetting): around
+      a seen post at its measured distance, or on the centre circle's position. ``RobotPose.lost`` says so.
+    """
+
+    @dataclass
+    class Parameters:
+        particles: int = bounded(20, 5000, 400)
+        translation_noise: float = bounded(0.0, 1.0, 0.15)
+        """share of the odometry's translation"""
+        rotation_noise: float = bounded(0.0, 1.0, 0.15)
+        """share of the odometry's rotation, plus a little per mm walked"""
+        fallen_rotation_noise: float = bounded(0.0, 3.0, 0.6)
+        """rad of rotation noise added when the robot has fallen"""
+        point_std: float = bounded(10.0, 1000.0, 80.0)
+        """mm: noise of a line point at the robot ..."""
+        point_std_per_m: float = bounded(0.0, 500.0, 50.0)
+        """... plus this per metre of distance"""
+        max_points: int = bounded(5, 500, 40)
+        point_weight: float = bounded(0.01, 1.0, 0.12)
+        """line points are not independent: each counts this much of a full measurement"""
+        post_std: float = bounded(10.0, 2000.0, 150.0)
+        post_std_per_m: float = bounded(0.0, 500.0, 60.0)
+        circle_std: float = bounded(10.0, 2000.0, 200.0)
+        alpha_slow: float = bounded(0.0, 1.0, 0.02)
+        alpha_fast: float = bounded(0.0, 1.0, 0.25)
+        """averaging rates of the measurement fit: a fast average far below the slow one means lost"""
+        lost_ratio: float = bounded(0.0, 1.0, 0.45)
+        reset_share: float = bounded(0.0, 1.0, 0.25)
+        """share of the particles made anew per frame while lost"""
+        search_share: float = bounded(0.0, 1.0, 0.05)
+        """share made anew per frame before the first fix"""
+        valid_deviation: float = bounded(10.0, 5000.0, 350.0)
+        """mm: the pose is valid while the particles around the estimate are this close together ..."""
+        valid_share: float = bounded(0.1, 1.0, 0.7)
+        """... and hold this share of all particles ..."""
+        confirm_after: float = bounded(0.0, 10.0, 1.0)
+        """... for this many seconds, in which the circle, a post, or lines both along and across the
+        field were seen (one straight line fits many places on the field)"""
+        roughening: float = bounded(0.0, 200.0, 15.0)
+        """mm of noise added to resampled particles (and a hundredth of it in rad), against collapse"""
+
+    def __init__(self) -> None:
+        self.rng = np.random.default_rng(0)  # fixed: replaying a log localizes the same way
+        self.particles = np.zeros((0, 3))
+        self.last_odometry: tuple[float, float, float] | None = None
+        self.slow = self.fast = 0.0
+        self.trusted: tuple[float, float, float] | None = None  # the last valid estimate, for continuity
+        self.was_upright = True
+        self.concentrated_since: float | None = None  # s since when the particles agree on one pose
+        self.evidence: set[str] = set()  # what was seen since: one line alone fits many places
+
+    def execute(self) -> None:
+        if len(self.particles) != self.parameters.particles:
+            self.particles = FIELD_MODEL.own_half(self.rng, self.parameters.particles)
+        self.predict()
+        upright = self.fall_state.upright
+        if upright and self.was_upright:  # percepts of a lying robot come through a wrong camera matrix
+            fits = self.weigh()
+            if fits is not None:
+                self.reset_if_lost(fits)
+        self.was_upright = upright
+        self.publish()
+
+    # ------------------------------------------------------------------------------------ motion
+    def predict(self) -> None:
+        p, odometry = self.parameters, self.odometry
+        now = (odometry.x, odometry.y, odometry.rotation)
+        previous, self.last_odometry = self.last_odometry, now
+        if not self.fall_state.upright and self.was_upright:
+            self.particles[:, 2] += self.rng.normal(0.0, p.fallen_rotation_noise, len(self.particles))
+        if previous is None:
+            return
+        c, s = math.cos(previous[2]), math.sin(previous[2])
+        dx, dy = now[0] - previous[0], now[1] - previous[1]
+        forward, left = c * dx + s * dy, -s * dx + c * dy  # the step in the previous robot frame
+        turn = math.remainder(now[2] - previous[2], math.tau)
+        n = len(self.particles)
+        step = math.hypot(forward, left)
+        forward = forward + self.rng.normal(0.0, p.translation_noise * step + 1.0, n)
+        left = left + self.rng.normal(0.0, p.translation_noise * step + 1.0, n)
+        turn = turn + self.rng.normal(0.0, p.rotation_noise * abs(turn) + 0.0002 * step + 0.002, n)
+        heading = self.particles[:, 2]
+        self.particles[:, 0] += np.cos(heading) * forward - np.sin(heading) * left
+        self.particles[:, 1] += np.sin(heading) * forward + np.cos(heading) * left
+        self.particles[:, 2] = np.remainder(heading + turn + math.pi, math.tau) - math.pi
+
+    # ----------------------------------------------------------------------------------- sensing
+    def weigh(self) -> float | None:
+        """Weigh and resample the particles by this frame's percepts; the mean fit per measurement
+        (0..1), or None if nothing was seen."""
+        p = self.parameters
+        log_weight = np.zeros(len(self.particles))
+        measurements = 0.0
+        points = np.asarray(self.line_percept.points, dtype=float).reshape(-1, 2)
+        if len(points):
+            if len(points) > p.max_points:
+                points = points[np.linspace(0, len(points) - 1, p.max_points).astype(int)]
+            std = p.point_std + p.point_std_per_m * np.linalg.norm(points, axis=1) / 1000.0
+            distance = FIELD_MODEL.line_distance(self.to_field(points))
+            log_weight += p.point_weight * robust(distance / std).sum(axis=1)
+            measurements += p.point_weight * len(points)
+        for post in self.goal_post_percept.posts:
+            std = p.post_std + p.post_std_per_m * math.hypot(post.x, post.y) / 1000.0
+            distance = FIELD_MODEL.post_distance(self.to_field(np.array([[post.x, post.y]]))[:, 0])
+            log_weight += robust(distance / std)
+            measurements += 1
+        if self.line_percept.circle_seen:
+            centre = self.to_field(np.array([[self.line_percept.circle_x, self.line_percept.circle_y]]))[:, 0]
+            log_weight += robust(np.linalg.norm(centre, axis=1) / p.circle_std)
+            measurements += 1
+        if measurements == 0:
+            return None
+        fit = float(np.mean(np.exp(log_weight / measurements)))
+        weights = np.exp(log_weight - log_weight.max())
+        weights /= weights.sum()
+        self.best = self.particles[int(np.argmax(weights))].copy()
+        if 1.0 / np.sum(weights**2) < 0.5 * len(weights):
+            self.particles = self.particles[low_variance_indices(weights, self.rng)]
+            n = len(self.particles)
+            self.particles[:, :2] += self.rng.normal(0.0, p.roughening, (n, 2))
+            self.particles[:, 2] += self.rng.normal(0.0, p.roughening / 1000.0 * 10, n)
+        return fit
+
+    def to_field(self, points: np.ndarray) -> np.ndarray:
+        """Robot-frame points (M x 2) as seen from every particle: (N x M x 2) field positions."""
+        x, y, heading = (self.particles[:, i : i + 1] for i in range(3))
+        c, s = np.cos(heading), np.sin(heading)
+        return np.stack([x + c * points[:, 0] - s * points[:, 1], y + s * points[:, 0] + c * points[:, 1]], axis=-1)
+
+    def reset_if_lost(self, fit: float) -> None:
+        """Make part of the particles anew from the percepts while lost, or before the first fix."""
+        p = self.parameters
+        self.slow += p.alpha_slow * (fit - self.slow) if self.slow else fit
+        self.fast += p.alpha_fast * (fit - self.fast) if self.fast else fit
+        plot("SelfLocator:fit", fit)
+        lost = self.fast < p.lost_ratio * self.slow
+        if not lost and self.trusted is not None:
+            return
+        # before the first fix a few fresh particles a frame keep every pose that fits what is seen alive
+        count = int((p.reset_share if lost else p.search_share) * len(self.particles))
+        fresh = FIELD_MODEL.poses_from_percepts(self.rng, count, self.line_percept, self.goal_post_percept)
+        fresh = mirror(fresh, towards=self.trusted or OWN_HALF)
+        self.particles[self.rng.choice(len(self.particles), len(fresh), replace=False)] = fresh
+
+    # ---------------------------------------------------------------------------------- estimate
+    def publish(self) -> None:
+        p, pose = self.parameters, self.robot_pose
+        centre = getattr(self, "best", None)
+        if centre is None:
+            centre = self.particles.mean(axis=0)
+        near = (np.hypot(self.particles[:, 0] - centre[0], self.particles[:, 1] - centre[1]) < 600.0) & (
+            np.abs(np.remainder(self.particles[:, 2] - centre[2] + math.pi, math.tau) - math.pi) < 0.6)
+        cluster = self.particles[near] if near.sum() >= 3 else self.particles
+        pose.x, pose.y = float(cluster[:, 0].mean()), float(cluster[:, 1].mean())
+        pose.rotation = float(math.atan2(np.sin(cluster[:, 2]).mean(), np.cos(cluster[:, 2]).mean()))
+        spread = np.hypot(cluster[:, 0] - pose.x, cluster[:, 1] - pose.y)
+        pose.deviation = float(math.sqrt(np.mean(spread**2)))
+        pose.rotation_deviation = float(math.sqrt(max(0.0, -2.0 * math.log(max(1e-9, math.hypot(np.sin(cluster[:, 2]).mean(), np.cos(cluster[:, 2]).mean()))))))
+        lost = bool(self.slow and self.fast < p.lost_ratio * self.slow)
+        now = self.frame_info.time_s
+        if not (near.mean() >= p.valid_share and pose.deviation <= p.valid_deviation and not lost):
+            self.concentrated_since, self.evidence = None, set()
+        elif self.concentrated_since is None:
+            self.concentrated_since = now
+        if self.concentrated_since is not None:
+            self.evidence |= self.evidence_seen(pose.rotation)
+        pose.valid = (self.concentrated_since is not None and now - self.concentrated_since >= p.confirm_after
+                      and bool(self.evidence & {"circle", "post"} or {"along", "across"} <= self.evidence))
+        pose.lost = lost or (self.trusted is not None and not pose.valid)
+        if pose.valid:
+            self.trusted = (pose.x, pose.y, pose.rotation)
+        if DRAW_PARTICLES:
+            canvas = drawing("field")
+            for x, y, heading in self.particles[:: max(1, len(self.particles) // 100)]:
+                canvas.line(x, y, x + 120 * math.cos(heading), y + 120 * math.sin(heading), color="gray")
+            canvas.robot_pose(pose.x, pose.y, pose.rotation, color="blue" if pose.valid else "red", width=2)
+
+
+    def evidence_seen(self, rotation: float) -> set[str]:
+        """What this frame saw that pins a pose down: the circle, a post, lines along or across the field."""
+        seen = {"circle"} if self.line_percept.circle_seen else set()
+        if self.goal_post_percept.posts:
+            seen.add("post")
+        for segment in self.line_percept.segments:
+            if segment.length >= 300.0:
+                angle = abs(math.remainder(math.atan2(segment.y2 - segment.y1, segment.x2 - segment.x1) + rotation, math.pi))
+                seen.add("along" if angle < 0.35 else "across" if angle > math.pi / 2 - 0.35 else "slanted")
+        return seen
+
+
+def robust(normalized: np.ndarray) -> np.ndarray:
+    """Log-likelihood of normalized errors, Gaussian near zero and flat beyond 2.5 standard deviations,
+    so that one wrong percept cannot wipe out the right particles."""
+    return -0.5 * np.minimum(normalized, 2.5) ** 2
+
+
+def low_variance_indices(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Indices of a low-variance (systematic) resampling of normalized ``weights``."""
+    n = len(weights)
+    positions = (rng.random() + np.arange(n)) / n
+    return np.minimum(np.searchsorted(np.cumsum(weights), positions), n - 1)

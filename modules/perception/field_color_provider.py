@@ -1,0 +1,76 @@
+"""FieldColorProvider: the field's green, estimated from the images rather than fixed, and both images
+segmented by it once for every detector."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from tafel.core import Module, bounded, provides, requires
+from tafel.debug import plot
+from tafel.representations.perception import CameraImageBottom, CameraImageTop, FieldColor, SegmentedImage
+
+
+@requires(CameraImageTop, CameraImageBottom)
+@provides(FieldColor, SegmentedImage)
+class FieldColorProvider(Module):
+    """The most frequent saturated hue among greenish pixels of the bottom image and the top image's
+    lower half (where the field usually is), with a tolerance from its spread, smoothed over frames.
+
+    Light changes move the estimate within a few frames; a frame with too little green (the robot
+    looks at a wall, or is lifted) keeps the last estimate.
+    """
+
+    @dataclass
+    class Parameters:
+        hue_low: int = bounded(0, 180, 25)
+        """OpenCV hue: the range a field can be in at all (yellowish to bluish green)"""
+        hue_high: int = bounded(0, 180, 95)
+        saturation_floor: int = bounded(0, 255, 50)
+        """pixels less saturated than this are lines, robots or walls, never field"""
+        min_share: float = bounded(0.0, 1.0, 0.15)
+        """share of the sampled pixels that must be green to update the estimate"""
+        smoothing: float = bounded(0.0, 1.0, 0.3)
+        """weight of this frame's estimate against the previous one"""
+        step: int = bounded(1, 16, 3)
+        """px between sampled pixels"""
+
+    def execute(self) -> None:
+        segmented = self.segmented_image
+        for camera, image in (("top", self.camera_image_top.image), ("bottom", self.camera_image_bottom.image)):
+            pixels = np.asarray(image)
+            valid = pixels.ndim == 3 and pixels.shape[2] == 3 and pixels.size > 0
+            hsv = cv2.cvtColor(np.ascontiguousarray(pixels), cv2.COLOR_RGB2HSV) if valid else np.zeros((0, 0, 3), np.uint8)
+            setattr(segmented, f"{camera}_hsv", hsv)
+        self.estimate()
+        for camera in ("top", "bottom"):
+            hsv = segmented.hsv(camera)
+            setattr(segmented, f"{camera}_green", self.field_color.mask(hsv) if hsv.size else np.zeros((0, 0), bool))
+
+    def estimate(self) -> None:
+        """This frame's field colour from samples of both images, blended into the last estimate."""
+        p, out, segmented = self.parameters, self.field_color, self.segmented_image
+        samples = [hsv[int(hsv.shape[0] * start) :: p.step, :: p.step].reshape(-1, 3)
+                   for hsv, start in ((segmented.bottom_hsv, 0.0), (segmented.top_hsv, 0.5)) if hsv.size]
+        if not samples:
+            return
+        hsv = np.concatenate(samples)
+        greenish = hsv[(hsv[:, 0] >= p.hue_low) & (hsv[:, 0] <= p.hue_high) & (hsv[:, 1] >= p.saturation_floor) & (hsv[:, 2] >= 30)]
+        if len(greenish) < p.min_share * len(hsv):
+            return
+        histogram = np.bincount(greenish[:, 0], minlength=180).astype(float)
+        histogram = np.convolve(histogram, np.ones(5) / 5, mode="same")
+        peak = float(np.argmax(histogram))
+        near = greenish[np.abs(greenish[:, 0].astype(float) - peak) <= 15]
+        tolerance = float(np.clip(3.0 * near[:, 0].std() + 4.0, 6.0, 20.0))
+        saturation = float(max(p.saturation_floor, 0.45 * np.median(near[:, 1])))
+        value = float(max(25.0, 0.35 * np.median(near[:, 2])))
+        weight = p.smoothing if out.valid else 1.0
+        out.hue += weight * (peak - out.hue)
+        out.hue_tolerance += weight * (tolerance - out.hue_tolerance)
+        out.saturation_min += weight * (saturation - out.saturation_min)
+        out.value_min += weight * (value - out.value_min)
+        out.valid = True
+        plot("FieldColorProvider:hue", out.hue)

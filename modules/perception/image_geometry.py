@@ -1,0 +1,98 @@
+"""Pixels to the ground and back, through a camera matrix: what every detector needs.
+
+A camera frame has x along the optical axis, y left and z up; images have their origin top-left, x
+right and y down (README: coordinate convention). The simulated cameras are pinholes without
+distortion, described by the image size and the field of view.
+"""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import numpy as np
+
+from tafel.representations.motion import CameraMatrix
+from tafel.representations.nao import FOOT_HEIGHT, HIP_OFFSET_Y, SOLE_BACK, SOLE_FRONT, SOLE_OUTSIDE
+
+
+def focal_lengths(width: int, height: int, horizontal_fov: float, vertical_fov: float) -> tuple[float, float]:
+    """(fx, fy) in px."""
+    return (width / 2) / math.tan(horizontal_fov / 2), (height / 2) / math.tan(vertical_fov / 2)
+
+
+def pixel_ray(x: float, y: float, width: int, height: int, horizontal_fov: float, vertical_fov: float) -> np.ndarray:
+    """The direction of a pixel in the camera frame (x along the optical axis, y left, z up)."""
+    fx, fy = focal_lengths(width, height, horizontal_fov, vertical_fov)
+    return np.array([1.0, -(x - width / 2) / fx, -(y - height / 2) / fy])
+
+
+def ground_point(ray_camera: np.ndarray, rotation: np.ndarray, translation: np.ndarray, height: float) -> np.ndarray | None:
+    """Where a camera ray meets the plane ``z = height`` in the robot frame (mm), None above the horizon."""
+    direction = np.asarray(rotation) @ ray_camera
+    if direction[2] >= -1e-6:
+        return None
+    scale = (height - translation[2]) / direction[2]
+    return np.asarray(translation) + scale * direction
+
+
+class ImageProjection:
+    """One camera's matrix and intrinsics, with vectorized conversions between pixels and the ground."""
+
+    def __init__(self, matrix: CameraMatrix, width: int, height: int, horizontal_fov: float, vertical_fov: float) -> None:
+        self.rotation = np.asarray(matrix.rotation, dtype=float)
+        self.translation = np.asarray(matrix.translation, dtype=float)
+        self.width, self.height = width, height
+        self.fx, self.fy = focal_lengths(width, height, horizontal_fov, vertical_fov)
+
+    def rays(self, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+        """Directions (N x 3, robot frame, not normalized) of the pixels (xs, ys)."""
+        camera = np.stack([np.ones_like(xs, dtype=float), -(np.asarray(xs, float) - self.width / 2) / self.fx,
+                           -(np.asarray(ys, float) - self.height / 2) / self.fy], axis=-1)
+        return camera @ self.rotation.T
+
+    def to_ground(self, xs: np.ndarray, ys: np.ndarray, z: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """The points (N x 2, mm, robot frame) where the pixels' rays meet the plane at height ``z``, and
+        which of them do (rays at or above the horizon do not)."""
+        rays = self.rays(xs, ys)
+        hits = rays[:, 2] < -1e-6
+        scale = np.where(hits, (z - self.translation[2]) / np.where(hits, rays[:, 2], -1.0), 0.0)
+        return self.translation[:2] + scale[:, None] * rays[:, :2], hits
+
+    def to_image(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Pixels (N x 2) of robot-frame points (N x 3, mm), and which lie in front of the camera."""
+        local = (np.asarray(points, float) - self.translation) @ self.rotation
+        front = local[:, 0] > 1.0
+        depth = np.where(front, local[:, 0], 1.0)
+        return np.stack([self.width / 2 - self.fx * local[:, 1] / depth, self.height / 2 - self.fy * local[:, 2] / depth], axis=1), front
+
+    def horizon(self, x: float) -> float:
+        """The row (px) of the horizon at column ``x`` (can lie outside the image)."""
+        # the horizon is where rays are level: z component of R @ (1, u, v) is 0
+        u = -(x - self.width / 2) / self.fx
+        r = self.rotation[2]
+        if abs(r[2]) < 1e-9:
+            return -1e9 if r[0] + r[1] * u > 0 else 1e9
+        v = -(r[0] + r[1] * u) / r[2]
+        return self.height / 2 - v * self.fy
+
+
+#: where the robot's own feet can be in the robot frame (mm): the soles' outline with the walk's reach
+#: (steps of 60 mm either way) and the feet's height, as a box
+FEET_REACH = 60.0
+FEET_BOX = ((-SOLE_BACK - FEET_REACH, SOLE_FRONT + FEET_REACH), (-(HIP_OFFSET_Y + SOLE_OUTSIDE + FEET_REACH), HIP_OFFSET_Y + SOLE_OUTSIDE + FEET_REACH),
+            (0.0, FOOT_HEIGHT + 20.0))
+
+
+def own_feet_mask(projection: ImageProjection, shape: tuple[int, int]) -> np.ndarray:
+    """Where the robot's own feet may show in an image (h x w bool): detectors must not take them for
+    lines or balls. A box round both feet projected into the image (the body contour teams use, for
+    the part of the body a camera can see)."""
+    mask = np.zeros(shape, np.uint8)
+    corners = np.array([(x, y, z) for x in FEET_BOX[0] for y in FEET_BOX[1] for z in FEET_BOX[2]], dtype=float)
+    pixels, front = projection.to_image(corners)
+    if front.sum() < 3:
+        return mask.astype(bool)
+    hull = cv2.convexHull(np.clip(pixels[front], -1e4, 1e4).astype(np.int32))
+    cv2.fillConvexPoly(mask, hull, 1)
+    return mask.astype(bool)

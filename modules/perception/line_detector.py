@@ -1,0 +1,216 @@
+"""LineDetector: the field lines on the ground, as segments and the centre circle."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from tafel.core import Module, bounded, provides, requires, uses
+from tafel.debug import drawing, request, stopwatch
+from tafel.modules.perception.image_geometry import ImageProjection, own_feet_mask
+from tafel.representations.field import CENTER_CIRCLE_DIAMETER, LINE_WIDTH
+from tafel.representations.motion import CameraMatrixBuffer
+from tafel.representations.perception import (
+    BallImagePercept,
+    CameraImage,
+    CameraImageBottom,
+    CameraImageTop,
+    FieldBoundary,
+    FieldColor,
+    LinePercept,
+    LineSegment,
+    SegmentedImage,
+)
+
+DRAW_POINTS = request("LineDetector:draw_points", "line points in the images and on the robot canvas")
+DRAW_LINES = request("LineDetector:draw_lines", "fitted segments and the centre circle on the robot canvas")
+CIRCLE_RADIUS = CENTER_CIRCLE_DIAMETER / 2
+
+
+def white_runs(white: np.ndarray, step: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Runs of white down every ``step``-th column of a mask: (column x, first row, last row) per run."""
+    columns = white[:, ::step].astype(np.int8)
+    edge = np.zeros((1, columns.shape[1]), np.int8)
+    change = np.diff(np.vstack([edge, columns, edge]), axis=0).T  # per column: +1 where a run starts, -1 after it ends
+    start_columns, start_rows = np.nonzero(change == 1)
+    _, end_rows = np.nonzero(change == -1)  # same order: each run ends in its column before the next starts
+    return start_columns * step, start_rows, end_rows - 1
+
+
+def longest_arc(angles: np.ndarray, max_gap: float) -> float:
+    """The longest span (rad) of ``angles`` (rad) on the circle without a gap wider than ``max_gap``."""
+    if len(angles) < 2:
+        return 0.0
+    ordered = np.sort(np.mod(angles, 2 * math.pi))
+    gaps = np.diff(np.concatenate([ordered, ordered[:1] + 2 * math.pi]))
+    breaks = np.nonzero(gaps > max_gap)[0]
+    if len(breaks) == 0:
+        return 2 * math.pi
+    # walk round from just after each break to the next one: the arcs between the gaps
+    spans = [(ordered[b2] - ordered[(b1 + 1) % len(ordered)]) % (2 * math.pi) for b1, b2 in zip(breaks, np.roll(breaks, -1))]
+    return float(max(spans))
+
+
+@requires(CameraImageTop, CameraImageBottom, SegmentedImage, FieldColor, FieldBoundary, CameraMatrixBuffer)
+@uses(BallImagePercept)
+@provides(LinePercept)
+class LineDetector(Module):
+    """Scan lines find thin white runs on the field; their middles, put on the ground through the
+    camera matrix, are line points. A run is kept if its extent on the ground fits a 50 mm line seen at
+    a slant, which rules out robots and the ball. Then, on the ground: the centre circle (points on a
+    circle of the known radius, found by RANSAC), then straight segments, greedily, by RANSAC too."""
+
+    @dataclass
+    class Parameters:
+        step: int = bounded(1, 32, 4)
+        """px between scan lines (both directions)"""
+        max_run_ground: float = bounded(50.0, 1000.0, 220.0)
+        """mm: a white run longer than this on the ground is no line"""
+        max_distance: float = bounded(500.0, 10000.0, 5000.0)
+        """mm: points farther away are too imprecise to use"""
+        saturation_max: int = bounded(0, 255, 70)
+        white_share: float = bounded(0.3, 1.0, 0.7)
+        """a pixel is white above this share of the field's brightest non-green value"""
+        inlier_distance: float = bounded(5.0, 300.0, 60.0)
+        """mm from a fitted line or circle that still counts"""
+        min_line_points: int = bounded(3, 100, 6)
+        min_circle_points: int = bounded(4, 200, 15)
+        min_arc: float = bounded(10.0, 360.0, 90.0)
+        """degrees of the circle that must be seen without a gap"""
+        max_arc_gap: float = bounded(1.0, 90.0, 15.0)
+        """degrees between neighbouring circle points that still count as one arc"""
+        max_points: int = bounded(10, 2000, 200)
+        """line points kept per frame"""
+        iterations: int = bounded(5, 500, 40)
+        """RANSAC tries per segment"""
+
+    def __init__(self) -> None:
+        self.rng = np.random.default_rng(0)  # fixed: a replay fits the same lines
+
+    def execute(self) -> None:
+        out = self.line_percept
+        points = [self.points(camera, image) for camera, image in (("top", self.camera_image_top), ("bottom", self.camera_image_bottom))]
+        found = np.concatenate(points)
+        if len(found) > self.parameters.max_points:  # evenly thinned: near and far points alike
+            found = found[np.linspace(0, len(found) - 1, self.parameters.max_points).astype(int)]
+        out.points = found.astype(np.float32)
+        out.segments, out.circle_seen = [], False
+        with stopwatch("LineDetector:fit"):
+            rest = self.fit_circle(found)
+            out.segments = self.fit_segments(rest)
+        if DRAW_LINES:
+            canvas = drawing("robot")
+            for segment in out.segments:
+                canvas.line(segment.x1, segment.y1, segment.x2, segment.y2, color="white", width=3)
+            if out.circle_seen:
+                canvas.circle(out.circle_x, out.circle_y, CIRCLE_RADIUS, color="white", width=3)
+
+    def points(self, camera: str, image: CameraImage) -> np.ndarray:
+        """Line points (N x 2, mm, robot frame) of one camera's image."""
+        p = self.parameters
+        pixels = np.asarray(image.image)
+        if pixels.ndim != 3 or pixels.size == 0 or not self.field_color.valid:
+            return np.zeros((0, 2))
+        matrix = self.camera_matrix_buffer.at(camera, image.time_ns)
+        if not matrix.valid or image.horizontal_fov <= 0:
+            return np.zeros((0, 2))
+        height, width = pixels.shape[:2]
+        projection = ImageProjection(matrix, width, height, image.horizontal_fov, image.vertical_fov)
+        hsv = self.segmented_image.hsv(camera)
+        boundary = self.field_boundary.rows(camera)
+        on_field = np.arange(height)[:, None] >= (boundary[None, :] if boundary.size == width else 0)
+        candidates = ~self.segmented_image.green(camera) & on_field & (hsv[..., 1] <= p.saturation_max)
+        if not candidates.any():
+            return np.zeros((0, 2))
+        brightest = float(np.percentile(hsv[..., 2][candidates], 99))
+        white = (candidates & (hsv[..., 2] >= p.white_share * brightest)).astype(np.uint8)
+        white[own_feet_mask(projection, white.shape)] = 0  # the robot's own feet are white too
+        for ball in self.ball_image_percept.candidates:  # and so is the ball
+            if ball.camera == camera:
+                cv2.circle(white, (int(ball.x), int(ball.y)), int(ball.radius * 1.4) + 2, 0, -1)
+        found = []
+        for mask, transposed in ((white, False), (white.T, True)):
+            x, first, last = white_runs(mask, p.step)
+            if len(x) == 0:
+                continue
+            if transposed:  # runs along rows: x and y swap
+                xs0, ys0, xs1, ys1 = first, x, last, x
+            else:
+                xs0, ys0, xs1, ys1 = x, first, x, last
+            starts, hit0 = projection.to_ground(xs0.astype(float), ys0.astype(float))
+            ends, hit1 = projection.to_ground(xs1.astype(float), ys1.astype(float))
+            middles, hit = projection.to_ground((xs0 + xs1) / 2.0, (ys0 + ys1) / 2.0)
+            extent = np.linalg.norm(ends - starts, axis=1)
+            keep = hit0 & hit1 & hit & (extent <= p.max_run_ground) & (np.linalg.norm(middles, axis=1) <= p.max_distance)
+            found.append(middles[keep])
+            if DRAW_POINTS:
+                canvas = drawing(f"image:{camera}")
+                for px, py in zip(((xs0 + xs1) / 2.0)[keep], ((ys0 + ys1) / 2.0)[keep]):
+                    canvas.circle(float(px), float(py), 1.5, color="red")
+        result = np.concatenate(found) if found else np.zeros((0, 2))
+        if DRAW_POINTS:
+            canvas = drawing("robot")
+            for x, y in result:
+                canvas.circle(float(x), float(y), 15, color="red")
+        return result
+
+    def fit_circle(self, points: np.ndarray) -> np.ndarray:
+        """Find the centre circle among ``points``; returns the points it does not explain."""
+        p, out = self.parameters, self.line_percept
+        if len(points) < p.min_circle_points:
+            return points
+        # every try at once: two points and the known radius give two centres
+        pairs = self.rng.integers(0, len(points), (p.iterations * 2, 2))
+        a, b = points[pairs[:, 0]], points[pairs[:, 1]]
+        chord = np.linalg.norm(b - a, axis=1)
+        usable = (chord > 200.0) & (chord < 2 * CIRCLE_RADIUS)
+        a, b, chord = a[usable], b[usable], chord[usable]
+        if len(a) == 0:
+            return points
+        normal = np.column_stack([-(b - a)[:, 1], (b - a)[:, 0]]) / chord[:, None]
+        offset = np.sqrt(CIRCLE_RADIUS**2 - (chord / 2) ** 2)[:, None]
+        centres = np.vstack([(a + b) / 2 + offset * normal, (a + b) / 2 - offset * normal])
+        residual = np.abs(np.linalg.norm(points[None, :, :] - centres[:, None, :], axis=2) - CIRCLE_RADIUS)
+        counts = (residual < p.inlier_distance).sum(axis=1)
+        best = int(np.argmax(counts))
+        if counts[best] < p.min_circle_points:
+            return points
+        centre, inliers = centres[best], residual[best] < p.inlier_distance
+        angles = np.arctan2(points[inliers, 1] - centre[1], points[inliers, 0] - centre[0])
+        if longest_arc(angles, math.radians(p.max_arc_gap)) < math.radians(p.min_arc):
+            return points  # pieces of straight lines crossing a circle, or too short an arc to tell from a line
+        out.circle_seen, out.circle_x, out.circle_y = True, float(centre[0]), float(centre[1])
+        return points[~inliers]
+
+    def fit_segments(self, points: np.ndarray) -> list[LineSegment]:
+        """Straight segments through ``points``, the best supported first, each cut to where its points are."""
+        p = self.parameters
+        segments: list[LineSegment] = []
+        while len(points) >= p.min_line_points and len(segments) < 8:
+            pairs = self.rng.integers(0, len(points), (p.iterations, 2))
+            a, direction = points[pairs[:, 0]], points[pairs[:, 1]] - points[pairs[:, 0]]
+            length = np.linalg.norm(direction, axis=1)
+            usable = length >= 2 * LINE_WIDTH
+            if not usable.any():
+                break
+            a, direction, length = a[usable], direction[usable], length[usable]
+            normal = np.column_stack([-direction[:, 1], direction[:, 0]]) / length[:, None]
+            offsets = np.abs(np.einsum("kj,nj->kn", normal, points) - np.einsum("kj,kj->k", normal, a)[:, None])
+            counts = (offsets < p.inlier_distance).sum(axis=1)
+            best = int(np.argmax(counts))
+            if counts[best] < p.min_line_points:
+                break
+            inliers = offsets[best] < p.inlier_distance
+            # refit on the inliers (principal axis), then cut at the outermost inliers
+            chosen = points[inliers]
+            centre = chosen.mean(axis=0)
+            axis = np.linalg.svd(chosen - centre)[2][0]
+            along = (chosen - centre) @ axis
+            start, end = centre + along.min() * axis, centre + along.max() * axis
+            if np.linalg.norm(end - start) >= 2 * LINE_WIDTH:
+                segments.append(LineSegment(float(start[0]), float(start[1]), float(end[0]), float(end[1])))
+            points = points[~inliers]
+        return segments

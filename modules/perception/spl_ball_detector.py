@@ -1,0 +1,173 @@
+"""SPLBallDetector: the SPL ball (white with black patches) in both images, as image positions."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from tafel.core import Module, bounded, provides, requires
+from tafel.debug import drawing, request, stopwatch
+from tafel.modules.perception.image_geometry import ImageProjection
+from tafel.representations.field import BALL_RADIUS
+from tafel.representations.motion import CameraMatrixBuffer
+from tafel.representations.perception import (
+    BallCandidate,
+    BallImagePercept,
+    CameraImage,
+    CameraImageBottom,
+    CameraImageTop,
+    FieldBoundary,
+    FieldColor,
+    SegmentedImage,
+)
+
+DRAW_CANDIDATES = request("SPLBallDetector:draw_candidates", "every ball candidate (grey) and accepted ball (blue) in the images")
+
+
+@dataclass
+class Spot:
+    """A place in the image where a ball of the expected size could be (px)."""
+
+    x: float
+    y: float
+    radius: float
+    expected: float
+
+
+@requires(CameraImageTop, CameraImageBottom, SegmentedImage, FieldColor, FieldBoundary, CameraMatrixBuffer)
+@provides(BallImagePercept)
+class SPLBallDetector(Module):
+    """Candidates, then a check of each.
+
+    - Candidates: everything on the field that is not green, thinned by a distance transform. A ball
+      is the thickest non-green thing of its size: its peak lies about one ball radius from the
+      green, while a line of the same distance is half as thick and a robot far thicker. The size a
+      ball would have at each pixel comes from the camera matrix of the image's time.
+    - Check: a ball is not green inside, is green around most of its edge, has black patches (dark
+      pixels among bright ones) and no colour. That tells it from line crossings, penalty marks,
+      goal posts (their non-green continues upwards) and robots' feet (no black patches, too large).
+    """
+
+    @dataclass
+    class Parameters:
+        size_low: float = bounded(0.2, 1.0, 0.55)
+        """share of the expected radius the thickest point must reach"""
+        size_high: float = bounded(1.0, 3.0, 1.5)
+        min_radius: float = bounded(0.5, 10.0, 1.5)
+        """px: smaller balls are not looked for"""
+        max_spots: int = bounded(1, 50, 10)
+        """candidates checked per image"""
+        green_inside_max: float = bounded(0.0, 1.0, 0.25)
+        green_around_min: float = bounded(0.0, 1.0, 0.3)
+        dark_share_min: float = bounded(0.0, 1.0, 0.04)
+        dark_share_max: float = bounded(0.0, 1.0, 0.6)
+        dark_ratio: float = bounded(0.1, 1.0, 0.4)
+        """a pixel is dark below this share of the bright pixels' value"""
+        saturation_max: float = bounded(0.0, 255.0, 70.0)
+        """mean saturation inside: the ball has no colour"""
+        above_boundary: float = bounded(0.0, 50.0, 8.0)
+        """px above the field boundary still searched: a ball on the border strip reaches over it"""
+        post_share: float = bounded(0.0, 1.0, 0.6)
+        """share of ball-white pixels right above a spot that makes it the foot of a goal post"""
+
+    def execute(self) -> None:
+        found: list[BallCandidate] = []
+        for camera, image in (("top", self.camera_image_top), ("bottom", self.camera_image_bottom)):
+            pixels = np.asarray(image.image)
+            if pixels.ndim != 3 or pixels.size == 0 or not self.field_color.valid:
+                continue
+            matrix = self.camera_matrix_buffer.at(camera, image.time_ns)
+            if not matrix.valid or image.horizontal_fov <= 0:
+                continue
+            height, width = pixels.shape[:2]
+            projection = ImageProjection(matrix, width, height, image.horizontal_fov, image.vertical_fov)
+            with stopwatch("SPLBallDetector:image"):
+                hsv, green = self.segmented_image.hsv(camera), self.segmented_image.green(camera)
+                spots = self.spots(green, self.field_boundary.rows(camera), projection)
+                for spot in spots:
+                    score = self.check(hsv, green, spot)
+                    if DRAW_CANDIDATES:
+                        drawing(f"image:{camera}").circle(spot.x, spot.y, spot.radius, color="blue" if score else "gray")
+                    if score:
+                        found.append(self.candidate(camera, image, spot, score))
+        found.sort(key=lambda c: -c.fill)
+        self.ball_image_percept.candidates = found
+
+    def spots(self, green: np.ndarray, boundary: np.ndarray, projection: ImageProjection) -> list[Spot]:
+        """Peaks of the non-green field's distance transform whose thickness fits a ball there."""
+        p = self.parameters
+        height, width = green.shape
+        field = np.ones_like(green) if boundary.size != width else np.arange(height)[:, None] >= boundary[None, :] - p.above_boundary
+        solid = (~green & field).astype(np.uint8)
+        if not solid.any():
+            return []
+        thickness = cv2.distanceTransform(solid, cv2.DIST_L2, 3)
+        peaks = (thickness >= p.min_radius) & (thickness >= cv2.dilate(thickness, np.ones((3, 3), np.uint8)))
+        ys, xs = np.nonzero(peaks)
+        if len(xs) == 0:
+            return []
+        radii = thickness[ys, xs]
+        centres, hits = projection.to_ground(xs, ys, BALL_RADIUS)
+        points = np.column_stack([centres, np.full(len(xs), BALL_RADIUS)])
+        distance = np.linalg.norm(points - projection.translation, axis=1)
+        expected = np.where(hits, projection.fx * BALL_RADIUS / np.maximum(distance, 1.0), 0.0)
+        fits = hits & (radii >= p.size_low * expected) & (radii <= p.size_high * expected + 1.0)
+        if boundary.size == width:
+            fits &= ys >= boundary[xs]  # the centre lies on the field; only the top may reach over its edge
+        # the spots most like a ball's size first: lines are thinner, robots and the border thicker
+        order = np.argsort(np.abs(np.log(np.maximum(radii[fits], 0.5) / np.maximum(expected[fits], 0.5))))
+        chosen: list[Spot] = []
+        for x, y, r, e in zip(xs[fits][order], ys[fits][order], radii[fits][order], expected[fits][order]):
+            if all((x - s.x) ** 2 + (y - s.y) ** 2 > (s.expected * 1.5) ** 2 for s in chosen):
+                chosen.append(Spot(float(x), float(y), float(max(r, 0.5 * (r + e))), float(e)))
+                if len(chosen) >= p.max_spots:
+                    break
+        return chosen
+
+    def check(self, hsv: np.ndarray, green: np.ndarray, spot: Spot) -> float:
+        """0 if the spot is no ball, else a score in (0, 1]: how well it fits."""
+        p = self.parameters
+        height, width = green.shape
+        r = spot.radius
+        reach = int(math.ceil(r * 1.7)) + 1
+        x0, x1 = max(0, int(spot.x) - reach), min(width, int(spot.x) + reach + 1)
+        y0, y1 = max(0, int(spot.y) - reach), min(height, int(spot.y) + reach + 1)
+        yy, xx = np.mgrid[y0:y1, x0:x1]
+        d = np.hypot(xx - spot.x, yy - spot.y)
+        inside, around = d <= 0.9 * r, (d >= 1.2 * r) & (d <= 1.7 * r)
+        if inside.sum() < 3 or around.sum() < 3:
+            return 0.0
+        patch_green, patch = green[y0:y1, x0:x1], hsv[y0:y1, x0:x1]
+        green_inside, green_around = patch_green[inside].mean(), patch_green[around].mean()
+        solid = inside & ~patch_green  # the ball's own pixels: green ones would count as dark next to white
+        if solid.sum() < 3:
+            return 0.0
+        value = patch[..., 2][solid].astype(float)
+        bright = np.percentile(value, 90)
+        dark = float((value < p.dark_ratio * bright).mean())
+        saturation = float(patch[..., 1][inside].mean())
+        if self.below_a_post(hsv, green, spot, bright):
+            return 0.0
+        if (green_inside > p.green_inside_max or green_around < p.green_around_min or not p.dark_share_min <= dark <= p.dark_share_max
+                or saturation > p.saturation_max):
+            return 0.0
+        return float(min(1.0, 0.5 + dark + 0.3 * green_around - green_inside))
+
+    def below_a_post(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, bright: float) -> bool:
+        """Whether something as white as the ball rises above the spot: a goal post (or a robot's leg)."""
+        x0, x1 = int(max(0, spot.x - 0.5 * spot.radius)), int(min(green.shape[1], spot.x + 0.5 * spot.radius + 1))
+        y0, y1 = int(max(0, spot.y - 4 * spot.radius)), int(max(0, spot.y - 1.5 * spot.radius))
+        if y1 - y0 < 2 or x1 <= x0:
+            return False
+        above = hsv[y0:y1, x0:x1]
+        white = (above[..., 2] >= 0.8 * bright) & (above[..., 1] <= self.parameters.saturation_max) & ~green[y0:y1, x0:x1]
+        return float(white.mean()) >= self.parameters.post_share
+
+    @staticmethod
+    def candidate(camera: str, image: CameraImage, spot: Spot, score: float) -> BallCandidate:
+        height, width = np.asarray(image.image).shape[:2]
+        return BallCandidate(camera, spot.x, spot.y, spot.radius, score, width, height, image.horizontal_fov, image.vertical_fov,
+                             image.time_ns)

@@ -1,0 +1,169 @@
+"""The SPL field world both simulators build: carpet, lines, marks, goals, the hall around it, the ball.
+
+Everything is generated from ``representations.field`` as engine-neutral ``FieldPart`` pieces (m), so
+MuJoCo and PyBullet show the same world. The SPL ball (white with black pentagons, used since 2016) is
+a textured sphere: ``ball_texture`` paints the pattern of a truncated icosahedron procedurally and
+``ball_mesh`` gives the UV sphere both engines wrap it on. Nothing is downloaded.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cache
+
+import numpy as np
+
+from tafel.representations import field
+from tafel.representations.field import circle_segments, goal_post_positions, line_segments, mark_centres
+
+M = 0.001  # mm -> m
+BALL_COLORS = ("spl", "orange")
+
+
+@dataclass(frozen=True)
+class FieldPart:
+    """One piece of the field world (m). ``kind``: plane, box (size = half extents, turned by ``yaw``),
+    cylinder (radius, half height), capsule (radius; from ``start`` to ``end``), or sphere (the ball).
+    ``texture``: the ball's pattern is painted on it (engines use ``ball_mesh`` and ``ball_texture``)."""
+
+    name: str
+    kind: str
+    position: tuple[float, float, float]
+    size: tuple[float, ...]
+    rgba: tuple[float, float, float, float]
+    collides: bool = True
+    yaw: float = 0.0
+    end: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    mass: float = 0.0  # > 0: a free body (the ball)
+    texture: bool = False
+
+
+CARPET_RGBA = (0.18, 0.55, 0.2, 1.0)
+WHITE = (1.0, 1.0, 1.0, 1.0)
+ORANGE_BALL_RGBA = (1.0, 0.42, 0.0, 1.0)
+HALL_RGBA = (0.42, 0.4, 0.38, 1.0)  # floor and walls around the carpet: neither green nor white
+CEILING_RGBA = (0.75, 0.75, 0.78, 1.0)
+HALL_MARGIN = 3.0  # m from the carpet's edge to the walls
+HALL_HEIGHT = 6.0  # m: above every camera's view from the field
+
+
+def _flat_box(name: str, x1: float, y1: float, x2: float, y2: float, half_width: float) -> FieldPart:
+    """A painted stripe from (x1, y1) to (x2, y2) (mm), ``half_width`` mm to each side."""
+    length = math.hypot(x2 - x1, y2 - y1)
+    return FieldPart(name, "box", ((x1 + x2) / 2 * M, (y1 + y2) / 2 * M, 0.0005), ((length / 2 + half_width) * M, half_width * M, 0.0005),
+                     WHITE, collides=False, yaw=math.atan2(y2 - y1, x2 - x1))
+
+
+def field_parts(ball: tuple[float, float] = (1.0, 0.0), ball_color: str = "spl") -> list[FieldPart]:
+    """Hall, carpet, lines and marks (visual only), goals and the ball at ``ball`` (m)."""
+    if ball_color not in BALL_COLORS:
+        raise ValueError(f"ball colour {ball_color!r}: choose one of {', '.join(BALL_COLORS)}")
+    half_x, half_y = field.LENGTH / 2 * M, field.WIDTH / 2 * M
+    carpet = (half_x + field.BORDER_STRIP * M, half_y + field.BORDER_STRIP * M, 0.1)
+    hall_x, hall_y = carpet[0] + HALL_MARGIN, carpet[1] + HALL_MARGIN
+    parts = [FieldPart("hall_floor", "plane", (0.0, 0.0, -0.0005), (hall_x, hall_y, 0.1), HALL_RGBA, collides=False),
+             FieldPart("carpet", "plane", (0.0, 0.0, 0.0), carpet, CARPET_RGBA)]
+    for name, x, y, sx, sy in (("wall_front", hall_x, 0.0, 0.05, hall_y), ("wall_back", -hall_x, 0.0, 0.05, hall_y),
+                               ("wall_left", 0.0, hall_y, hall_x, 0.05), ("wall_right", 0.0, -hall_y, hall_x, 0.05)):
+        parts.append(FieldPart(name, "box", (x, y, HALL_HEIGHT / 2), (sx, sy, HALL_HEIGHT / 2), HALL_RGBA, collides=False))
+    parts.append(FieldPart("ceiling", "box", (0.0, 0.0, HALL_HEIGHT), (hall_x, hall_y, 0.05), CEILING_RGBA, collides=False))
+    w = field.LINE_WIDTH / 2
+    parts += [_flat_box(f"line{i}", *segment, w) for i, segment in enumerate(line_segments() + circle_segments())]
+    for i, (x, y) in enumerate(mark_centres()):
+        arm = field.MARK_SIZE / 2 - w
+        parts += [_flat_box(f"mark{i}_x", x - arm, y, x + arm, y, w), _flat_box(f"mark{i}_y", x, y - arm, x, y + arm, w)]
+    r, h = field.GOAL_POST_DIAMETER / 2 * M, field.GOAL_HEIGHT * M
+    posts = goal_post_positions()
+    for (x, y), name in zip(posts, ("opponent_left", "opponent_right", "own_left", "own_right")):
+        parts.append(FieldPart(f"goal_{name}", "cylinder", (x * M, y * M, h / 2), (r, h / 2), WHITE))
+    for side, (x, y) in (("opponent", posts[0]), ("own", posts[2])):
+        parts.append(FieldPart(f"goal_{side}_bar", "capsule", (x * M, -y * M, h), (r,), WHITE, collides=False, end=(x * M, y * M, h)))
+    ball_r = field.BALL_RADIUS * M
+    rgba = WHITE if ball_color == "spl" else ORANGE_BALL_RGBA
+    parts.append(FieldPart("ball", "sphere", (ball[0], ball[1], ball_r), (ball_r,), rgba, mass=field.BALL_MASS,
+                           texture=ball_color == "spl"))
+    return parts
+
+
+# ------------------------------------------------------------------------------------- the SPL ball
+PENTAGON_RADIUS = math.radians(20.1)  # angular circumradius of a truncated icosahedron's pentagons
+BALL_BLACK = 25  # the patches' grey level (0..255): printed black, not a light trap
+BALL_WHITE = 240
+
+
+@cache
+def _icosahedron() -> tuple[np.ndarray, np.ndarray]:
+    """The 12 vertices (unit vectors) and, for each, the direction to one neighbour in its tangent plane."""
+    g = (1 + math.sqrt(5)) / 2
+    vertices = np.array([(0, s1, s2 * g) for s1 in (-1, 1) for s2 in (-1, 1)]
+                        + [(s1, s2 * g, 0) for s1 in (-1, 1) for s2 in (-1, 1)]
+                        + [(s2 * g, 0, s1) for s1 in (-1, 1) for s2 in (-1, 1)], dtype=float)
+    vertices /= np.linalg.norm(vertices, axis=1, keepdims=True)
+    towards = np.empty_like(vertices)
+    for i, v in enumerate(vertices):
+        dots = vertices @ v
+        dots[i] = -2.0
+        neighbour = vertices[int(np.argmax(dots))]
+        tangent = neighbour - (neighbour @ v) * v
+        towards[i] = tangent / np.linalg.norm(tangent)
+    return vertices, towards
+
+
+def ball_is_black(directions: np.ndarray) -> np.ndarray:
+    """Whether each unit direction (..., 3) from the ball's centre hits a black pentagon.
+
+    The pentagons sit at the icosahedron's vertices with their corners towards the neighbouring
+    vertices, as on a truncated icosahedron (the classic football): 12 patches, 28 % of the surface.
+    """
+    vertices, towards = _icosahedron()
+    flat = directions.reshape(-1, 3)
+    nearest = np.argmax(flat @ vertices.T, axis=1)
+    v, e1 = vertices[nearest], towards[nearest]
+    e2 = np.cross(v, e1)
+    along = np.einsum("ij,ij->i", flat, v)
+    # gnomonic projection onto the tangent plane at the pentagon's centre: polygons stay polygons
+    px, py = np.einsum("ij,ij->i", flat, e1) / along, np.einsum("ij,ij->i", flat, e2) / along
+    radius, angle = np.hypot(px, py), np.arctan2(py, px)
+    sector = np.mod(angle + math.pi / 5, 2 * math.pi / 5) - math.pi / 5  # angle from the nearest corner
+    inside = radius * np.cos(np.abs(sector) - math.pi / 5) <= math.tan(PENTAGON_RADIUS) * math.cos(math.pi / 5)
+    return inside.reshape(directions.shape[:-1])
+
+
+def _sphere_direction(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Texture coordinates (0..1) -> unit directions; u goes round the equator, v from pole to pole."""
+    longitude, latitude = u * 2 * math.pi, (v - 0.5) * math.pi
+    return np.stack([np.cos(latitude) * np.cos(longitude), np.cos(latitude) * np.sin(longitude), np.sin(latitude)], axis=-1)
+
+
+@cache
+def ball_texture(width: int = 512, height: int = 256) -> np.ndarray:
+    """The SPL ball's pattern as an equirectangular RGB image (row 0 at v = 0), 4x4 supersampled."""
+    samples = 4
+    u = (np.arange(width * samples) + 0.5) / (width * samples)
+    v = (np.arange(height * samples) + 0.5) / (height * samples)
+    black = ball_is_black(_sphere_direction(*np.meshgrid(u, v)))
+    share = black.reshape(height, samples, width, samples).mean(axis=(1, 3))
+    grey = np.round(BALL_WHITE + (BALL_BLACK - BALL_WHITE) * share).astype(np.uint8)
+    return np.repeat(grey[:, :, None], 3, axis=2)
+
+
+@cache
+def ball_mesh(radius: float, rings: int = 24, segments: int = 48) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A UV sphere: vertices (m), unit normals, texture coordinates (u, v) and triangles (vertex indices).
+
+    The seam's vertices are doubled (u = 0 and u = 1) so that the texture does not wrap backwards.
+    """
+    u, v = np.meshgrid(np.linspace(0.0, 1.0, segments + 1), np.linspace(0.0, 1.0, rings + 1))
+    normals = _sphere_direction(u, v).reshape(-1, 3)
+    uvs = np.stack([u.ravel(), v.ravel()], axis=1)
+    triangles = []
+    for ring in range(rings):
+        for segment in range(segments):
+            a = ring * (segments + 1) + segment
+            b, c, d = a + 1, a + segments + 1, a + segments + 2
+            if ring > 0:
+                triangles.append((a, b, d))
+            if ring < rings - 1:
+                triangles.append((a, d, c))
+    return normals * radius, normals, uvs, np.array(triangles, dtype=np.int64)

@@ -1,0 +1,133 @@
+"""Rendered camera frames with ground truth: data for detector tests, the perception benchmark and training.
+
+``SceneRenderer`` poses the simulated robot kinematically (stand pose, any head angles, anywhere on
+the field), puts the ball where asked and renders both cameras, without stepping the physics. Each
+``LabelledFrame`` carries what a detector should find: the ball in the robot frame, its circle in the
+image, the share of it that is visible (from the engine's segmentation, so occlusion counts), and
+the camera matrix computed by the same kinematics the program uses.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tafel.core.platform import load_platform
+from tafel.modules.motion.kinematics import CAMERA_LINKS, angles_by_name, camera_pose_in_torso, link_poses, robot_frame_from_torso
+from tafel.modules.motion.stand_motion import stand_pose
+from tafel.platforms.simulated import SimulatedRobotPlatform
+from tafel.representations import field as spl
+from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, CameraMatrix
+from tafel.representations.nao import BOTTOM_CAMERA, TOP_CAMERA
+
+CAMERAS = {"top": TOP_CAMERA, "bottom": BOTTOM_CAMERA}
+#: how far from the centre spot random balls lie (mm): on the field, or just over its lines
+BALL_X = spl.LENGTH / 2 + 300.0
+BALL_Y = spl.WIDTH / 2 + 300.0
+
+
+@dataclass
+class LabelledFrame:
+    """One camera's image with what is really there. Positions in the robot frame are mm."""
+
+    camera: str
+    image: np.ndarray
+    matrix: CameraMatrix
+    horizontal_fov: float
+    vertical_fov: float
+    robot_pose: tuple[float, float, float]  # field mm, mm, rad
+    ball: tuple[float, float]  # robot frame, mm
+    ball_distance: float  # mm from the camera's ground point
+    ball_image: tuple[float, float, float] | None  # centre x, y and radius (px) of the ball's projection; None behind
+    ball_visible: float  # share of the ball's projected disc that the image shows (0..1)
+    ball_pixels: int = 0
+    notes: dict[str, float] = field(default_factory=dict)
+
+
+class SceneRenderer:
+    """A simulated platform used as a camera: pose, place, render, with the truth alongside."""
+
+    def __init__(self, engine: str = "mujoco", resolution: str = "320x240", ball_color: str = "spl") -> None:
+        self.platform: SimulatedRobotPlatform = load_platform(engine)({"resolution": resolution, "ball_color": ball_color})
+        self.platform.start(frozenset({"motion", "cognition"}))
+        self.angles = stand_pose()
+
+    def close(self) -> None:
+        self.platform.stop()
+
+    def __enter__(self) -> SceneRenderer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def frames(self, robot_pose: tuple[float, float, float], head: tuple[float, float], ball: tuple[float, float]) -> dict[str, LabelledFrame]:
+        """Both cameras' frames with the robot at ``robot_pose`` (field mm, rad), head (yaw, pitch) in
+        rad and the ball at ``ball`` (field mm)."""
+        angles = self.angles.copy()
+        angles[HEAD_YAW], angles[HEAD_PITCH] = head
+        poses = link_poses(angles_by_name(angles), CAMERA_LINKS)
+        torso_in_robot = robot_frame_from_torso(poses, 0.0, 0.0)
+        x, y, heading = robot_pose
+        c, s = math.cos(heading), math.sin(heading)
+        offset = torso_in_robot[:3, 3]  # the torso above the robot frame's origin, turned with the robot
+        torso_x, torso_y = x + c * offset[0] - s * offset[1], y + s * offset[0] + c * offset[1]
+        p = self.platform
+        p.pose_joints(angles)
+        p.place_robot(np.array([torso_x, torso_y, offset[2]]) * 0.001,
+                      np.array([math.cos(heading / 2), 0.0, 0.0, math.sin(heading / 2)]))
+        p.move_ball(*ball)
+        bx, by = ball[0] - x, ball[1] - y
+        ball_robot = (c * bx + s * by, -s * bx + c * by)
+        horizontal_fov, vertical_fov = p.fov()
+        result = {}
+        for name, mount in CAMERAS.items():
+            camera = torso_in_robot @ camera_pose_in_torso(poses, mount)
+            matrix = CameraMatrix(camera[:3, :3].copy(), camera[:3, 3].copy(), True)
+            image = p.render(name)
+            mask = p.ball_mask(name)
+            projected = project_ball(matrix, ball_robot, p.width, p.height, horizontal_fov, vertical_fov)
+            visible = 0.0
+            if projected is not None:
+                area = math.pi * projected[2] ** 2
+                visible = min(1.0, float(mask.sum()) / area) if area > 0 else 0.0
+            distance = math.hypot(ball_robot[0] - matrix.translation[0], ball_robot[1] - matrix.translation[1])
+            result[name] = LabelledFrame(name, image, matrix, horizontal_fov, vertical_fov, robot_pose, ball_robot, distance,
+                                         projected, visible, int(mask.sum()))
+        return result
+
+    def random_frames(self, count: int, seed: int = 0, ball_range: tuple[float, float] = (300.0, 5000.0)) -> Iterator[LabelledFrame]:
+        """``count`` frames of random scenes: the robot anywhere on the field, the head anywhere it can
+        look, the ball mostly in front of it within ``ball_range`` mm (sometimes behind, so that frames
+        without a ball occur), both cameras."""
+        rng = np.random.default_rng(seed)
+        made = 0
+        while made < count:
+            pose = (rng.uniform(-4300, 4300), rng.uniform(-2800, 2800), rng.uniform(-math.pi, math.pi))
+            head = (rng.uniform(-0.8, 0.8), rng.uniform(-0.3, 0.45))
+            distance = rng.uniform(*ball_range)
+            bearing = pose[2] + head[0] + rng.normal(0.0, 0.5)
+            ball = (pose[0] + distance * math.cos(bearing), pose[1] + distance * math.sin(bearing))
+            if abs(ball[0]) > BALL_X or abs(ball[1]) > BALL_Y:
+                continue  # a ball off the field is put back by the referee; no detector needs to find it there
+            for frame in self.frames(pose, head, ball).values():
+                if made < count:
+                    made += 1
+                    yield frame
+
+
+def project_ball(matrix: CameraMatrix, ball: tuple[float, float], width: int, height: int, horizontal_fov: float,
+                 vertical_fov: float) -> tuple[float, float, float] | None:
+    """The ball's centre and radius in the image (px) for a pinhole camera, None when behind it."""
+    centre = np.array([ball[0], ball[1], spl.BALL_RADIUS])
+    local = np.asarray(matrix.rotation).T @ (centre - np.asarray(matrix.translation))
+    if local[0] <= spl.BALL_RADIUS:
+        return None
+    fx = (width / 2) / math.tan(horizontal_fov / 2)
+    fy = (height / 2) / math.tan(vertical_fov / 2)
+    x = width / 2 - fx * local[1] / local[0]
+    y = height / 2 - fy * local[2] / local[0]
+    return x, y, fx * spl.BALL_RADIUS / float(np.linalg.norm(local))
