@@ -167,3 +167,22 @@ def ball_mesh(radius: float, rings: int = 24, segments: int = 48) -> tuple[np.nd
             if ring < rings - 1:
                 triangles.append((a, d, c))
     return normals * radius, normals, uvs, np.array(triangles, dtype=np.int64)
+
+
+@cache
+def cylinder_mesh(radius: float, half_height: float, segments: int = 24) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A closed cylinder along z: vertices (m), unit normals and triangles. The side has its own
+    vertices with outward normals (PyBullet's built-in cylinder shades flat grey in its CPU renderer)."""
+    angles = np.linspace(0.0, 2 * math.pi, segments, endpoint=False)
+    ring = np.column_stack([np.cos(angles), np.sin(angles), np.zeros(segments)])
+    side = np.vstack([ring * radius + [0, 0, -half_height], ring * radius + [0, 0, half_height]])
+    caps = np.vstack([side, [[0, 0, -half_height], [0, 0, half_height]]])
+    vertices = np.vstack([side, caps])
+    normals = np.vstack([ring, ring, np.tile([0, 0, -1.0], (segments, 1)), np.tile([0, 0, 1.0], (segments, 1)), [[0, 0, -1.0], [0, 0, 1.0]]])
+    triangles = []
+    for i in range(segments):
+        j = (i + 1) % segments
+        triangles += [(i, j, segments + j), (i, segments + j, segments + i)]  # the side, counter-clockwise from outside
+        base, bottom, top = 2 * segments, 4 * segments, 4 * segments + 1
+        triangles += [(bottom, base + j, base + i), (top, base + segments + i, base + segments + j)]
+    return vertices, normals, np.array(triangles, dtype=np.int64)

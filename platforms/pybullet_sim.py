@@ -16,7 +16,7 @@ import numpy as np
 import pybullet
 
 from tafel.core.platform import PlatformError
-from tafel.platforms.field_world import FieldPart, ball_mesh, ball_texture, field_parts
+from tafel.platforms.field_world import FieldPart, ball_mesh, ball_texture, cylinder_mesh, field_parts
 from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, fsr_sites, joint_motor, urdf
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.motion import JOINT_NAMES
@@ -86,6 +86,10 @@ class PybulletPlatform(SimulatedRobotPlatform):
             visual = pybullet.createVisualShape(pybullet.GEOM_MESH, vertices=vertices.tolist(), normals=normals.tolist(),
                                                 uvs=uvs.tolist(), indices=triangles.ravel().tolist(), rgbaColor=part.rgba,
                                                 physicsClientId=c)
+        elif part.kind == "cylinder":
+            vertices, normals, triangles = cylinder_mesh(part.size[0], part.size[1])
+            visual = pybullet.createVisualShape(pybullet.GEOM_MESH, vertices=vertices.tolist(), normals=normals.tolist(),
+                                                indices=triangles.ravel().tolist(), rgbaColor=part.rgba, physicsClientId=c)
         elif part.kind == "plane":
             visual = pybullet.createVisualShape(pybullet.GEOM_BOX, halfExtents=[part.size[0], part.size[1], 0.0005],
                                                 rgbaColor=part.rgba, visualFramePosition=[0, 0, -0.0005], physicsClientId=c)

@@ -159,12 +159,15 @@ class LinePercept:
 
 @dataclass
 class GoalPost:
-    """One goal post's foot on the ground (mm, robot frame), with the image column (px) it was found at."""
+    """One goal post's foot on the ground (mm, robot frame), with where it was found in the image (px):
+    its centre column, its width and the row of its foot."""
 
     x: float = 0.0
     y: float = 0.0
     camera: str = ""
     image_x: float = 0.0
+    image_width: float = 0.0
+    image_foot: float = 0.0
 
 
 @representation

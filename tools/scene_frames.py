@@ -15,12 +15,22 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tafel.core.manager import Blackboard, ModuleManager
 from tafel.core.platform import load_platform
 from tafel.modules.motion.kinematics import CAMERA_LINKS, angles_by_name, camera_pose_in_torso, link_poses, robot_frame_from_torso
 from tafel.modules.motion.stand_motion import stand_pose
+from tafel.modules.perception.ball_detector import BallDetector
+from tafel.modules.perception.ball_locator import BallLocator
+from tafel.modules.perception.field_boundary_detector import FieldBoundaryDetector
+from tafel.modules.perception.field_color_provider import FieldColorProvider
+from tafel.modules.perception.goal_post_detector import GoalPostDetector
+from tafel.modules.perception.line_detector import LineDetector
+from tafel.modules.perception.spl_ball_detector import SPLBallDetector
 from tafel.platforms.simulated import SimulatedRobotPlatform
 from tafel.representations import field as spl
-from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, CameraMatrix
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, CameraMatrix, CameraMatrixBottom, CameraMatrixBuffer, CameraMatrixTop
+from tafel.representations.perception import CameraImageBottom, CameraImageTop
 from tafel.representations.nao import BOTTOM_CAMERA, TOP_CAMERA
 
 CAMERAS = {"top": TOP_CAMERA, "bottom": BOTTOM_CAMERA}
@@ -117,6 +127,33 @@ class SceneRenderer:
                 if made < count:
                     made += 1
                     yield frame
+
+
+class Perception:
+    """The program's perception modules on labelled frames, as one module manager that keeps its state
+    from frame to frame (the field colour is smoothed over frames, as in the program)."""
+
+    MODULES = (FieldColorProvider, FieldBoundaryDetector, SPLBallDetector, BallDetector, BallLocator, LineDetector, GoalPostDetector)
+
+    def __init__(self, ball_detector: str = "SPLBallDetector") -> None:
+        self.manager = ModuleManager(list(self.MODULES), external=[CameraImageTop, CameraImageBottom, CameraMatrixBuffer, FrameInfo],
+                                     providers={"BallImagePercept": ball_detector})
+        self.frame = 0
+
+    def __call__(self, frames: dict[str, LabelledFrame]) -> Blackboard:
+        """Run one cognition frame on both cameras' frames; the blackboard holds every percept."""
+        self.frame += 1
+        time_ns = self.frame * 33_333_333
+        board = self.manager.blackboard
+        board.set(FrameInfo(frame_number=self.frame, time_ns=time_ns))
+        for camera, rep in (("top", CameraImageTop), ("bottom", CameraImageBottom)):
+            frame = frames[camera]
+            board.set(rep(image=frame.image, horizontal_fov=frame.horizontal_fov, vertical_fov=frame.vertical_fov, time_ns=time_ns))
+        top, bottom = frames["top"].matrix, frames["bottom"].matrix
+        board.set(CameraMatrixBuffer.of(CameraMatrixTop(top.rotation, top.translation, True),
+                                        CameraMatrixBottom(bottom.rotation, bottom.translation, True), time_ns))
+        self.manager.execute()
+        return board
 
 
 def project_ball(matrix: CameraMatrix, ball: tuple[float, float], width: int, height: int, horizontal_fov: float,

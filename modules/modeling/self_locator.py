@@ -127,6 +127,7 @@ class SelfLocator(Module):
         log_weight = np.zeros(len(self.particles))
         measurements = 0.0
         points = np.asarray(self.line_percept.points, dtype=float).reshape(-1, 2)
+        points = points[np.isfinite(points).all(axis=1) & (np.abs(points) < 20000.0).all(axis=1)]  # what no camera sees
         if len(points):
             if len(points) > p.max_points:
                 points = points[np.linspace(0, len(points) - 1, p.max_points).astype(int)]
@@ -135,11 +136,13 @@ class SelfLocator(Module):
             log_weight += p.point_weight * robust(distance / std).sum(axis=1)
             measurements += p.point_weight * len(points)
         for post in self.goal_post_percept.posts:
+            if not (math.isfinite(post.x) and math.isfinite(post.y)):
+                continue
             std = p.post_std + p.post_std_per_m * math.hypot(post.x, post.y) / 1000.0
             distance = FIELD_MODEL.post_distance(self.to_field(np.array([[post.x, post.y]]))[:, 0])
             log_weight += robust(distance / std)
             measurements += 1
-        if self.line_percept.circle_seen:
+        if self.line_percept.circle_seen and math.isfinite(self.line_percept.circle_x) and math.isfinite(self.line_percept.circle_y):
             centre = self.to_field(np.array([[self.line_percept.circle_x, self.line_percept.circle_y]]))[:, 0]
             log_weight += robust(np.linalg.norm(centre, axis=1) / p.circle_std)
             measurements += 1

@@ -70,7 +70,7 @@ class FieldBoundaryDetector(Module):
         padded = np.vstack([cells, np.zeros((p.window, n_cols), np.float32)])
         cumulative = np.vstack([np.zeros((1, n_cols), np.float32), np.cumsum(padded, axis=0)])
         below = (cumulative[p.window : p.window + n_rows] - cumulative[:n_rows]) / np.minimum(p.window, n_rows - np.arange(n_rows))[:, None]
-        field = below >= p.green_share
+        field = (below >= p.green_share) & (cells >= p.green_share)  # the cell itself is field, and so is what lies below it
         found = field.any(axis=0)
         tops = np.where(found, np.argmax(field, axis=0), n_rows).astype(np.float32) * p.cell
         xs = (np.arange(n_cols) + 0.5) * p.cell

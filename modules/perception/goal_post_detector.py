@@ -114,4 +114,4 @@ class GoalPostDetector(Module):
         # the foot's edge is seen; the post's centre lies half a post behind it
         direction = ground[0] / max(np.linalg.norm(ground[0]), 1.0)
         x, y = ground[0] + direction * GOAL_POST_DIAMETER / 2
-        return GoalPost(float(x), float(y), camera, float(centre))
+        return GoalPost(float(x), float(y), camera, float(centre), float(post_width), float(foot))

@@ -20,6 +20,7 @@ from tafel.representations.perception import (
     CameraImageTop,
     FieldBoundary,
     FieldColor,
+    GoalPostPercept,
     LinePercept,
     LineSegment,
     SegmentedImage,
@@ -54,13 +55,14 @@ def longest_arc(angles: np.ndarray, max_gap: float) -> float:
     return float(max(spans))
 
 
-@requires(CameraImageTop, CameraImageBottom, SegmentedImage, FieldColor, FieldBoundary, CameraMatrixBuffer)
+@requires(CameraImageTop, CameraImageBottom, SegmentedImage, FieldColor, FieldBoundary, CameraMatrixBuffer, GoalPostPercept)
 @uses(BallImagePercept)
 @provides(LinePercept)
 class LineDetector(Module):
     """Scan lines find thin white runs on the field; their middles, put on the ground through the
     camera matrix, are line points. A run is kept if its extent on the ground fits a 50 mm line seen at
-    a slant, which rules out robots and the ball. Then, on the ground: the centre circle (points on a
+    a slant, which rules out robots and the ball; the own feet, goal posts and ball candidates are
+    masked out before. Then, on the ground: the centre circle (points on a
     circle of the known radius, found by RANSAC), then straight segments, greedily, by RANSAC too."""
 
     @dataclass
@@ -128,6 +130,10 @@ class LineDetector(Module):
         brightest = float(np.percentile(hsv[..., 2][candidates], 99))
         white = (candidates & (hsv[..., 2] >= p.white_share * brightest)).astype(np.uint8)
         white[own_feet_mask(projection, white.shape)] = 0  # the robot's own feet are white too
+        for post in self.goal_post_percept.posts:  # and the posts, which would be lines behind the goal on the ground
+            if post.camera == camera:
+                half = post.image_width
+                white[: int(post.image_foot) + 2, max(0, int(post.image_x - half)) : int(post.image_x + half) + 1] = 0
         for ball in self.ball_image_percept.candidates:  # and so is the ball
             if ball.camera == camera:
                 cv2.circle(white, (int(ball.x), int(ball.y)), int(ball.radius * 1.4) + 2, 0, -1)

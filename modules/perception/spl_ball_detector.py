@@ -71,7 +71,9 @@ class SPLBallDetector(Module):
         above_boundary: float = bounded(0.0, 50.0, 8.0)
         """px above the field boundary still searched: a ball on the border strip reaches over it"""
         post_share: float = bounded(0.0, 1.0, 0.6)
-        """share of ball-white pixels right above a spot that makes it the foot of a goal post"""
+        """share of white pixels right above a spot that makes it the foot of a goal post ..."""
+        post_white: float = bounded(0.1, 1.0, 0.55)
+        """... white being at least this share of the image's brightest value (posts are shaded)"""
 
     def execute(self) -> None:
         found: list[BallCandidate] = []
@@ -87,8 +89,13 @@ class SPLBallDetector(Module):
             with stopwatch("SPLBallDetector:image"):
                 hsv, green = self.segmented_image.hsv(camera), self.segmented_image.green(camera)
                 spots = self.spots(green, self.field_boundary.rows(camera), projection)
+                white = float(np.percentile(hsv[..., 2][~green], 99)) if spots and (~green).any() else 255.0
                 for spot in spots:
-                    score = self.check(hsv, green, spot)
+                    score, under_post = self.check(hsv, green, spot, white)
+                    if under_post:  # perhaps a ball behind a post, merged with it in the image: look beside it
+                        beside = self.beside_post(hsv, green, spot, white)
+                        score = self.check(hsv, green, beside, white, beside_post=True)[0] if beside else 0.0
+                        spot = beside or spot
                     if DRAW_CANDIDATES:
                         drawing(f"image:{camera}").circle(spot.x, spot.y, spot.radius, color="blue" if score else "gray")
                     if score:
@@ -127,8 +134,10 @@ class SPLBallDetector(Module):
                     break
         return chosen
 
-    def check(self, hsv: np.ndarray, green: np.ndarray, spot: Spot) -> float:
-        """0 if the spot is no ball, else a score in (0, 1]: how well it fits."""
+    def check(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, beside_post: bool = False) -> tuple[float, bool]:
+        """(0 if the spot is no ball, else a score in (0, 1]: how well it fits; whether a post rises over
+        it). ``white``: the value (V) of the image's brightest non-green pixels. ``beside_post``: the
+        spot was moved off a post already (its edge may still be in the way above)."""
         p = self.parameters
         height, width = green.shape
         r = spot.radius
@@ -139,32 +148,59 @@ class SPLBallDetector(Module):
         d = np.hypot(xx - spot.x, yy - spot.y)
         inside, around = d <= 0.9 * r, (d >= 1.2 * r) & (d <= 1.7 * r)
         if inside.sum() < 3 or around.sum() < 3:
-            return 0.0
+            return 0.0, False
         patch_green, patch = green[y0:y1, x0:x1], hsv[y0:y1, x0:x1]
         green_inside, green_around = patch_green[inside].mean(), patch_green[around].mean()
         solid = inside & ~patch_green  # the ball's own pixels: green ones would count as dark next to white
         if solid.sum() < 3:
-            return 0.0
+            return 0.0, False
         value = patch[..., 2][solid].astype(float)
         bright = np.percentile(value, 90)
         dark = float((value < p.dark_ratio * bright).mean())
         saturation = float(patch[..., 1][inside].mean())
-        if self.below_a_post(hsv, green, spot, bright):
-            return 0.0
+        if not beside_post and self.post_columns(hsv, green, spot, white)[int(min(max(spot.x, 0), green.shape[1] - 1))]:
+            return 0.0, True
         if (green_inside > p.green_inside_max or green_around < p.green_around_min or not p.dark_share_min <= dark <= p.dark_share_max
                 or saturation > p.saturation_max):
-            return 0.0
-        return float(min(1.0, 0.5 + dark + 0.3 * green_around - green_inside))
+            return 0.0, False
+        return float(min(1.0, 0.5 + dark + 0.3 * green_around - green_inside)), False
 
-    def below_a_post(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, bright: float) -> bool:
-        """Whether something as white as the ball rises above the spot: a goal post (or a robot's leg)."""
-        x0, x1 = int(max(0, spot.x - 0.5 * spot.radius)), int(min(green.shape[1], spot.x + 0.5 * spot.radius + 1))
+    def post_columns(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float) -> np.ndarray:
+        """Per image column: whether something white rises above the spot's row there (a goal post, or
+        a robot's leg), judged on the rows 1.5 to 4 radii above it."""
+        p = self.parameters
         y0, y1 = int(max(0, spot.y - 4 * spot.radius)), int(max(0, spot.y - 1.5 * spot.radius))
-        if y1 - y0 < 2 or x1 <= x0:
-            return False
-        above = hsv[y0:y1, x0:x1]
-        white = (above[..., 2] >= 0.8 * bright) & (above[..., 1] <= self.parameters.saturation_max) & ~green[y0:y1, x0:x1]
-        return float(white.mean()) >= self.parameters.post_share
+        if y1 - y0 < 2:
+            return np.zeros(green.shape[1], bool)
+        above = hsv[y0:y1]
+        whites = (above[..., 2] >= p.post_white * white) & (above[..., 1] <= p.saturation_max) & ~green[y0:y1]
+        return whites.mean(axis=0) >= p.post_share
+
+    def beside_post(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float) -> Spot | None:
+        """Where a ball seen next to a post (partly behind it) has its centre. A post hides a vertical
+        strip of it, so the row where the non-green run leaving the post's side is longest is the
+        ball's centre row, and that run ends at its far edge, one radius from the centre."""
+        posts = self.post_columns(hsv, green, spot, white)
+        height, width = green.shape
+        first = max(0, int(spot.x - 2 * spot.radius))
+        post = np.nonzero(posts[first : int(spot.x + 2 * spot.radius) + 1])[0]
+        if len(post) == 0:
+            return None
+        best: tuple[int, float, int] | None = None  # (extent px, centre x, row)
+        for row in range(max(0, int(spot.y - 2 * spot.radius)), min(height, int(spot.y + 2 * spot.radius) + 1)):
+            solid = ~green[row] & ~posts
+            for edge, step in ((first + int(post.max()) + 1, 1), (first + int(post.min()) - 1, -1)):
+                if not (0 <= edge < width and solid[edge]):
+                    continue
+                far = edge
+                while 0 <= far + step < width and solid[far + step]:
+                    far += step
+                extent = abs(far - edge) + 1
+                if extent <= 2 * spot.expected + 2 and (best is None or extent > best[0]):
+                    best = (extent, far - step * spot.expected, row)
+        if best is None or best[0] < 0.5 * spot.expected:
+            return None
+        return Spot(float(best[1]), float(best[2]), spot.expected, spot.expected)
 
     @staticmethod
     def candidate(camera: str, image: CameraImage, spot: Spot, score: float) -> BallCandidate:

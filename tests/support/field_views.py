@@ -1,0 +1,56 @@
+"""Synthetic percepts of the field from a known pose: what perfect detectors would report, with noise.
+
+Module tests of the localization feed these to ``SelfLocator`` through the mocked blackboard, so
+that the filter is tested apart from the images.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tafel.representations import field
+from tafel.representations.perception import GoalPost, GoalPostPercept, LinePercept, LineSegment
+
+VIEW = math.radians(30.0)  # half the angle one camera image covers
+REACH = 3500.0  # mm
+
+
+def to_robot(pose: tuple[float, float, float], points: np.ndarray) -> np.ndarray:
+    x, y, rotation = pose
+    c, s = math.cos(rotation), math.sin(rotation)
+    d = points - np.array([x, y])
+    return np.column_stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]])
+
+
+def visible(points: np.ndarray, head: float = 0.0, reach: float = REACH) -> np.ndarray:
+    """Which robot-frame points the robot sees with its head turned by ``head`` (rad)."""
+    distance = np.hypot(points[:, 0], points[:, 1])
+    bearing = np.abs(np.remainder(np.arctan2(points[:, 1], points[:, 0]) - head + math.pi, math.tau) - math.pi)
+    return (distance > 200.0) & (distance < reach) & (bearing < VIEW)
+
+
+def line_percept(pose: tuple[float, float, float], rng: np.random.Generator, noise: float = 20.0, head: float = 0.0) -> LinePercept:
+    """Points every 100 mm along every marking the robot sees, with the segments they form."""
+    percept = LinePercept(segments=[])
+    points = []
+    for x1, y1, x2, y2 in field.all_markings():
+        steps = max(2, int(math.hypot(x2 - x1, y2 - y1) / 100.0))
+        along = np.linspace(0.0, 1.0, steps)[:, None]
+        seen = to_robot(pose, np.array([x1, y1]) + along * np.array([x2 - x1, y2 - y1]))
+        seen = seen[visible(seen, head)]
+        points.append(seen)
+        if len(seen) >= 5 and (x1, y1, x2, y2) in field.line_segments():
+            percept.segments.append(LineSegment(*seen[0], *seen[-1]))
+    all_points = np.concatenate(points)
+    percept.points = (all_points + rng.normal(0.0, noise, all_points.shape)).astype(np.float32)
+    centre = to_robot(pose, np.zeros((1, 2)))
+    if visible(centre, head)[0]:
+        percept.circle_seen, percept.circle_x, percept.circle_y = True, float(centre[0, 0]), float(centre[0, 1])
+    return percept
+
+
+def post_percept(pose: tuple[float, float, float], head: float = 0.0) -> GoalPostPercept:
+    seen = to_robot(pose, np.array(field.goal_post_positions()))
+    return GoalPostPercept(posts=[GoalPost(float(x), float(y), "top") for x, y in seen[visible(seen, head, 6000.0)]])

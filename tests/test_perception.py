@@ -1,0 +1,247 @@
+"""The perception pipeline against rendered images with known positions (``tools.scene_frames``), and its
+parts alone: field colour, field boundary, image geometry, the SPL ball's texture.
+
+Rendered scenes are posed kinematically (no physics), so each takes a few milliseconds. MuJoCo runs in
+the fast tier; the same checks on PyBullet are marked slow.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+
+import cv2
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tafel.core.testing import ModuleHarness
+from tafel.modules.modeling.field_model import FIELD_MODEL
+from tafel.modules.perception.field_boundary_detector import FieldBoundaryDetector, lower_hull
+from tafel.modules.perception.field_color_provider import FieldColorProvider
+from tafel.modules.perception.image_geometry import ImageProjection
+from tafel.modules.perception.line_detector import longest_arc, white_runs
+from tafel.platforms.field_world import ball_is_black, ball_texture
+from tafel.representations import field
+from tafel.representations.motion import CameraMatrix
+from tafel.representations.perception import (
+    BallPercept,
+    CameraImageBottom,
+    CameraImageTop,
+    FieldBoundary,
+    FieldColor,
+    GoalPostPercept,
+    LinePercept,
+    SegmentedImage,
+)
+from tafel.tools.scene_frames import Perception, SceneRenderer
+
+ENGINES = ["mujoco", pytest.param("pybullet", marks=pytest.mark.slow)]
+
+
+@pytest.fixture(scope="module", params=ENGINES)
+def renderer(request: pytest.FixtureRequest) -> Iterator[SceneRenderer]:
+    with SceneRenderer(request.param) as scene:
+        yield scene
+
+
+def percepts(renderer: SceneRenderer, pose: tuple[float, float, float], head: tuple[float, float], ball: tuple[float, float]):
+    frames = renderer.frames(pose, head, ball)
+    perception = Perception()
+    for _ in range(3):  # the field colour settles over a few frames, as in the program
+        board = perception(frames)
+    return frames, board
+
+
+# ------------------------------------------------------------------------------------------ ball
+@pytest.mark.parametrize("distance", [500.0, 1000.0, 2000.0, 3000.0, 4000.0])
+def test_the_spl_ball_is_found_where_it_is(renderer: SceneRenderer, distance: float) -> None:
+    pose = (-2500.0, -500.0, 0.3)
+    bearing = pose[2] + 0.15
+    ball = (pose[0] + distance * math.cos(bearing), pose[1] + distance * math.sin(bearing))
+    head = (0.15, 0.45 if distance < 700 else 0.25 if distance < 1500 else 0.05)
+    frames, board = percepts(renderer, pose, head, ball)
+    truth = frames["top"].ball
+    percept = board[BallPercept]
+    assert max(f.ball_visible for f in frames.values()) > 0.9, "the scene must show the ball"
+    assert percept.seen
+    assert math.hypot(percept.x - truth[0], percept.y - truth[1]) < max(60.0, 0.08 * distance)
+
+
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_a_ball_half_out_of_the_image_is_still_found(renderer: SceneRenderer, side: float) -> None:
+    pose, ball = (-2000.0, 0.0, 0.0), (-500.0, 0.0)
+    # turn the head until the ball sits on the image's edge, between half and nine tenths in view
+    for yaw in np.arange(0.45, 0.6, 0.005):
+        frames = renderer.frames(pose, (side * yaw, 0.1), ball)
+        if 0.55 <= frames["top"].ball_visible <= 0.9:
+            break
+    else:
+        pytest.fail("no head yaw puts the ball on the image's edge")
+    perception = Perception()
+    for _ in range(3):
+        board = perception(frames)
+    assert board[BallPercept].seen
+    assert math.hypot(board[BallPercept].x - 1500.0, board[BallPercept].y) < 150.0
+
+
+def test_a_ball_partly_behind_a_goal_post_is_still_found(renderer: SceneRenderer) -> None:
+    post = field.goal_post_positions()[0]
+    pose = (post[0] - 1200.0, post[1], 0.0)
+    ball = (post[0] + 120.0, post[1] - 60.0)  # inside the goal, its left part hidden by the post
+    frames, board = percepts(renderer, pose, (0.0, 0.3), ball)
+    assert 0.5 <= frames["top"].ball_visible <= 0.9, frames["top"].ball_visible
+    assert board[BallPercept].seen
+    truth = frames["top"].ball
+    assert math.hypot(board[BallPercept].x - truth[0], board[BallPercept].y - truth[1]) < 200.0
+
+
+@pytest.mark.parametrize(("pose", "head"), [
+    ((3000.0, 0.0, 0.0), (0.0, 0.25)),  # the penalty mark, the penalty area and the goal ahead
+    ((-600.0, 0.0, 0.0), (0.0, 0.3)),  # the centre circle, the centre mark and the halfway line
+    ((-4000.0, -2000.0, 0.8), (0.3, 0.3)),  # the penalty area's corner, the goal area, a post
+    ((-1500.0, 0.0, 0.0), (0.0, 0.5)),  # looking down at the own feet
+])
+def test_no_ball_where_there_is_none(renderer: SceneRenderer, pose: tuple[float, float, float], head: tuple[float, float]) -> None:
+    frames, board = percepts(renderer, pose, head, (pose[0] - 2000.0 * math.cos(pose[2]), pose[1] - 2000.0 * math.sin(pose[2])))
+    assert max(f.ball_pixels for f in frames.values()) == 0
+    assert not board[BallPercept].seen
+
+
+def test_the_orange_ball_needs_the_orange_detector() -> None:
+    with SceneRenderer("mujoco", ball_color="orange") as scene:
+        frames = scene.frames((-1500.0, 0.0, 0.0), (0.0, 0.25), (0.0, 100.0))
+        assert not Perception("SPLBallDetector")(frames)[BallPercept].seen
+        board = Perception("BallDetector")(frames)
+        assert board[BallPercept].seen and math.hypot(board[BallPercept].x - 1500.0, board[BallPercept].y - 100.0) < 120.0
+
+
+# ----------------------------------------------------------------------------- lines and posts
+def to_field(pose: tuple[float, float, float], points: np.ndarray) -> np.ndarray:
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    return np.column_stack([pose[0] + c * points[:, 0] - s * points[:, 1], pose[1] + s * points[:, 0] + c * points[:, 1]])
+
+
+@pytest.mark.parametrize(("pose", "head"), [((-2000.0, 300.0, 0.1), (0.0, 0.2)), ((-3300.0, -1800.0, 2.0), (-0.4, 0.3)),
+                                            ((1200.0, 1000.0, -2.6), (0.3, 0.1))])
+def test_line_points_lie_on_the_field_lines(renderer: SceneRenderer, pose: tuple[float, float, float], head: tuple[float, float]) -> None:
+    _, board = percepts(renderer, pose, head, (5000.0, 3500.0))
+    lines = board[LinePercept]
+    points = np.asarray(lines.points, float)
+    assert len(points) >= 30
+    distance = FIELD_MODEL.line_distance(to_field(pose, points))
+    assert np.median(distance) < 40.0 and np.mean(distance < 150.0) > 0.9
+    assert lines.segments
+    for segment in lines.segments:
+        ends = to_field(pose, np.array([[segment.x1, segment.y1], [segment.x2, segment.y2]]))
+        assert np.all(FIELD_MODEL.line_distance(ends) < 300.0)
+
+
+def test_the_centre_circle_is_found_where_it_is(renderer: SceneRenderer) -> None:
+    pose = (-1700.0, 200.0, 0.05)
+    _, board = percepts(renderer, pose, (0.0, 0.2), (4000.0, 3000.0))
+    lines = board[LinePercept]
+    assert lines.circle_seen
+    centre = to_field(pose, np.array([[lines.circle_x, lines.circle_y]]))[0]
+    assert math.hypot(*centre) < 150.0
+
+
+def test_both_posts_of_the_goal_ahead_are_found(renderer: SceneRenderer) -> None:
+    pose = (2000.0, 300.0, 0.05)
+    _, board = percepts(renderer, pose, (0.0, 0.0), (-4000.0, 0.0))
+    posts = board[GoalPostPercept].posts
+    assert len(posts) == 2
+    true = np.array(field.goal_post_positions()[:2])
+    for post in posts:
+        where = to_field(pose, np.array([[post.x, post.y]]))[0]
+        assert np.min(np.linalg.norm(true - where, axis=1)) < 0.06 * math.hypot(post.x, post.y)
+
+
+def test_no_posts_where_there_are_none(renderer: SceneRenderer) -> None:
+    _, board = percepts(renderer, (0.0, 0.0, math.pi / 2), (0.0, 0.1), (0.0, -1000.0))  # looking at the sideline
+    assert board[GoalPostPercept].posts == []
+
+
+# ---------------------------------------------------------------------------- the parts alone
+def field_image(green: tuple[int, int, int], boundary_row: int = 80) -> np.ndarray:
+    image = np.zeros((240, 320, 3), np.uint8)
+    image[:] = (120, 118, 115)  # a grey wall
+    image[boundary_row:] = green
+    image[150:155, :] = 255  # a line
+    return image
+
+
+@pytest.mark.parametrize("green", [(45, 140, 50), (20, 80, 25), (90, 200, 70), (60, 150, 110)])
+def test_the_field_colour_follows_the_light(green: tuple[int, int, int]) -> None:
+    image = field_image(green)
+    board = ModuleHarness(FieldColorProvider, CameraImageTop(image=image), CameraImageBottom(image=image)).execute()
+    color, segmented = board[FieldColor], board[SegmentedImage]
+    assert color.valid
+    assert segmented.top_green[200:].mean() > 0.95  # the field
+    assert segmented.top_green[:70].mean() == 0.0 and segmented.top_green[150:155].mean() == 0.0  # wall and line
+
+
+def test_no_green_no_field_colour_and_no_crash() -> None:
+    grey = np.full((240, 320, 3), 128, np.uint8)
+    board = ModuleHarness(FieldColorProvider, CameraImageTop(image=grey), CameraImageBottom(image=np.zeros((0, 0, 3), np.uint8))).execute()
+    assert not board[FieldColor].valid
+    assert board[SegmentedImage].bottom_hsv.size == 0
+
+
+def test_the_boundary_ignores_what_stands_on_the_field() -> None:
+    image = field_image((45, 140, 50), boundary_row=80)
+    image[40:180, 150:165] = 255  # a post standing on the field, rising over the boundary
+    board = ModuleHarness(FieldColorProvider, CameraImageTop(image=image), CameraImageBottom(image=image)).execute()
+    rows = ModuleHarness(FieldBoundaryDetector, board[SegmentedImage], board[FieldColor]).execute()[FieldBoundary].top
+    assert len(rows) == 320
+    assert np.all(np.abs(rows - 80) <= 4)  # also behind the post
+
+
+@given(st.lists(st.tuples(st.floats(0, 300), st.floats(0, 200)), min_size=2, max_size=40, unique_by=lambda p: p[0]))
+def test_lower_hull_is_convex_and_below_every_point(points: list[tuple[float, float]]) -> None:
+    points.sort()
+    xs, ys = np.array([p[0] for p in points]), np.array([p[1] for p in points])
+    hx, hy = lower_hull(xs, ys)
+    assert np.all(np.interp(xs, hx, hy) <= ys + 1e-6)
+    apart = np.diff(hx) > 1e-3  # slopes between points that are not on top of each other
+    slopes = np.diff(hy)[apart] / np.diff(hx)[apart]
+    assert np.all(np.diff(slopes) >= -1e-6 * (1 + np.abs(slopes[1:])))
+
+
+@given(yaw=st.floats(-1.0, 1.0), pitch=st.floats(0.1, 0.8), height=st.floats(300.0, 600.0),
+       x=st.floats(0.0, 319.0), y=st.floats(0.0, 239.0))
+@settings(max_examples=80)
+def test_pixels_to_the_ground_and_back(yaw: float, pitch: float, height: float, x: float, y: float) -> None:
+    cy, sy, cp, sp = math.cos(yaw), math.sin(yaw), math.cos(pitch), math.sin(pitch)
+    rotation = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]]) @ np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    projection = ImageProjection(CameraMatrix(rotation, np.array([0.0, 0.0, height]), True), 320, 240, math.radians(60.97), math.radians(47.64))
+    ground, hit = projection.to_ground(np.array([x]), np.array([y]))
+    if not hit[0] or np.linalg.norm(ground[0]) > 50_000:
+        return
+    pixel, front = projection.to_image(np.array([[ground[0, 0], ground[0, 1], 0.0]]))
+    assert front[0] and pixel[0] == pytest.approx([x, y], abs=1e-6)
+    assert y > projection.horizon(x) - 1e-6  # what reaches the ground lies below the horizon
+
+
+def test_white_runs_and_arcs() -> None:
+    mask = np.zeros((10, 4), bool)
+    mask[2:5, 0] = True
+    mask[7:9, 0] = True
+    mask[0:10, 2] = True
+    x, first, last = white_runs(mask, step=2)
+    assert sorted(zip(x.tolist(), first.tolist(), last.tolist())) == [(0, 2, 4), (0, 7, 8), (2, 0, 9)]
+    assert longest_arc(np.radians(np.arange(0, 100, 5)), math.radians(15)) == pytest.approx(math.radians(95))
+    assert longest_arc(np.radians([0, 60, 120, 180]), math.radians(15)) == 0.0
+    assert longest_arc(np.array([]), 0.3) == 0.0
+
+
+def test_the_spl_ball_is_white_with_black_pentagons() -> None:
+    directions = np.random.default_rng(0).normal(size=(200_000, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    share = ball_is_black(directions).mean()
+    assert 0.25 < share < 0.31  # twelve pentagons of a truncated icosahedron: 28 % of the surface
+    texture = ball_texture()
+    assert texture.shape == (256, 512, 3) and texture.dtype == np.uint8
+    grey = cv2.cvtColor(texture, cv2.COLOR_RGB2GRAY)
+    assert (grey < 60).mean() > 0.15 and (grey > 200).mean() > 0.55

@@ -1,0 +1,196 @@
+"""SelfLocator and its field model through the mocked blackboard: synthetic percepts from known poses."""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tafel.core.testing import ModuleHarness
+from tafel.modules.modeling.field_model import FIELD_MODEL, mirror
+from tafel.modules.modeling.self_locator import SelfLocator, low_variance_indices, robust
+from tafel.representations import field
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.modeling import RobotPose
+from tafel.representations.motion_control import FallDirection, FallPhase, FallState, Odometry
+from tafel.representations.perception import GoalPostPercept, LinePercept
+from tests.support.field_views import line_percept, post_percept
+
+FRAME_NS = 33_333_333
+HEADS = [0.0, 0.8, 0.0, -0.8]  # the head glances left and right now and then
+
+
+class Run:
+    """A SelfLocator fed what perfect detectors would see from a true pose that the test moves."""
+
+    def __init__(self, seed: int = 0) -> None:
+        self.harness = ModuleHarness(SelfLocator, Odometry(), LinePercept(segments=[]), GoalPostPercept(posts=[]), FrameInfo(), FallState())
+        self.rng = np.random.default_rng(seed)
+        self.frame = 0
+        self.odometry = np.zeros(3)  # x, y, rotation in the start frame
+
+    def step(self, pose: tuple[float, float, float], seeing: bool = True, head: float | None = None) -> RobotPose:
+        self.frame += 1
+        look = HEADS[(self.frame // 30) % len(HEADS)] if head is None else head
+        lines = line_percept(pose, self.rng, head=look) if seeing else LinePercept(segments=[])
+        posts = post_percept(pose, head=look) if seeing else GoalPostPercept(posts=[])
+        odometry = Odometry(x=float(self.odometry[0]), y=float(self.odometry[1]), rotation=float(self.odometry[2]))
+        self.harness.set(FrameInfo(frame_number=self.frame, time_ns=self.frame * FRAME_NS), odometry, lines, posts)
+        return copy.copy(self.harness.execute()[RobotPose])  # the blackboard's instance changes every frame
+
+    def walk(self, pose: tuple[float, float, float], forward: float, left: float, turn: float) -> tuple[float, float, float]:
+        """The true pose after a step (robot frame), with odometry that measures it."""
+        x, y, rotation = pose
+        c, s = math.cos(rotation), math.sin(rotation)
+        o = self.odometry
+        oc, os_ = math.cos(o[2]), math.sin(o[2])
+        self.odometry = np.array([o[0] + oc * forward - os_ * left, o[1] + os_ * forward + oc * left, o[2] + turn])
+        return x + c * forward - s * left, y + s * forward + c * left, math.remainder(rotation + turn, math.tau)
+
+
+def error(pose: RobotPose, truth: tuple[float, float, float]) -> tuple[float, float]:
+    """(mm, degrees) between an estimate and the truth."""
+    return math.hypot(pose.x - truth[0], pose.y - truth[1]), abs(math.degrees(math.remainder(pose.rotation - truth[2], math.tau)))
+
+
+OWN_HALF_POSES = [(-1500.0, 0.0, 0.0), (-3200.0, 1800.0, -0.7), (-600.0, -2200.0, 2.5), (-4000.0, -500.0, 1.2)]
+
+
+@pytest.mark.parametrize("truth", OWN_HALF_POSES)
+def test_finds_its_pose_in_the_own_half_and_says_when_it_is_sure(truth: tuple[float, float, float]) -> None:
+    run = Run()
+    poses = [run.step(truth) for _ in range(150)]  # 5 s
+    assert not poses[0].valid  # nothing is trusted at once
+    final = poses[-1]
+    assert final.valid and not final.lost
+    distance, degrees = error(final, truth)
+    assert distance < 100.0 and degrees < 5.0
+    assert final.deviation < 350.0
+    first_valid = next(i for i, p in enumerate(poses) if p.valid)
+    assert all(error(p, truth)[0] < 250.0 for p in poses[first_valid:])  # once valid, never far off
+
+
+def test_the_symmetric_twin_in_the_other_half_is_never_chosen() -> None:
+    """Turned by 180 degrees about the centre spot the field looks the same: the own half decides."""
+    for seed in range(3):
+        run = Run(seed)
+        truth = (-2500.0, 1000.0, 0.4)
+        for _ in range(150):
+            pose = run.step(truth)
+        assert pose.valid and pose.x < 0 and error(pose, truth)[0] < 150.0
+
+
+def test_follows_the_walk_by_odometry_between_percepts() -> None:
+    run = Run()
+    truth = (-2000.0, -1000.0, 0.0)
+    for _ in range(120):
+        run.step(truth)
+    for i in range(150):  # 5 s of walking a curve, seeing nothing in two of three frames
+        truth = run.walk(truth, 8.0, 1.0, 0.01)
+        pose = run.step(truth, seeing=i % 3 == 0)
+        distance, degrees = error(pose, truth)
+        assert distance < 200.0 and degrees < 10.0, (i, distance, degrees)
+
+
+def test_a_kidnapped_robot_says_it_is_lost_and_finds_itself_again() -> None:
+    run = Run()
+    start, elsewhere = (-1500.0, 0.0, 0.0), (-3500.0, 2000.0, -1.5)
+    for _ in range(120):
+        run.step(start)
+    lost_seen, recovered_at = False, None
+    for i in range(300):  # 10 s carried elsewhere; odometry knows nothing of it
+        pose = run.step(elsewhere)
+        lost_seen |= pose.lost
+        if recovered_at is None and pose.valid and error(pose, elsewhere)[0] < 200.0:
+            recovered_at = i
+    assert lost_seen
+    assert recovered_at is not None and recovered_at * FRAME_NS * 1e-9 < 8.0
+    assert error(pose, elsewhere)[0] < 150.0
+
+
+def test_seeing_nothing_keeps_the_pose() -> None:
+    run = Run()
+    truth = (-1000.0, 1500.0, -0.5)
+    for _ in range(120):
+        run.step(truth)
+    for _ in range(150):
+        pose = run.step(truth, seeing=False)
+    assert pose.valid and error(pose, truth)[0] < 100.0
+
+
+def test_a_fall_turns_the_belief_and_percepts_while_lying_are_ignored() -> None:
+    run = Run()
+    truth = (-2000.0, 500.0, 0.3)
+    for _ in range(120):
+        run.step(truth)
+    run.harness.set(FallState(phase=FallPhase.lying_front, direction=FallDirection.front))
+    wrong = (1000.0, -2000.0, 2.0)  # what a lying robot's camera matrix makes of the field
+    for _ in range(30):
+        run.step(wrong)
+    run.harness.set(FallState())
+    for _ in range(150):
+        pose = run.step(truth)
+    assert pose.valid and error(pose, truth)[0] < 150.0
+
+
+def test_bad_percepts_do_not_break_it() -> None:
+    run = Run()
+    truth = (-1500.0, 0.0, 0.0)
+    for _ in range(60):
+        run.step(truth)
+    junk = LinePercept(segments=[], points=np.array([[np.nan, 1.0], [np.inf, -np.inf], [1e12, 5.0]], np.float32),
+                       circle_seen=True, circle_x=float("nan"), circle_y=0.0)
+    run.harness.set(junk)
+    pose = run.harness.execute()[RobotPose]
+    assert all(math.isfinite(v) for v in (pose.x, pose.y, pose.rotation, pose.deviation))
+
+
+# ------------------------------------------------------------------------------------ properties
+poses = st.tuples(st.floats(-5000, 5000), st.floats(-3500, 3500), st.floats(-math.pi, math.pi))
+
+
+@given(pose=poses, towards=poses)
+def test_mirror_picks_the_pose_or_its_twin_whichever_is_nearer(pose: tuple, towards: tuple) -> None:
+    chosen = mirror(np.array([pose]), towards)[0]
+    twin = (-pose[0], -pose[1], math.remainder(pose[2] + math.pi, math.tau))
+    candidates = [pose, twin]
+    nearest = min(candidates, key=lambda c: math.hypot(c[0] - towards[0], c[1] - towards[1]))
+    assert chosen[:2] == pytest.approx(nearest[:2])
+    assert math.remainder(chosen[2] - nearest[2], math.tau) == pytest.approx(0.0, abs=1e-9)
+
+
+@given(st.lists(st.floats(0.0, 1.0), min_size=1, max_size=50))
+@settings(max_examples=60)
+def test_low_variance_resampling_keeps_shares(raw: list[float]) -> None:
+    weights = np.array(raw) + 1e-3
+    weights /= weights.sum()
+    picked = low_variance_indices(weights, np.random.default_rng(0))
+    counts = np.bincount(picked, minlength=len(weights))
+    assert np.all(np.abs(counts - weights * len(weights)) <= 1.0 + 1e-9)  # systematic: off by at most one
+
+
+def test_robust_likelihood_is_flat_beyond_a_few_deviations() -> None:
+    assert robust(np.array([0.0]))[0] == 0.0
+    assert robust(np.array([3.0]))[0] == robust(np.array([300.0]))[0] < robust(np.array([1.0]))[0]
+
+
+def test_the_distance_map_is_zero_on_lines_and_grows_off_them() -> None:
+    on = np.array([[0.0, 0.0], [field.LENGTH / 2, 1000.0], [-2000.0, field.WIDTH / 2], [750.0, 0.0]])
+    assert np.all(FIELD_MODEL.line_distance(on) <= 20.0)
+    assert FIELD_MODEL.line_distance(np.array([[-1200.0, 1800.0]]))[0] == pytest.approx(1200.0, abs=30.0)
+    assert FIELD_MODEL.line_distance(np.array([[99999.0, 0.0]]))[0] >= 1000.0  # off the carpet
+
+
+def test_poses_made_from_percepts_include_the_true_one() -> None:
+    rng = np.random.default_rng(1)
+    truth = (-2000.0, 800.0, 0.6)
+    for head in (0.0, 1.0):
+        lines, posts = line_percept(truth, rng, noise=0.0, head=head), post_percept(truth, head=head)
+        made = mirror(FIELD_MODEL.poses_from_percepts(rng, 2000, lines, posts), towards=(-2250.0, 0.0, 0.0))
+        near = np.hypot(made[:, 0] - truth[0], made[:, 1] - truth[1]) < 250.0
+        turned = np.abs(np.remainder(made[:, 2] - truth[2] + math.pi, math.tau) - math.pi) < 0.15
+        assert (near & turned).any()
