@@ -13,6 +13,7 @@ import multiprocessing
 import os
 import pkgutil
 import queue
+import re
 import sys
 import threading
 import time
@@ -747,11 +748,27 @@ class PipeSafeStream:
         return getattr(self._stream, name)
 
 
+#: a value made of numbers and commas that starts with a minus sign: -1500,0,0
+NEGATIVE_LIST = re.compile(r"^-\d[\d.]*(,-?[\d.]+)+$")
+
+
+def join_negative_values(argv: Sequence[str]) -> list[str]:
+    """``--start -3000,-1500,0`` as ``--start=-3000,-1500,0``: argparse takes a value that starts with a
+    minus sign for an option, and most of the own half has negative x."""
+    out: list[str] = []
+    for token in argv:
+        if out and out[-1].startswith("--") and "=" not in out[-1] and NEGATIVE_LIST.match(token):
+            out[-1] = f"{out[-1]}={token}"
+        else:
+            out.append(token)
+    return out
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     if not isinstance(sys.stdout, PipeSafeStream) and sys.stdout is not None:
         sys.stdout = PipeSafeStream(sys.stdout)
     parser = build_parser()
-    args, extra = parser.parse_known_args(argv)
+    args, extra = parser.parse_known_args(join_negative_values(sys.argv[1:] if argv is None else argv))
     if extra and args.command == "platforms":
         parser.error(f"unrecognized arguments: {' '.join(extra)}")
     try:

@@ -30,8 +30,8 @@ from tafel.platforms.simulated import SimulatedRobotPlatform
 from tafel.representations import field as spl
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, CameraMatrix, CameraMatrixBottom, CameraMatrixBuffer, CameraMatrixTop
-from tafel.representations.perception import CameraImageBottom, CameraImageTop
 from tafel.representations.nao import BOTTOM_CAMERA, TOP_CAMERA
+from tafel.representations.perception import CameraImageBottom, CameraImageTop
 
 CAMERAS = {"top": TOP_CAMERA, "bottom": BOTTOM_CAMERA}
 #: how far from the centre spot random balls lie (mm): on the field, or just over its lines

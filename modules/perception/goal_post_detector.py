@@ -8,7 +8,7 @@ import numpy as np
 
 from tafel.core import Module, bounded, provides, requires
 from tafel.debug import drawing, request
-from tafel.modules.perception.image_geometry import ImageProjection
+from tafel.modules.perception.image_geometry import ImageProjection, camera_views
 from tafel.representations.field import GOAL_POST_DIAMETER
 from tafel.representations.motion import CameraMatrixBuffer
 from tafel.representations.perception import (
@@ -53,14 +53,12 @@ class GoalPostDetector(Module):
 
     def execute(self) -> None:
         self.goal_post_percept.posts = []
-        for camera, image in (("top", self.camera_image_top), ("bottom", self.camera_image_bottom)):
-            pixels = np.asarray(image.image)
-            matrix = self.camera_matrix_buffer.at(camera, image.time_ns)
+        if not self.field_color.valid:
+            return
+        for camera, _, projection in camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer):
             boundary = self.field_boundary.rows(camera)
-            if pixels.ndim != 3 or pixels.size == 0 or not matrix.valid or boundary.size != pixels.shape[1] or not self.field_color.valid:
+            if boundary.size != projection.width:
                 continue
-            height, width = pixels.shape[:2]
-            projection = ImageProjection(matrix, width, height, image.horizontal_fov, image.vertical_fov)
             self.goal_post_percept.posts += self.posts(camera, boundary, projection)
         self.goal_post_percept.posts.sort(key=lambda post: post.x * post.x + post.y * post.y)
 

@@ -8,12 +8,14 @@ distortion, described by the image size and the field of view.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 import cv2
 import numpy as np
 
-from tafel.representations.motion import CameraMatrix
+from tafel.representations.motion import CameraMatrix, CameraMatrixBuffer
 from tafel.representations.nao import FOOT_HEIGHT, HIP_OFFSET_Y, SOLE_BACK, SOLE_FRONT, SOLE_OUTSIDE
+from tafel.representations.perception import CameraImage
 
 
 def focal_lengths(width: int, height: int, horizontal_fov: float, vertical_fov: float) -> tuple[float, float]:
@@ -77,22 +79,42 @@ class ImageProjection:
         return self.height / 2 - v * self.fy
 
 
-#: where the robot's own feet can be in the robot frame (mm): the soles' outline with the walk's reach
-#: (steps of 60 mm either way) and the feet's height, as a box
+#: where the robot's own body can be in the robot frame (mm), as boxes ((x0, x1), (y0, y1), (z0, z1)): both
+#: feet with the walk's reach (steps of 60 mm either way), the legs, and each arm hanging beside the
+#: torso as the stand and the walk hold it. A camera sees these parts when it looks down or aside.
 FEET_REACH = 60.0
-FEET_BOX = ((-SOLE_BACK - FEET_REACH, SOLE_FRONT + FEET_REACH), (-(HIP_OFFSET_Y + SOLE_OUTSIDE + FEET_REACH), HIP_OFFSET_Y + SOLE_OUTSIDE + FEET_REACH),
-            (0.0, FOOT_HEIGHT + 20.0))
+BODY_BOXES = (
+    ((-SOLE_BACK - FEET_REACH, SOLE_FRONT + FEET_REACH), (-(HIP_OFFSET_Y + SOLE_OUTSIDE + FEET_REACH), HIP_OFFSET_Y + SOLE_OUTSIDE + FEET_REACH),
+     (0.0, FOOT_HEIGHT + 20.0)),
+    ((-90.0, 130.0), (-(HIP_OFFSET_Y + 70.0), HIP_OFFSET_Y + 70.0), (0.0, 340.0)),
+    ((-130.0, 170.0), (60.0, 240.0), (120.0, 460.0)),
+    ((-130.0, 170.0), (-240.0, -60.0), (120.0, 460.0)),
+)
 
 
-def own_feet_mask(projection: ImageProjection, shape: tuple[int, int]) -> np.ndarray:
-    """Where the robot's own feet may show in an image (h x w bool): detectors must not take them for
-    lines or balls. A box round both feet projected into the image (the body contour teams use, for
-    the part of the body a camera can see)."""
+def own_body_mask(projection: ImageProjection, shape: tuple[int, int]) -> np.ndarray:
+    """Where the robot's own body may show in an image (h x w bool): detectors must not take its feet
+    and arms for lines. Boxes round the feet, legs and arms projected into the image (the body
+    contour teams use, for the parts of the body a camera can see)."""
     mask = np.zeros(shape, np.uint8)
-    corners = np.array([(x, y, z) for x in FEET_BOX[0] for y in FEET_BOX[1] for z in FEET_BOX[2]], dtype=float)
-    pixels, front = projection.to_image(corners)
-    if front.sum() < 3:
-        return mask.astype(bool)
-    hull = cv2.convexHull(np.clip(pixels[front], -1e4, 1e4).astype(np.int32))
-    cv2.fillConvexPoly(mask, hull, 1)
+    for points in BODY_POINTS:
+        pixels, front = projection.to_image(points)
+        if front.sum() >= 3:  # the part of the box in front of the camera (a grid of points: boxes reach behind it)
+            cv2.fillConvexPoly(mask, cv2.convexHull(np.clip(pixels[front], -1e4, 1e4).astype(np.int32)), 1)
     return mask.astype(bool)
+
+
+#: each box of ``BODY_BOXES`` as a grid of points, so that the part in front of a camera can be projected
+BODY_POINTS = [np.array(np.meshgrid(*(np.linspace(low, high, 6) for low, high in box))).reshape(3, -1).T for box in BODY_BOXES]
+
+
+def camera_views(top: CameraImage, bottom: CameraImage, buffer: CameraMatrixBuffer) -> Iterator[tuple[str, CameraImage, ImageProjection]]:
+    """(camera, image, projection) for each camera whose image is there and whose matrix at the image's
+    time is known: what every detector that works on the ground loops over."""
+    for camera, image in (("top", top), ("bottom", bottom)):
+        pixels = np.asarray(image.image)
+        if pixels.ndim != 3 or pixels.size == 0 or image.horizontal_fov <= 0:
+            continue
+        matrix = buffer.at(camera, image.time_ns)
+        if matrix.valid and np.isfinite(matrix.rotation).all() and np.isfinite(matrix.translation).all():
+            yield camera, image, ImageProjection(matrix, pixels.shape[1], pixels.shape[0], image.horizontal_fov, image.vertical_fov)

@@ -10,12 +10,11 @@ import numpy as np
 
 from tafel.core import Module, bounded, provides, requires, uses
 from tafel.debug import drawing, request, stopwatch
-from tafel.modules.perception.image_geometry import ImageProjection, own_feet_mask
+from tafel.modules.perception.image_geometry import ImageProjection, camera_views, own_body_mask
 from tafel.representations.field import CENTER_CIRCLE_DIAMETER, LINE_WIDTH
 from tafel.representations.motion import CameraMatrixBuffer
 from tafel.representations.perception import (
     BallImagePercept,
-    CameraImage,
     CameraImageBottom,
     CameraImageTop,
     FieldBoundary,
@@ -94,7 +93,8 @@ class LineDetector(Module):
 
     def execute(self) -> None:
         out = self.line_percept
-        points = [self.points(camera, image) for camera, image in (("top", self.camera_image_top), ("bottom", self.camera_image_bottom))]
+        views = camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer) if self.field_color.valid else ()
+        points = [np.zeros((0, 2)), *(self.points(camera, projection) for camera, _, projection in views)]
         found = np.concatenate(points)
         if len(found) > self.parameters.max_points:  # evenly thinned: near and far points alike
             found = found[np.linspace(0, len(found) - 1, self.parameters.max_points).astype(int)]
@@ -110,17 +110,10 @@ class LineDetector(Module):
             if out.circle_seen:
                 canvas.circle(out.circle_x, out.circle_y, CIRCLE_RADIUS, color="white", width=3)
 
-    def points(self, camera: str, image: CameraImage) -> np.ndarray:
+    def points(self, camera: str, projection: ImageProjection) -> np.ndarray:
         """Line points (N x 2, mm, robot frame) of one camera's image."""
         p = self.parameters
-        pixels = np.asarray(image.image)
-        if pixels.ndim != 3 or pixels.size == 0 or not self.field_color.valid:
-            return np.zeros((0, 2))
-        matrix = self.camera_matrix_buffer.at(camera, image.time_ns)
-        if not matrix.valid or image.horizontal_fov <= 0:
-            return np.zeros((0, 2))
-        height, width = pixels.shape[:2]
-        projection = ImageProjection(matrix, width, height, image.horizontal_fov, image.vertical_fov)
+        height, width = projection.height, projection.width
         hsv = self.segmented_image.hsv(camera)
         boundary = self.field_boundary.rows(camera)
         on_field = np.arange(height)[:, None] >= (boundary[None, :] if boundary.size == width else 0)
@@ -129,7 +122,7 @@ class LineDetector(Module):
             return np.zeros((0, 2))
         brightest = float(np.percentile(hsv[..., 2][candidates], 99))
         white = (candidates & (hsv[..., 2] >= p.white_share * brightest)).astype(np.uint8)
-        white[own_feet_mask(projection, white.shape)] = 0  # the robot's own feet are white too
+        white[own_body_mask(projection, white.shape)] = 0  # the robot's own feet and arms are white too
         for post in self.goal_post_percept.posts:  # and the posts, which would be lines behind the goal on the ground
             if post.camera == camera:
                 half = post.image_width

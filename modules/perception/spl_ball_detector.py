@@ -10,7 +10,7 @@ import numpy as np
 
 from tafel.core import Module, bounded, provides, requires
 from tafel.debug import drawing, request, stopwatch
-from tafel.modules.perception.image_geometry import ImageProjection
+from tafel.modules.perception.image_geometry import ImageProjection, camera_views
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import CameraMatrixBuffer
 from tafel.representations.perception import (
@@ -77,15 +77,10 @@ class SPLBallDetector(Module):
 
     def execute(self) -> None:
         found: list[BallCandidate] = []
-        for camera, image in (("top", self.camera_image_top), ("bottom", self.camera_image_bottom)):
-            pixels = np.asarray(image.image)
-            if pixels.ndim != 3 or pixels.size == 0 or not self.field_color.valid:
-                continue
-            matrix = self.camera_matrix_buffer.at(camera, image.time_ns)
-            if not matrix.valid or image.horizontal_fov <= 0:
-                continue
-            height, width = pixels.shape[:2]
-            projection = ImageProjection(matrix, width, height, image.horizontal_fov, image.vertical_fov)
+        self.ball_image_percept.candidates = found
+        if not self.field_color.valid:
+            return
+        for camera, image, projection in camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer):
             with stopwatch("SPLBallDetector:image"):
                 hsv, green = self.segmented_image.hsv(camera), self.segmented_image.green(camera)
                 spots = self.spots(green, self.field_boundary.rows(camera), projection)
@@ -101,7 +96,6 @@ class SPLBallDetector(Module):
                     if score:
                         found.append(self.candidate(camera, image, spot, score))
         found.sort(key=lambda c: -c.fill)
-        self.ball_image_percept.candidates = found
 
     def spots(self, green: np.ndarray, boundary: np.ndarray, projection: ImageProjection) -> list[Spot]:
         """Peaks of the non-green field's distance transform whose thickness fits a ball there."""

@@ -1,0 +1,183 @@
+"""Perception and self-localization against simulator ground truth (MuJoCo by default).
+
+- Ball detector precision and recall on rendered scenes (``tools.scene_frames``): the robot anywhere
+  on the field, the head anywhere it can look, the ball 0.3 to 5 m away, so lines, goal posts, the
+  penalty marks and the robot's own feet come into view. Precision over every frame in which a ball
+  was reported; recall over the frames that show a ball within 4 m, at least half of it visible.
+- Localization error along the route of ``tests/test_localization.py`` (eight waypoints, walked by
+  ``walk_to`` requests), sampled every cognition frame once the pose is valid: mean and p95.
+- Kidnap recovery: the robot carried to three places in its own half, the time until its pose is
+  within 200 mm and 10 degrees of the truth again.
+- Cognition frame time (all modules of the frame, measured by the module manager) p95 at 320x240,
+  and the real-time factor of the whole program with both cameras rendered, along the route.
+
+    python benchmarks/localization.py [--frames 600] [--engine mujoco]
+
+Prints one JSON line. Targets: precision >= 0.97, recall >= 0.90, route error mean <= 100 mm and
+<= 5 degrees, p95 <= 250 mm, kidnap recovery <= 10 s, frame time p95 <= 25 ms, real-time factor >= 1.0.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(REPO))
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+from tafel.representations.modeling import RobotPose  # noqa: E402
+from tafel.representations.motion_control import MotionRequest, MotionType  # noqa: E402
+from tafel.representations.perception import BallPercept  # noqa: E402
+from tafel.tools.scene_frames import Perception, SceneRenderer  # noqa: E402
+from tests.support.simulation import Simulation  # noqa: E402
+from tests.test_localization import ROUTE  # noqa: E402
+
+KIDNAPS = [(-3500.0, 1800.0, -2.2), (-1000.0, -2200.0, 1.0), (-2500.0, 0.0, 3.0)]
+
+
+def ball_detection(engine: str, frames: int, seed: int = 0) -> dict[str, float]:
+    """Precision and recall of the whole ball pipeline (SPLBallDetector, BallLocator) on rendered scenes."""
+    true_positive = false_positive = shown = found = 0
+    with SceneRenderer(engine) as renderer:
+        perception = Perception()
+        rng = np.random.default_rng(seed)
+        scenes = 0
+        while scenes < frames:
+            pose = (rng.uniform(-4300, 4300), rng.uniform(-2800, 2800), rng.uniform(-math.pi, math.pi))
+            head = (rng.uniform(-0.8, 0.8), rng.uniform(-0.3, 0.45))
+            distance, bearing = rng.uniform(300.0, 5000.0), pose[2] + head[0] + rng.normal(0.0, 0.5)
+            ball = (pose[0] + distance * math.cos(bearing), pose[1] + distance * math.sin(bearing))
+            if abs(ball[0]) > 4800 or abs(ball[1]) > 3300:
+                continue
+            scenes += 1
+            views = renderer.frames(pose, head, ball)
+            percept = perception(views)[BallPercept]
+            truth = views["top"].ball  # the same robot-frame position for both cameras
+            close = math.hypot(percept.x - truth[0], percept.y - truth[1]) < max(150.0, 0.1 * distance)
+            in_view = max(v.ball_pixels for v in views.values()) > 0
+            if percept.seen:
+                true_positive += close and in_view
+                false_positive += not (close and in_view)
+            if distance <= 4000.0 and max(v.ball_visible for v in views.values()) >= 0.5:
+                shown += 1
+                found += percept.seen and close
+    return {"ball_frames": frames, "ball_frames_showing_a_ball": shown, "ball_precision": round(true_positive / max(1, true_positive + false_positive), 4),
+            "ball_recall": round(found / max(1, shown), 4), "ball_false_positives": false_positive}
+
+
+class Walker:
+    """The program with both cameras, its MotionRequest set in motion each frame (as ``motion:walk_to``)."""
+
+    def __init__(self, engine: str, start: str) -> None:
+        self.sim = Simulation(engine, start=start, ball="4000,2500")
+        self.request = MotionRequest(motion=MotionType.stand)
+        motion = self.sim.blackboard("motion")
+        self.sim.runtime.runners["motion"].manager.before_frame.append(lambda: motion.set(self.request))
+        cognition = self.sim.runtime.runners["cognition"].manager
+        self.frame_ms: list[float] = []
+        cognition.after_frame.append(lambda: self.frame_ms.append(sum(cognition.last_times_ms()[1])))
+
+    def pose_error(self) -> tuple[bool, float, float]:
+        pose = self.sim.blackboard("cognition")[RobotPose]
+        x, y, heading = self.sim.platform.robot_pose()
+        return pose.valid, math.hypot(pose.x - x, pose.y - y), abs(math.remainder(pose.rotation - heading, math.tau))
+
+    def walk_to(self, target: tuple[float, float]) -> None:
+        x, y, heading = self.sim.platform.robot_pose()
+        c, s = math.cos(heading), math.sin(heading)
+        dx, dy = target[0] - x, target[1] - y
+        self.request = MotionRequest(motion=MotionType.walk_to, target_x=c * dx + s * dy, target_y=-s * dx + c * dy)
+
+
+def route(engine: str) -> dict[str, float]:
+    walker = Walker(engine, "-3000,-1500,0")
+    sim = walker.sim
+    errors: list[tuple[float, float]] = []
+    invalid = 0
+
+    def sample(s: Simulation) -> None:
+        nonlocal invalid
+        if s.runtime.runners["motion"].frames % 3 == 0:  # about once per cognition frame
+            valid, distance, angle = walker.pose_error()
+            errors.append((distance, angle))
+            invalid += not valid
+
+    try:
+        for _ in range(100):  # the first fix
+            sim.run(0.1)
+            if walker.pose_error()[0]:
+                break
+        started, wall = sim.time, time.perf_counter()
+        for target in ROUTE:
+            walker.walk_to(target)
+            for _ in range(250):
+                sim.run(0.1, sample)
+                x, y, _ = sim.platform.robot_pose()
+                if math.hypot(x - target[0], y - target[1]) < 150.0:
+                    break
+        realtime = (sim.time - started) / (time.perf_counter() - wall)
+        distances, angles = np.array(errors).T
+        return {"route_seconds": round(sim.time - started, 1), "route_error_mean_mm": round(float(distances.mean()), 1),
+                "route_error_p95_mm": round(float(np.percentile(distances, 95)), 1),
+                "route_error_max_mm": round(float(distances.max()), 1),
+                "route_error_mean_deg": round(math.degrees(float(angles.mean())), 2),
+                "route_error_p95_deg": round(math.degrees(float(np.percentile(angles, 95))), 2),
+                "route_invalid_share": round(invalid / len(errors), 4),
+                "cognition_frame_ms_p95": round(float(np.percentile(walker.frame_ms, 95)), 2),
+                "cognition_frame_ms_mean": round(float(np.mean(walker.frame_ms)), 2),
+                "realtime_factor_with_cameras": round(realtime, 2)}
+    finally:
+        sim.close()
+
+
+def kidnaps(engine: str) -> dict[str, float]:
+    """Seconds until the pose is right again after each of ``KIDNAPS``."""
+    walker = Walker(engine, "-1500,0,0")
+    sim = walker.sim
+    times = []
+    try:
+        sim.run(5.0)
+        for x, y, heading in KIDNAPS:
+            sim.platform.move_robot(x, y, heading)
+            moved = sim.time
+            recovered = None
+            while sim.time < moved + 20.0:
+                sim.run(0.1)
+                valid, distance, angle = walker.pose_error()
+                if valid and distance < 200.0 and angle < math.radians(10.0):
+                    recovered = sim.time - moved
+                    break
+            times.append(recovered if recovered is not None else float("inf"))
+            sim.run(3.0)
+        return {"kidnap_recovery_s": [round(t, 2) for t in times], "kidnap_recovery_max_s": round(max(times), 2)}
+    finally:
+        sim.close()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--frames", type=int, default=600, help="rendered scenes for the ball detector (>= 500)")
+    parser.add_argument("--engine", default="mujoco", choices=["mujoco", "pybullet"])
+    args = parser.parse_args()
+    started = time.perf_counter()
+    figures: dict[str, object] = {"benchmark": "localization", "engine": args.engine}
+    figures |= ball_detection(args.engine, args.frames)
+    figures |= route(args.engine)
+    figures |= kidnaps(args.engine)
+    figures["targets"] = {"ball_precision": 0.97, "ball_recall": 0.90, "route_error_mean_mm": 100, "route_error_mean_deg": 5,
+                          "route_error_p95_mm": 250, "kidnap_recovery_max_s": 10, "cognition_frame_ms_p95": 25,
+                          "realtime_factor_with_cameras": 1.0}
+    figures["benchmark_wall_s"] = round(time.perf_counter() - started, 1)
+    print(json.dumps(figures))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,154 @@
+"""Self-localization and the striker in the simulators, judged against ground truth.
+
+- A route of eight waypoints, driven by ``motion:walk_to`` over the debug server of a ``tafel run``
+  subprocess, then a kidnapping by ``sim:move_robot``; the pose is read with
+  ``representation:print RobotPose`` and compared with ``sim:status`` all along.
+- The striker scores from random starts in its own half (seeded), in-process.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tafel.modules.behavior.striker import Striker
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.modeling import BallModel, RobotPose
+from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType, Odometry
+from tests.support.simulation import Simulation
+from tests.test_debug_server import Program
+from tests.test_walking import Robot
+
+#: field positions (mm) the route visits in turn, from the start at (-3000, -1500) facing the opponent goal
+ROUTE = [(-2000.0, -1500.0), (-1200.0, -800.0), (-1200.0, 300.0), (-2200.0, 900.0), (-3200.0, 700.0), (-3300.0, -300.0),
+         (-2400.0, -900.0), (-1500.0, 0.0)]
+POSITION_LIMIT, ANGLE_LIMIT = 200.0, math.radians(10.0)  # what "the pose stays right" means throughout
+
+
+def believed(robot: Robot) -> dict[str, float | bool]:
+    """RobotPose as the program prints it."""
+    text = robot.ask("representation:print RobotPose")
+    fields = dict(re.findall(r"^\s+(\w+): (\S+)$", text, re.MULTILINE))
+    return {"valid": fields["valid"] == "True", "lost": fields["lost"] == "True", "x": float(fields["x"]),
+            "y": float(fields["y"]), "rotation": float(fields["rotation"])}
+
+
+def pose_error(robot: Robot) -> tuple[float, float, dict, dict]:
+    """(mm, rad) between the believed pose and the truth, with both."""
+    truth = robot.status()
+    pose = believed(robot)
+    distance = math.hypot(pose["x"] - truth["x"], pose["y"] - truth["y"])
+    return distance, abs(math.remainder(pose["rotation"] - truth["heading"], math.tau)), pose, truth
+
+
+def wait_until_valid(robot: Robot, seconds: float) -> None:
+    start = robot.status()["time"]
+    while not believed(robot)["valid"]:
+        assert robot.status()["time"] < start + seconds, f"no valid pose within {seconds} s"
+        robot.run_for(0.2)
+
+
+@pytest.fixture(params=["mujoco", pytest.param("pybullet")])
+def localizing_robot(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[Robot]:
+    program = Program("--platform", request.param, "--speed", "max", "--start", "-3000,-1500,0", "--ball", "4000,2500", cwd=tmp_path)
+    try:
+        robot = Robot(program)
+        yield robot
+        robot.client.close()
+    finally:
+        program.stop()
+
+
+@pytest.mark.slow
+def test_the_pose_stays_right_along_a_route_and_after_a_kidnapping(localizing_robot: Robot) -> None:
+    robot = localizing_robot
+    wait_until_valid(robot, 10.0)
+    worst = (0.0, 0.0)
+    for target in ROUTE:
+        truth = robot.status()
+        c, s = math.cos(truth["heading"]), math.sin(truth["heading"])
+        dx, dy = target[0] - truth["x"], target[1] - truth["y"]
+        robot.ask(f"motion:walk_to -x {c * dx + s * dy:.0f} -y {-s * dx + c * dy:.0f} -rotation 0")
+        start = truth["time"]
+        while True:
+            distance, angle, pose, truth = pose_error(robot)
+            assert pose["valid"] and distance < POSITION_LIMIT and angle < ANGLE_LIMIT, (target, pose, truth)
+            worst = (max(worst[0], distance), max(worst[1], angle))
+            if math.hypot(truth["x"] - target[0], truth["y"] - target[1]) < 150.0:
+                break
+            assert truth["time"] < start + 25.0, f"did not reach {target}: {truth}"
+            robot.run_for(0.25)
+    assert worst[0] < POSITION_LIMIT
+
+    # carried elsewhere in its own half, turned round: lost, then right again within 15 s
+    robot.ask("motion:stand")
+    robot.ask("sim:move_robot -x -3500 -y 1800 -rotation -2.2")
+    moved_at = robot.status()["time"]
+    while True:
+        distance, angle, pose, truth = pose_error(robot)
+        if pose["valid"] and distance < POSITION_LIMIT and angle < ANGLE_LIMIT:
+            break
+        assert truth["time"] < moved_at + 15.0, f"not relocalized 15 s after the kidnapping: {pose} vs {truth}"
+        robot.run_for(0.25)
+    robot.ask("motion:release")
+
+
+def scores(engine: str, start: tuple[float, float, float], ball: tuple[float, float], seconds: float = 90.0) -> float | None:
+    """Simulated seconds until the ball is in the opponent goal, or None."""
+    sim = Simulation(engine, scene="default", start=",".join(f"{v:.3f}" for v in start), ball=f"{ball[0]:.0f},{ball[1]:.0f}")
+    scored: list[float] = []
+
+    def goal(s: Simulation) -> None:
+        bx, by = s.platform.ball_position()
+        if not scored and bx > 4500.0 + 50.0 and abs(by) < 750.0:
+            scored.append(s.time)
+
+    try:
+        for _ in range(int(seconds)):
+            sim.run(1.0, goal)
+            if scored:
+                return scored[0]
+        return None
+    finally:
+        sim.close()
+
+
+def random_starts(seed: int, count: int) -> list[tuple[tuple[float, float, float], tuple[float, float]]]:
+    """Robot poses anywhere in the own half and balls between it and the halfway line."""
+    rng = np.random.default_rng(seed)
+    return [((rng.uniform(-4000, -800), rng.uniform(-2500, 2500), rng.uniform(-math.pi, math.pi)),
+             (rng.uniform(-2500, 500), rng.uniform(-2000, 2000))) for _ in range(count)]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("start", "ball"), random_starts(17, 5))
+def test_the_striker_scores_from_its_own_half(start: tuple[float, float, float], ball: tuple[float, float]) -> None:
+    assert scores("mujoco", start, ball) is not None
+
+
+@pytest.mark.slow
+def test_the_striker_scores_on_pybullet_too() -> None:
+    start, ball = random_starts(23, 1)[0]
+    assert scores("pybullet", start, ball) is not None
+
+
+def test_striker_aims_at_the_goal_from_anywhere(run_module) -> None:
+    """Module test: with a valid pose the kick direction points from the ball to the goal's centre."""
+    for pose, heading_to_goal in [((-3000.0, 2000.0, 1.0), None), ((2000.0, -1500.0, -2.0), None), ((0.0, 0.0, 0.0), 0.0)]:
+        board = run_module(Striker, BallModel(valid=True, x=1000.0, y=0.0), RobotPose(valid=True, x=pose[0], y=pose[1], rotation=pose[2]),
+                           Odometry(), MotionInfo(), FrameInfo())
+        request = board[MotionRequest]
+        assert request.motion is MotionType.walk_to
+        ball_field = RobotPose(valid=True, x=pose[0], y=pose[1], rotation=pose[2]).to_field(1000.0, 0.0)
+        goal_bearing = math.atan2(0.0 - ball_field[1], 4750.0 - ball_field[0]) - pose[2]
+        assert math.remainder(request.target_rotation - goal_bearing, math.tau) == pytest.approx(0.0, abs=1e-6)
+        if heading_to_goal is not None:
+            assert request.target_rotation == pytest.approx(heading_to_goal, abs=1e-6)
+    # without a valid pose: the start heading by odometry
+    board = run_module(Striker, BallModel(valid=True, x=1000.0, y=0.0), RobotPose(valid=False), Odometry(rotation=0.5), MotionInfo(), FrameInfo())
+    assert board[MotionRequest].target_rotation == pytest.approx(-0.5)
