@@ -287,7 +287,7 @@ def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002, ba
         '<mujoco model="tafel-nao-spl">',
         f'  <option timestep="{timestep}" integrator="implicitfast" cone="elliptic"/>',
         '  <compiler angle="radian" autolimits="true"/>',
-        f'  <visual><global offwidth="{width}" offheight="{height}"/><quality shadowsize="0"/>'
+        f'  <visual><global offwidth="{width}" offheight="{height}"/><quality shadowsize="0" offsamples="0"/>'
         '<headlight ambient="0.45 0.45 0.45" diffuse="0.5 0.5 0.5" specular="0 0 0"/></visual>',
         "  <asset>", *("    " + a for a in _ball_assets(ball_color)), "  </asset>",
         "  <worldbody>",

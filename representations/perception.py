@@ -97,18 +97,25 @@ class FieldColor:
 
 @representation
 class SegmentedImage:
-    """Both images in HSV with their field-green masks, computed once per frame for every detector."""
+    """Both images in HSV with their field-green masks, and the value (V, 0..255) of white in each (the
+    brightest unsaturated pixels off the field), computed once per frame for every detector."""
 
     top_hsv: np.ndarray = array((None, None, 3), np.uint8)
     top_green: np.ndarray = array((None, None), np.bool_)
+    top_white: float = 255.0
     bottom_hsv: np.ndarray = array((None, None, 3), np.uint8)
     bottom_green: np.ndarray = array((None, None), np.bool_)
+    bottom_white: float = 255.0
 
+    def white(self, camera: str) -> float:
+        return self.top_white if camera == "top" else self.bottom_white
+
+    # plain arrays: numpy on a module's read-only view of them would pass through the access checks
     def hsv(self, camera: str) -> np.ndarray:
-        return self.top_hsv if camera == "top" else self.bottom_hsv
+        return np.asarray(self.top_hsv if camera == "top" else self.bottom_hsv)
 
     def green(self, camera: str) -> np.ndarray:
-        return self.top_green if camera == "top" else self.bottom_green
+        return np.asarray(self.top_green if camera == "top" else self.bottom_green)
 
 
 @representation
@@ -120,7 +127,7 @@ class FieldBoundary:
     bottom: np.ndarray = array((None,), np.float32)
 
     def rows(self, camera: str) -> np.ndarray:
-        return self.top if camera == "top" else self.bottom
+        return np.asarray(self.top if camera == "top" else self.bottom)
 
     def inside(self, camera: str, x: float, y: float) -> bool:
         """Whether the pixel (x, y) lies on the field (below the boundary)."""

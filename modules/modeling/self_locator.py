@@ -72,7 +72,9 @@ class SelfLocator(Module):
         """... for this many seconds, in which the circle, a post, or lines both along and across the
         field were seen (one straight line fits many places on the field)"""
         roughening: float = bounded(0.0, 200.0, 15.0)
-        """mm of noise added to resampled particles (and a hundredth of it in rad), against collapse"""
+        """mm of noise added to resampled particles, against their collapse onto a few ..."""
+        roughening_rotation: float = bounded(0.0, 1.0, 0.15)
+        """... and rad"""
 
     def __init__(self) -> None:
         self.rng = np.random.default_rng(0)  # fixed: replaying a log localizes the same way
@@ -81,6 +83,8 @@ class SelfLocator(Module):
         self.slow = self.fast = 0.0
         self.trusted: tuple[float, float, float] | None = None  # the last valid estimate, for continuity
         self.was_upright = True
+        self.best: np.ndarray | None = None  # this frame's best-weighted particle, None if nothing was seen
+        self.estimate: np.ndarray | None = None  # the last published pose, moved by odometry since
         self.concentrated_since: float | None = None  # s since when the particles agree on one pose
         self.evidence: set[str] = set()  # what was seen since: one line alone fits many places
 
@@ -103,12 +107,15 @@ class SelfLocator(Module):
         previous, self.last_odometry = self.last_odometry, now
         if not self.fall_state.upright and self.was_upright:
             self.particles[:, 2] += self.rng.normal(0.0, p.fallen_rotation_noise, len(self.particles))
+        self.best = None
         if previous is None:
             return
         c, s = math.cos(previous[2]), math.sin(previous[2])
         dx, dy = now[0] - previous[0], now[1] - previous[1]
         forward, left = c * dx + s * dy, -s * dx + c * dy  # the step in the previous robot frame
         turn = math.remainder(now[2] - previous[2], math.tau)
+        if self.estimate is not None:
+            self.estimate = moved(self.estimate, forward, left, turn)
         n = len(self.particles)
         step = math.hypot(forward, left)
         forward = forward + self.rng.normal(0.0, p.translation_noise * step + 1.0, n)
@@ -156,7 +163,7 @@ class SelfLocator(Module):
             self.particles = self.particles[low_variance_indices(weights, self.rng)]
             n = len(self.particles)
             self.particles[:, :2] += self.rng.normal(0.0, p.roughening, (n, 2))
-            self.particles[:, 2] += self.rng.normal(0.0, p.roughening / 1000.0 * 10, n)
+            self.particles[:, 2] += self.rng.normal(0.0, p.roughening_rotation, n)
         return fit
 
     def to_field(self, points: np.ndarray) -> np.ndarray:
@@ -183,9 +190,8 @@ class SelfLocator(Module):
     # ---------------------------------------------------------------------------------- estimate
     def publish(self) -> None:
         p, pose = self.parameters, self.robot_pose
-        centre = getattr(self, "best", None)
-        if centre is None:
-            centre = self.particles.mean(axis=0)
+        # around this frame's best particle, or, with nothing seen, around the last estimate moved on
+        centre = self.best if self.best is not None else self.estimate if self.estimate is not None else self.particles.mean(axis=0)
         near = (np.hypot(self.particles[:, 0] - centre[0], self.particles[:, 1] - centre[1]) < 600.0) & (
             np.abs(np.remainder(self.particles[:, 2] - centre[2] + math.pi, math.tau) - math.pi) < 0.6)
         cluster = self.particles[near] if near.sum() >= 3 else self.particles
@@ -193,6 +199,7 @@ class SelfLocator(Module):
         pose.rotation = float(math.atan2(np.sin(cluster[:, 2]).mean(), np.cos(cluster[:, 2]).mean()))
         spread = np.hypot(cluster[:, 0] - pose.x, cluster[:, 1] - pose.y)
         pose.deviation = float(math.sqrt(np.mean(spread**2)))
+        self.estimate = np.array([pose.x, pose.y, pose.rotation])
         pose.rotation_deviation = float(math.sqrt(max(0.0, -2.0 * math.log(max(1e-9, math.hypot(np.sin(cluster[:, 2]).mean(), np.cos(cluster[:, 2]).mean()))))))
         lost = bool(self.slow and self.fast < p.lost_ratio * self.slow)
         now = self.frame_info.time_s
@@ -224,6 +231,12 @@ class SelfLocator(Module):
                 angle = abs(math.remainder(math.atan2(segment.y2 - segment.y1, segment.x2 - segment.x1) + rotation, math.pi))
                 seen.add("along" if angle < 0.35 else "across" if angle > math.pi / 2 - 0.35 else "slanted")
         return seen
+
+
+def moved(pose: np.ndarray, forward: float, left: float, turn: float) -> np.ndarray:
+    """A field pose (x, y, rotation) after a step given in its own frame."""
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    return np.array([pose[0] + c * forward - s * left, pose[1] + s * forward + c * left, math.remainder(pose[2] + turn, math.tau)])
 
 
 def robust(normalized: np.ndarray) -> np.ndarray:

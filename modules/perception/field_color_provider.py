@@ -34,7 +34,7 @@ class FieldColorProvider(Module):
         """share of the sampled pixels that must be green to update the estimate"""
         smoothing: float = bounded(0.0, 1.0, 0.3)
         """weight of this frame's estimate against the previous one"""
-        step: int = bounded(1, 16, 3)
+        step: int = bounded(1, 16, 4)
         """px between sampled pixels"""
 
     def execute(self) -> None:
@@ -47,7 +47,12 @@ class FieldColorProvider(Module):
         self.estimate()
         for camera in ("top", "bottom"):
             hsv = segmented.hsv(camera)
-            setattr(segmented, f"{camera}_green", self.field_color.mask(hsv) if hsv.size else np.zeros((0, 0), bool))
+            green = self.field_color.mask(hsv) if hsv.size else np.zeros((0, 0), bool)
+            setattr(segmented, f"{camera}_green", green)
+            # white: the brightest unsaturated pixels off the field (sampled: a percentile of every pixel costs)
+            step = self.parameters.step
+            sample = hsv[::step, ::step][~green[::step, ::step] & (hsv[::step, ::step, 1] <= 70)] if hsv.size else hsv.reshape(-1, 3)
+            setattr(segmented, f"{camera}_white", float(np.percentile(sample[:, 2], 99)) if len(sample) else 255.0)
 
     def estimate(self) -> None:
         """This frame's field colour from samples of both images, blended into the last estimate."""

@@ -69,7 +69,7 @@ class GoalPostDetector(Module):
         unsaturated = (hsv[..., 1] <= p.saturation_max) & ~green
         if not unsaturated.any():
             return []
-        white = unsaturated & (hsv[..., 2] >= p.white_share * float(np.percentile(hsv[..., 2][unsaturated], 99)))
+        white = unsaturated & (hsv[..., 2] >= p.white_share * self.segmented_image.white(camera))
         rows = np.arange(height)[:, None]
         top = np.round(boundary).astype(int)
         band = (rows < top[None, :]) & (rows >= top[None, :] - p.band)

@@ -66,7 +66,7 @@ class LineDetector(Module):
 
     @dataclass
     class Parameters:
-        step: int = bounded(1, 32, 4)
+        step: int = bounded(1, 32, 5)
         """px between scan lines (both directions)"""
         max_run_ground: float = bounded(50.0, 1000.0, 220.0)
         """mm: a white run longer than this on the ground is no line"""
@@ -113,32 +113,20 @@ class LineDetector(Module):
     def points(self, camera: str, projection: ImageProjection) -> np.ndarray:
         """Line points (N x 2, mm, robot frame) of one camera's image."""
         p = self.parameters
-        height, width = projection.height, projection.width
-        hsv = self.segmented_image.hsv(camera)
-        boundary = self.field_boundary.rows(camera)
-        on_field = np.arange(height)[:, None] >= (boundary[None, :] if boundary.size == width else 0)
-        candidates = ~self.segmented_image.green(camera) & on_field & (hsv[..., 1] <= p.saturation_max)
-        if not candidates.any():
-            return np.zeros((0, 2))
-        brightest = float(np.percentile(hsv[..., 2][candidates], 99))
-        white = (candidates & (hsv[..., 2] >= p.white_share * brightest)).astype(np.uint8)
-        white[own_body_mask(projection, white.shape)] = 0  # the robot's own feet and arms are white too
-        for post in self.goal_post_percept.posts:  # and the posts, which would be lines behind the goal on the ground
-            if post.camera == camera:
-                half = post.image_width
-                white[: int(post.image_foot) + 2, max(0, int(post.image_x - half)) : int(post.image_x + half) + 1] = 0
-        for ball in self.ball_image_percept.candidates:  # and so is the ball
-            if ball.camera == camera:
-                cv2.circle(white, (int(ball.x), int(ball.y)), int(ball.radius * 1.4) + 2, 0, -1)
+        hsv, green = self.segmented_image.hsv(camera), self.segmented_image.green(camera)
+        ignored = self.ignored(camera, projection)
+        threshold = p.white_share * self.segmented_image.white(camera)
         found = []
-        for mask, transposed in ((white, False), (white.T, True)):
-            x, first, last = white_runs(mask, p.step)
-            if len(x) == 0:
+        # white is only classified on the scan lines: every step-th column (runs down) and row (runs across)
+        for transposed in (False, True):
+            grid = (slice(None, None, p.step), slice(None)) if transposed else (slice(None), slice(None, None, p.step))
+            cut = hsv[grid]
+            white = ~green[grid] & ~ignored[grid] & (cut[..., 1] <= p.saturation_max) & (cut[..., 2] >= threshold)
+            line, first, last = white_runs(white.T if transposed else white, 1)
+            line = line * p.step
+            xs0, ys0, xs1, ys1 = (first, line, last, line) if transposed else (line, first, line, last)
+            if len(xs0) == 0:
                 continue
-            if transposed:  # runs along rows: x and y swap
-                xs0, ys0, xs1, ys1 = first, x, last, x
-            else:
-                xs0, ys0, xs1, ys1 = x, first, x, last
             starts, hit0 = projection.to_ground(xs0.astype(float), ys0.astype(float))
             ends, hit1 = projection.to_ground(xs1.astype(float), ys1.astype(float))
             middles, hit = projection.to_ground((xs0 + xs1) / 2.0, (ys0 + ys1) / 2.0)
@@ -155,6 +143,23 @@ class LineDetector(Module):
             for x, y in result:
                 canvas.circle(float(x), float(y), 15, color="red")
         return result
+
+    def ignored(self, camera: str, projection: ImageProjection) -> np.ndarray:
+        """Pixels that are white but no line: off the field, the robot's own feet and arms, goal posts
+        (on the ground they would be lines behind the goal) and ball candidates."""
+        height, width = projection.height, projection.width
+        boundary = self.field_boundary.rows(camera)
+        ignored = (np.arange(height)[:, None] < boundary[None, :]) if boundary.size == width else np.zeros((height, width), bool)
+        ignored |= own_body_mask(projection, (height, width))
+        for post in self.goal_post_percept.posts:
+            if post.camera == camera:
+                half = post.image_width
+                ignored[: int(post.image_foot) + 2, max(0, int(post.image_x - half)) : int(post.image_x + half) + 1] = True
+        balls = np.zeros((height, width), np.uint8)
+        for ball in self.ball_image_percept.candidates:
+            if ball.camera == camera:
+                cv2.circle(balls, (int(ball.x), int(ball.y)), int(ball.radius * 1.4) + 2, 1, -1)
+        return ignored | balls.astype(bool)
 
     def fit_circle(self, points: np.ndarray) -> np.ndarray:
         """Find the centre circle among ``points``; returns the points it does not explain."""

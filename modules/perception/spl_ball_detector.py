@@ -58,7 +58,7 @@ class SPLBallDetector(Module):
         size_high: float = bounded(1.0, 3.0, 1.5)
         min_radius: float = bounded(0.5, 10.0, 1.5)
         """px: smaller balls are not looked for"""
-        max_spots: int = bounded(1, 50, 10)
+        max_spots: int = bounded(1, 50, 8)
         """candidates checked per image"""
         green_inside_max: float = bounded(0.0, 1.0, 0.25)
         green_around_min: float = bounded(0.0, 1.0, 0.3)
@@ -84,7 +84,7 @@ class SPLBallDetector(Module):
             with stopwatch("SPLBallDetector:image"):
                 hsv, green = self.segmented_image.hsv(camera), self.segmented_image.green(camera)
                 spots = self.spots(green, self.field_boundary.rows(camera), projection)
-                white = float(np.percentile(hsv[..., 2][~green], 99)) if spots and (~green).any() else 255.0
+                white = self.segmented_image.white(camera)
                 for spot in spots:
                     score, under_post = self.check(hsv, green, spot, white)
                     if under_post:  # perhaps a ball behind a post, merged with it in the image: look beside it
@@ -101,8 +101,10 @@ class SPLBallDetector(Module):
         """Peaks of the non-green field's distance transform whose thickness fits a ball there."""
         p = self.parameters
         height, width = green.shape
-        field = np.ones_like(green) if boundary.size != width else np.arange(height)[:, None] >= boundary[None, :] - p.above_boundary
-        solid = (~green & field).astype(np.uint8)
+        known = boundary.size == width
+        top = max(0, int(boundary.min() - p.above_boundary)) if known else 0  # nothing above the field is looked at
+        field = np.arange(top, height)[:, None] >= boundary[None, :] - p.above_boundary if known else np.ones((height - top, width), bool)
+        solid = (~green[top:] & field).astype(np.uint8)
         if not solid.any():
             return []
         thickness = cv2.distanceTransform(solid, cv2.DIST_L2, 3)
@@ -111,12 +113,13 @@ class SPLBallDetector(Module):
         if len(xs) == 0:
             return []
         radii = thickness[ys, xs]
+        ys = ys + top
         centres, hits = projection.to_ground(xs, ys, BALL_RADIUS)
         points = np.column_stack([centres, np.full(len(xs), BALL_RADIUS)])
         distance = np.linalg.norm(points - projection.translation, axis=1)
         expected = np.where(hits, projection.fx * BALL_RADIUS / np.maximum(distance, 1.0), 0.0)
         fits = hits & (radii >= p.size_low * expected) & (radii <= p.size_high * expected + 1.0)
-        if boundary.size == width:
+        if known:
             fits &= ys >= boundary[xs]  # the centre lies on the field; only the top may reach over its edge
         # the spots most like a ball's size first: lines are thinner, robots and the border thicker
         order = np.argsort(np.abs(np.log(np.maximum(radii[fits], 0.5) / np.maximum(expected[fits], 0.5))))
@@ -152,37 +155,40 @@ class SPLBallDetector(Module):
         bright = np.percentile(value, 90)
         dark = float((value < p.dark_ratio * bright).mean())
         saturation = float(patch[..., 1][inside].mean())
-        if not beside_post and self.post_columns(hsv, green, spot, white)[int(min(max(spot.x, 0), green.shape[1] - 1))]:
+        first, posts = self.post_columns(hsv, green, spot, white)
+        if not beside_post and 0 <= int(spot.x) - first < len(posts) and posts[int(spot.x) - first]:
             return 0.0, True
         if (green_inside > p.green_inside_max or green_around < p.green_around_min or not p.dark_share_min <= dark <= p.dark_share_max
                 or saturation > p.saturation_max):
             return 0.0, False
         return float(min(1.0, 0.5 + dark + 0.3 * green_around - green_inside)), False
 
-    def post_columns(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float) -> np.ndarray:
-        """Per image column: whether something white rises above the spot's row there (a goal post, or
-        a robot's leg), judged on the rows 1.5 to 4 radii above it."""
+    def post_columns(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float) -> tuple[int, np.ndarray]:
+        """(first column, flags): for the columns within three radii of the spot, whether something white
+        rises above the spot's row there (a goal post, or a robot's leg), judged on the rows 1.5 to 4
+        radii above it."""
         p = self.parameters
+        x0, x1 = max(0, int(spot.x - 3 * spot.radius)), min(green.shape[1], int(spot.x + 3 * spot.radius) + 1)
         y0, y1 = int(max(0, spot.y - 4 * spot.radius)), int(max(0, spot.y - 1.5 * spot.radius))
-        if y1 - y0 < 2:
-            return np.zeros(green.shape[1], bool)
-        above = hsv[y0:y1]
-        whites = (above[..., 2] >= p.post_white * white) & (above[..., 1] <= p.saturation_max) & ~green[y0:y1]
-        return whites.mean(axis=0) >= p.post_share
+        if y1 - y0 < 2 or x1 <= x0:
+            return x0, np.zeros(max(0, x1 - x0), bool)
+        above = hsv[y0:y1, x0:x1]
+        whites = (above[..., 2] >= p.post_white * white) & (above[..., 1] <= p.saturation_max) & ~green[y0:y1, x0:x1]
+        return x0, whites.mean(axis=0) >= p.post_share
 
     def beside_post(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float) -> Spot | None:
         """Where a ball seen next to a post (partly behind it) has its centre. A post hides a vertical
         strip of it, so the row where the non-green run leaving the post's side is longest is the
         ball's centre row, and that run ends at its far edge, one radius from the centre."""
-        posts = self.post_columns(hsv, green, spot, white)
+        first, posts = self.post_columns(hsv, green, spot, white)
         height, width = green.shape
-        first = max(0, int(spot.x - 2 * spot.radius))
-        post = np.nonzero(posts[first : int(spot.x + 2 * spot.radius) + 1])[0]
+        post = np.nonzero(posts)[0]
         if len(post) == 0:
             return None
         best: tuple[int, float, int] | None = None  # (extent px, centre x, row)
         for row in range(max(0, int(spot.y - 2 * spot.radius)), min(height, int(spot.y + 2 * spot.radius) + 1)):
-            solid = ~green[row] & ~posts
+            solid = ~green[row]
+            solid[first : first + len(posts)] &= ~posts
             for edge, step in ((first + int(post.max()) + 1, 1), (first + int(post.min()) - 1, -1)):
                 if not (0 <= edge < width and solid[edge]):
                     continue
