@@ -62,8 +62,13 @@ def field_parts(ball: tuple[float, float] = (1.0, 0.0), ball_color: str = "spl")
     half_x, half_y = field.LENGTH / 2 * M, field.WIDTH / 2 * M
     carpet = (half_x + field.BORDER_STRIP * M, half_y + field.BORDER_STRIP * M, 0.1)
     hall_x, hall_y = carpet[0] + HALL_MARGIN, carpet[1] + HALL_MARGIN
-    parts = [FieldPart("hall_floor", "plane", (0.0, 0.0, -0.0005), (hall_x, hall_y, 0.1), HALL_RGBA, collides=False),
-             FieldPart("carpet", "plane", (0.0, 0.0, 0.0), carpet, CARPET_RGBA)]
+    parts = [FieldPart("carpet", "plane", (0.0, 0.0, 0.0), carpet, CARPET_RGBA)]
+    # the hall's floor: four strips round the carpet, not a plane under it (PyBullet's CPU renderer would
+    # draw the hidden part too, at twice the cost of a frame)
+    strip_x, strip_y = (hall_x - carpet[0]) / 2, (hall_y - carpet[1]) / 2
+    for name, x, y, sx, sy in (("floor_front", carpet[0] + strip_x, 0.0, strip_x, hall_y), ("floor_back", -carpet[0] - strip_x, 0.0, strip_x, hall_y),
+                               ("floor_left", 0.0, carpet[1] + strip_y, carpet[0], strip_y), ("floor_right", 0.0, -carpet[1] - strip_y, carpet[0], strip_y)):
+        parts.append(FieldPart(name, "box", (x, y, -0.0005), (sx, sy, 0.0005), HALL_RGBA, collides=False))
     for name, x, y, sx, sy in (("wall_front", hall_x, 0.0, 0.05, hall_y), ("wall_back", -hall_x, 0.0, 0.05, hall_y),
                                ("wall_left", 0.0, hall_y, hall_x, 0.05), ("wall_right", 0.0, -hall_y, hall_x, 0.05)):
         parts.append(FieldPart(name, "box", (x, y, HALL_HEIGHT / 2), (sx, sy, HALL_HEIGHT / 2), HALL_RGBA, collides=False))

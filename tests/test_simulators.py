@@ -33,6 +33,7 @@ from tafel.representations.perception import BallCandidate, BallImagePercept, Ba
 from tests.support.simulation import Simulation
 from tests.test_cli_runtime import REPO, frames, tafel
 
+NO_GLANCES = ["parameters.LookAtBallBehavior.glance_interval=1000", "parameters.LookAtBallBehavior.glance_interval_lost=1000"]
 STANDING_TORSO_HEIGHT = 250.0  # mm: a fallen robot's torso is below 150
 ENGINES = ["mujoco", "pybullet"]
 
@@ -88,7 +89,8 @@ def model_distance_error(sim: Simulation) -> float:
 
 @pytest.mark.slow
 def test_the_head_tracks_the_ball_and_follows_when_it_moves(engine: str) -> None:
-    sim = simulation(engine, ball="1500,500")
+    # tracking alone: no glances round for the localization (tests/test_behavior_glances.py has those)
+    sim = Simulation(engine, overrides=NO_GLANCES, ball="1500,500")
     try:
         _tracks(sim)
     finally:

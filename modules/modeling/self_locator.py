@@ -10,6 +10,7 @@ import numpy as np
 from tafel.core import Module, bounded, provides, requires, uses
 from tafel.debug import drawing, plot, request
 from tafel.modules.modeling.field_model import FIELD_MODEL, OWN_HALF, mirror
+from tafel.representations import field
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import RobotPose
 from tafel.representations.motion_control import FallState, Odometry
@@ -28,13 +29,15 @@ class SelfLocator(Module):
       the motion (and much more rotation noise after a fall).
     - Sensing: line points are weighed by their distance to the nearest painted line (a precomputed
       distance map), goal posts by their distance to the nearest post, the centre circle's centre by
-      its distance to the centre spot. Noise grows with the distance of what was seen.
+      its distance to the centre spot. Noise grows with the distance of what was seen. Poses beyond
+      the field's lines are unlikely (the referee takes such robots off), beyond the carpet more so.
     - The field looks the same turned by 180 degrees. Particles start in the own half (the robot
       enters the field there), and every particle made anew is put on the side nearer to the last
       estimate: continuity decides.
     - Lost: when the measurements keep fitting much worse than they used to (the robot was carried
       or slipped), part of the particles are made anew from what is seen (sensor resetting): around
-      a seen post at its measured distance, or on the centre circle's position. ``RobotPose.lost`` says so.
+      a seen post at its measured distance, on the centre circle's position, or on a field line.
+      ``RobotPose.lost`` says so.
     """
 
     @dataclass
@@ -64,6 +67,8 @@ class SelfLocator(Module):
         """share of the particles made anew per frame while lost"""
         search_share: float = bounded(0.0, 1.0, 0.05)
         """share made anew per frame before the first fix"""
+        outside_std: float = bounded(10.0, 5000.0, 300.0)
+        """mm beyond the field's lines at which a pose is one standard deviation unlikely"""
         valid_deviation: float = bounded(10.0, 5000.0, 350.0)
         """mm: the pose is valid while the particles around the estimate are this close together ..."""
         valid_share: float = bounded(0.1, 1.0, 0.7)
@@ -156,6 +161,7 @@ class SelfLocator(Module):
         if measurements == 0:
             return None
         fit = float(np.mean(np.exp(log_weight / measurements)))
+        log_weight += self.on_field_prior()
         weights = np.exp(log_weight - log_weight.max())
         weights /= weights.sum()
         self.best = self.particles[int(np.argmax(weights))].copy()
@@ -165,6 +171,12 @@ class SelfLocator(Module):
             self.particles[:, :2] += self.rng.normal(0.0, p.roughening, (n, 2))
             self.particles[:, 2] += self.rng.normal(0.0, p.roughening_rotation, n)
         return fit
+
+    def on_field_prior(self) -> np.ndarray:
+        """Log-prior of each particle's place: a robot far beyond the lines is taken off by the referee, and
+        one beyond the carpet stands in the wall; so poses out there need much more evidence."""
+        outside = np.maximum(np.abs(self.particles[:, 0]) - field.LENGTH / 2, 0.0) + np.maximum(np.abs(self.particles[:, 1]) - field.WIDTH / 2, 0.0)
+        return -0.5 * (outside / self.parameters.outside_std) ** 2
 
     def to_field(self, points: np.ndarray) -> np.ndarray:
         """Robot-frame points (M x 2) as seen from every particle: (N x M x 2) field positions."""
