@@ -163,6 +163,24 @@ def test_mirror_picks_the_pose_or_its_twin_whichever_is_nearer(pose: tuple, towa
     assert math.remainder(chosen[2] - nearest[2], math.tau) == pytest.approx(0.0, abs=1e-9)
 
 
+@given(pose=poses, towards=poses)
+def test_mirror_takes_the_own_half_when_the_robot_was_carried_far(pose: tuple, towards: tuple) -> None:
+    chosen = mirror(np.array([pose]), towards, far=2000.0)[0]
+    twin = (-pose[0], -pose[1])
+    if min(math.dist(pose[:2], towards[:2]), math.dist(twin, towards[:2])) > 2000.0:
+        assert chosen[0] == pytest.approx(min(pose[0], twin[0]))
+    else:
+        assert chosen[:2] == pytest.approx(min((pose[:2], twin), key=lambda c: math.dist(c, towards[:2])))
+
+
+def test_a_robot_carried_across_the_field_relocalizes_in_its_own_half() -> None:
+    run = Run()
+    for truth in [(-1500.0, 0.0, 0.0), (-3500.0, 1800.0, -2.2), (-1000.0, -2200.0, 1.0), (-2500.0, 0.0, 3.0)]:
+        for _ in range(240):  # 8 s at each place
+            pose = run.step(truth)
+        assert pose.valid and error(pose, truth)[0] < 150.0, (truth, pose)
+
+
 @given(st.lists(st.floats(0.0, 1.0), min_size=1, max_size=50))
 @settings(max_examples=60)
 def test_low_variance_resampling_keeps_shares(raw: list[float]) -> None:

@@ -123,13 +123,15 @@ def distance_to_line(point: np.ndarray, segment: LineSegment) -> float:
     return abs(float(d[0] * (point - a)[1] - d[1] * (point - a)[0])) / length
 
 
-def mirror(poses: np.ndarray, towards: tuple[float, float, float]) -> np.ndarray:
+def mirror(poses: np.ndarray, towards: tuple[float, float, float], far: float = math.inf) -> np.ndarray:
     """Each pose or its twin turned by 180 degrees about the centre spot (the field cannot tell them
-    apart), whichever lies nearer to ``towards``."""
+    apart), whichever lies nearer to ``towards``; where both lie more than ``far`` mm from it (the robot
+    was carried, as a referee does with a penalized robot), the one in the own half."""
     twin = np.column_stack([-poses[:, 0], -poses[:, 1], np.remainder(poses[:, 2], math.tau) - math.pi])  # rotation + 180 degrees
     own = np.hypot(poses[:, 0] - towards[0], poses[:, 1] - towards[1])
     other = np.hypot(twin[:, 0] - towards[0], twin[:, 1] - towards[1])
-    return np.where((other < own)[:, None], twin, poses)
+    take_twin = np.where(np.minimum(own, other) > far, twin[:, 0] < poses[:, 0], other < own)
+    return np.where(take_twin[:, None], twin, poses)
 
 
 FIELD_MODEL = FieldModel()

@@ -33,7 +33,8 @@ class SelfLocator(Module):
       the field's lines are unlikely (the referee takes such robots off), beyond the carpet more so.
     - The field looks the same turned by 180 degrees. Particles start in the own half (the robot
       enters the field there), and every particle made anew is put on the side nearer to the last
-      estimate: continuity decides.
+      valid estimate: continuity decides. If both sides are far from it, the robot was carried, and
+      the own half is taken (referees put penalized robots back there).
     - Lost: when the measurements keep fitting much worse than they used to (the robot was carried
       or slipped), part of the particles are made anew from what is seen (sensor resetting): around
       a seen post at its measured distance, on the centre circle's position, or on a field line.
@@ -65,6 +66,9 @@ class SelfLocator(Module):
         lost_ratio: float = bounded(0.0, 1.0, 0.45)
         reset_share: float = bounded(0.0, 1.0, 0.25)
         """share of the particles made anew per frame while lost"""
+        carried_distance: float = bounded(0.0, 20000.0, 2000.0)
+        """mm: a new pose this far from the last valid one, as from its twin, means the robot was carried
+        (a referee moves penalized robots to their own half): it is put in the own half, not the nearer one"""
         search_share: float = bounded(0.0, 1.0, 0.05)
         """share made anew per frame before the first fix"""
         outside_std: float = bounded(10.0, 5000.0, 300.0)
@@ -196,7 +200,7 @@ class SelfLocator(Module):
         # before the first fix a few fresh particles a frame keep every pose that fits what is seen alive
         count = int((p.reset_share if lost else p.search_share) * len(self.particles))
         fresh = FIELD_MODEL.poses_from_percepts(self.rng, count, self.line_percept, self.goal_post_percept)
-        fresh = mirror(fresh, towards=self.trusted or OWN_HALF)
+        fresh = mirror(fresh, towards=self.trusted or OWN_HALF, far=p.carried_distance)
         self.particles[self.rng.choice(len(self.particles), len(fresh), replace=False)] = fresh
 
     # ---------------------------------------------------------------------------------- estimate
