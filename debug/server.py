@@ -29,6 +29,8 @@ from tafel.core.naming import did_you_mean
 from tafel.debug.commands import SPECS, CommandError, merge_answers
 from tafel.debug.protocol import Command, ParseError, TelnetDecoder, answer_bytes, parse
 
+#: s between two log lines about the same kind of failure (descriptors running out, say)
+RESOURCE_LOG_INTERVAL = 10.0
 log = logging.getLogger("tafel.debug")
 
 MAX_OUTSTANDING = 2000  # open commands per connection before it is read no more
@@ -360,6 +362,7 @@ class DebugServer:
         self._frame: asyncio.Event | None = None  # set (and replaced) when a frame starts, for throttled clients
         self._throttled = 0
         self._resource_errors = 0
+        self._resource_logged_at = 0.0  # monotonic s of the last line about them
         self.pending: queue.SimpleQueue[_Request] = queue.SimpleQueue()
         self._queues: dict[_Connection, deque[_Request]] = {}
         self._turns: deque[_Connection] = deque()  # connections with queued commands, in rotation
@@ -444,11 +447,14 @@ class DebugServer:
     def _loop_error(self, loop: asyncio.AbstractEventLoop, context: dict[str, Any]) -> None:
         """asyncio's errors as one line each, never a traceback per failed accept.
 
-        When file descriptors run out, asyncio retries ``accept`` every second and would log a
-        traceback each time: here the first is one line, and every hundredth after it another.
+        When file descriptors run out, asyncio retries ``accept`` (for every waiting connection, often
+        hundreds of times a second) and would log a traceback each time: here the first is one line,
+        and after it at most one line every ``RESOURCE_LOG_INTERVAL`` seconds, with the count.
         """
         self._resource_errors += 1
-        if self._resource_errors == 1 or self._resource_errors % 100 == 0:
+        now = time.monotonic()
+        if self._resource_errors == 1 or now - self._resource_logged_at >= RESOURCE_LOG_INTERVAL:
+            self._resource_logged_at = now
             exc = context.get("exception")
             log.error("debug server: %s%s (%d so far; the program goes on)", context.get("message", "error"),
                       f": {exc}" if exc else "", self._resource_errors)
