@@ -69,6 +69,7 @@ def test_the_spl_ball_is_found_where_it_is(renderer: SceneRenderer, distance: fl
     assert math.hypot(percept.x - truth[0], percept.y - truth[1]) < max(60.0, 0.08 * distance)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("side", [1.0, -1.0])
 def test_a_ball_half_out_of_the_image_is_still_found(renderer: SceneRenderer, side: float) -> None:
     pose, ball = (-2000.0, 0.0, 0.0), (-500.0, 0.0)

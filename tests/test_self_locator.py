@@ -74,6 +74,7 @@ def test_finds_its_pose_in_the_own_half_and_says_when_it_is_sure(truth: tuple[fl
     assert all(error(p, truth)[0] < 250.0 for p in poses[first_valid:])  # once valid, never far off
 
 
+@pytest.mark.slow
 def test_the_symmetric_twin_in_the_other_half_is_never_chosen() -> None:
     """Turned by 180 degrees about the centre spot the field looks the same: the own half decides."""
     for seed in range(3):
@@ -96,6 +97,7 @@ def test_follows_the_walk_by_odometry_between_percepts() -> None:
         assert distance < 200.0 and degrees < 10.0, (i, distance, degrees)
 
 
+@pytest.mark.slow
 def test_a_kidnapped_robot_says_it_is_lost_and_finds_itself_again() -> None:
     run = Run()
     start, elsewhere = (-1500.0, 0.0, 0.0), (-3500.0, 2000.0, -1.5)
@@ -173,6 +175,7 @@ def test_mirror_takes_the_own_half_when_the_robot_was_carried_far(pose: tuple, t
         assert chosen[:2] == pytest.approx(min((pose[:2], twin), key=lambda c: math.dist(c, towards[:2])))
 
 
+@pytest.mark.slow
 def test_a_robot_carried_across_the_field_relocalizes_in_its_own_half() -> None:
     run = Run()
     for truth in [(-1500.0, 0.0, 0.0), (-3500.0, 1800.0, -2.2), (-1000.0, -2200.0, 1.0), (-2500.0, 0.0, 3.0)]:
