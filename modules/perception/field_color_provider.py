@@ -12,6 +12,9 @@ from tafel.core import Module, bounded, provides, requires
 from tafel.debug import plot
 from tafel.representations.perception import CameraImageBottom, CameraImageTop, FieldColor, SegmentedImage
 
+#: the most saturation (0..255) a pixel may have and still count as white (lines, posts, the ball)
+WHITE_SATURATION_MAX = 70
+
 
 @requires(CameraImageTop, CameraImageBottom)
 @provides(FieldColor, SegmentedImage)
@@ -51,8 +54,9 @@ class FieldColorProvider(Module):
             setattr(segmented, f"{camera}_green", green)
             # white: the brightest unsaturated pixels off the field (sampled: a percentile of every pixel costs)
             step = self.parameters.step
-            sample = hsv[::step, ::step][~green[::step, ::step] & (hsv[::step, ::step, 1] <= 70)] if hsv.size else hsv.reshape(-1, 3)
-            setattr(segmented, f"{camera}_white", float(np.percentile(sample[:, 2], 99)) if len(sample) else 255.0)
+            sampled, off_field = hsv[::step, ::step], ~green[::step, ::step]
+            values = sampled[off_field & (sampled[..., 1] <= WHITE_SATURATION_MAX)][:, 2]
+            setattr(segmented, f"{camera}_white", float(np.percentile(values, 99)) if values.size else 255.0)
 
     def estimate(self) -> None:
         """This frame's field colour from samples of both images, blended into the last estimate."""
