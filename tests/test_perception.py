@@ -1,8 +1,8 @@
 """The perception pipeline against rendered images with known positions (``tools.scene_frames``), and its
 parts alone: field colour, field boundary, image geometry, the SPL ball's texture.
 
-Rendered scenes are posed kinematically (no physics), so each takes a few milliseconds. MuJoCo runs in
-the fast tier; the same checks on PyBullet are marked slow.
+Rendered scenes are posed kinematically (no physics), so each takes a few milliseconds; opening a
+renderer takes seconds, so the rendered checks are marked slow and the parts alone run in the fast tier.
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ from tafel.representations.perception import (
 )
 from tafel.tools.scene_frames import Perception, SceneRenderer
 
-ENGINES = ["mujoco", pytest.param("pybullet", marks=pytest.mark.slow)]
+ENGINES = [pytest.param("mujoco", marks=pytest.mark.slow), pytest.param("pybullet", marks=pytest.mark.slow)]
 
 
 @pytest.fixture(scope="module", params=ENGINES)
@@ -110,6 +110,7 @@ def test_no_ball_where_there_is_none(renderer: SceneRenderer, pose: tuple[float,
     assert not board[BallPercept].seen
 
 
+@pytest.mark.slow
 def test_the_orange_ball_needs_the_orange_detector() -> None:
     with SceneRenderer("mujoco", ball_color="orange") as scene:
         frames = scene.frames((-1500.0, 0.0, 0.0), (0.0, 0.25), (0.0, 100.0))
