@@ -150,6 +150,12 @@ class ModuleManager:
         self.after_frame: list[Callable[[], None]] = []
         self._modules = list(modules)
         self._by_name = module_names(self._modules)
+        # the module set is fixed for the manager's life: its declarations are read once (tools ask often)
+        self._requirements = {m: m.requirements() for m in self._modules}
+        self._alternatives: dict[str, list[str]] = {}
+        for m, req in self._requirements.items():
+            for rep in req.provides:
+                self._alternatives.setdefault(rep.__name__, []).append(m.__name__)
         self._external = list(dict.fromkeys(external))
         self._providers = dict(providers or {})
         self._disabled: set[str] = set(disabled)
@@ -249,7 +255,7 @@ class ModuleManager:
 
     def alternatives(self, rep_name: str) -> list[str]:
         """Every module that could provide ``rep_name`` (enabled or not)."""
-        return [m.__name__ for m in self._modules if any(r.__name__ == rep_name for r in m.requirements().provides)]
+        return list(self._alternatives.get(rep_name, ()))
 
     def last_times_ms(self) -> tuple[list[str], list[float]]:
         """(module names, how long each ran in the last frame in ms), cheap enough for every frame."""
@@ -305,8 +311,7 @@ class ModuleManager:
         """The module graph as plain data (for tools, the debug server and ``tafel modules``)."""
         active = {slot.name for slot in self._slots}
         modules = []
-        for m in self._modules:
-            req = m.requirements()
+        for m, req in self._requirements.items():
             modules.append({
                 "name": m.__name__,
                 "enabled": m.__name__ not in self._disabled,

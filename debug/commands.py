@@ -63,26 +63,30 @@ def _spec(name: str, summary: str, usage: str = "", routing: str = "merge") -> N
     SPECS[name] = CommandSpec(name, summary, usage or name, routing)
 
 
-_spec("modules:list", "per context: execution order, enabled, providers and alternatives, mean and max time")
+_spec("modules:list", "per context: execution order, enabled, providers and alternatives, mean and max time",
+      "modules:list [-format json]")
 _spec("modules:set", "enable or disable a module", "modules:set -module NAME -enabled true|false", "first")
 _spec("modules:provider", "choose the module that provides a representation", "modules:provider -representation NAME -module NAME", "first")
-_spec("representation:list", "the representations of both contexts and who provides them")
-_spec("representation:print", "a representation's current value as readable text", "representation:print -name NAME", "first")
+_spec("representation:list", "the representations of both contexts and who provides them", "representation:list [-format json]")
+_spec("representation:print", "a representation's current value as readable text (or JSON)", "representation:print -name NAME [-format json]", "first")
 _spec("representation:get", "a representation's current value as protobuf bytes (use +representation:get for base64)", "+representation:get -name NAME", "first")
 _spec("representation:set", "set a representation from protobuf bytes or one field", "representation:set -name NAME +data BASE64 | -field FIELD -value VALUE", "first")
 _spec("representation:override", "keep a representation at a value before every frame until representation:release (remote control)",
       "representation:override -name NAME [-fields JSON] [+data BASE64]", "first")
 _spec("representation:release", "end an override: the representation's provider writes it again",
       "representation:release -name NAME", "first")
-_spec("debug_request:list", "debug requests, on or off")
+_spec("debug_request:list", "debug requests, on or off", "debug_request:list [-format json]")
 _spec("debug_request:set", "switch a debug request on or off", "debug_request:set -name NAME -value on|off", "first")
-_spec("modify:list", "published modify values, and which are pinned")
+_spec("modify:list", "published modify values, and which are pinned", "modify:list [-format json]")
 _spec("modify:set", "pin a modify value", "modify:set -name NAME -value VALUE", "first")
 _spec("modify:release", "unpin a modify value", "modify:release -name NAME", "first")
-_spec("stopwatch:list", "per module and named stopwatch: last, mean, max, p95 (us), per context, and loop frequency")
+_spec("stopwatch:list", "per module and named stopwatch: last, mean, max, p95 (us), per context, and loop frequency",
+      "stopwatch:list [-format json]")
 _spec("plot:get", "a plot's recent values (frame value per line); without -name the plot names", "plot:get [-name NAME] [-count N]", "lines")
 _spec("drawings:get", "the last frame's drawings of both contexts as JSON lines", "drawings:get [-canvas field|image:top|image:bottom]", "lines")
-_spec("parameter:list", "modules with parameters and their values")
+_spec("parameter:list", "modules with parameters and their values", "parameter:list [-format json]")
+_spec("image:get", "a camera image as JPEG (use +image:get for base64)", "+image:get -name CameraImageTop|CameraImageBottom [-quality 1..100]",
+      "first")
 _spec("parameter:get", "a module's parameters", "parameter:get -module NAME", "first")
 _spec("parameter:set", "change a parameter; the module sees it next frame", "parameter:set -module NAME -name PARAMETER -value VALUE", "first")
 
@@ -109,6 +113,49 @@ def parse_bool(text: str, what: str) -> bool:
     if lowered in ("off", "false", "0", "no"):
         return False
     raise CommandError(f"{what} takes on/off or true/false, got {text!r}")
+
+
+def wants_json(command: Command) -> bool:
+    """``-format json`` (for tools and the web page) or ``-format text`` (the default)."""
+    wanted = command.args.get("format", "")
+    if wanted in ("", "text"):
+        return False
+    if wanted == "json":
+        return True
+    raise CommandError(f"-format takes text or json, got {wanted!r}")
+
+
+#: arrays with more elements than this are summarized in JSON (an image is no list of 230 400 numbers)
+JSON_ARRAY_LIMIT = 64
+
+
+def json_value(value: Any) -> Any:
+    """A representation (or any value in one) as plain JSON data: dataclasses as objects, enums by name,
+    small arrays as lists, large ones as their shape and range, and non-finite numbers as null."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {info.name: json_value(getattr(value, info.name)) for info in fields_of(type(value))}
+    if isinstance(value, (list, tuple)):
+        return [json_value(v) for v in value]
+    if isinstance(value, np.ndarray):
+        if value.size > JSON_ARRAY_LIMIT:
+            summary: dict[str, Any] = {"shape": list(value.shape), "dtype": str(value.dtype)}
+            if value.size and value.dtype.kind in "biuf":
+                summary.update(min=json_value(float(value.min())), max=json_value(float(value.max())))
+            return summary
+        return json_value(value.tolist())
+    if isinstance(value, (float, np.floating)):
+        return float(value) if np.isfinite(value) else None
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, enum.Enum):
+        return value.name
+    if isinstance(value, bytes):
+        return f"{len(value)} bytes"
+    if isinstance(value, dict):
+        return {str(k): json_value(v) for k, v in value.items()}
+    return value if value is None or isinstance(value, str) else str(value)
 
 
 def pretty(value: Any, indent: str = "") -> str:
@@ -261,6 +308,14 @@ class ContextDebug:
 
     def cmd_modules_list(self, command: Command) -> str:
         timings = self.manager.timings()
+        if wants_json(command):
+            graph = self.manager.graph()
+            errors = self.manager.errors()
+            for module in graph["modules"]:
+                timing = timings.get(module["name"])
+                module.update(mean_us=timing.mean_us if timing else None, max_us=timing.max_us if timing else None,
+                              errors=errors.get(module["name"], (0, ""))[0], last_error=errors.get(module["name"], (0, ""))[1])
+            return json.dumps(graph)
         lines = [f"order: {' -> '.join(self.manager.order) or '(none)'}"]
         for name in self.manager.modules:
             state = "on" if self.manager.is_enabled(name) else "off"
@@ -299,18 +354,35 @@ class ContextDebug:
         return self.manager.blackboard.get(name)
 
     def cmd_representation_list(self, command: Command) -> str:
-        lines = []
+        providers = {}
         for name in self.manager.blackboard.names():
             try:
-                provider = self.manager.provider_of(name) or "from outside (platform or other context)"
+                providers[name] = self.manager.provider_of(name) or "from outside (platform or other context)"
             except TafelError:
-                provider = "read only here"
-            lines.append(f"  {name:<28} {provider}")
-        return "\n".join(lines)
+                providers[name] = "read only here"
+        if wants_json(command):
+            return json.dumps([{"name": name, "provider": provider} for name, provider in providers.items()])
+        return "\n".join(f"  {name:<28} {provider}" for name, provider in providers.items())
 
     def cmd_representation_print(self, command: Command) -> str:
         rep = self._representation(command)
+        if wants_json(command):
+            return json.dumps(representation_message(rep, self.context, frame_number(self.manager)))
         return f"{type(rep).__name__} ({self.context}, frame {self.manager.frame}):\n{pretty(rep, '  ')}"
+
+    def cmd_image_get(self, command: Command) -> bytes:
+        name = argument(command, "name", "camera")
+        rep = self._representation(command)
+        if not isinstance(getattr(rep, "image", None), np.ndarray) or rep.image.ndim != 3:
+            raise CommandError(f"{name} holds no camera image; image:get takes a CameraImage such as CameraImageTop")
+        text = argument(command, "quality", positional=False, required=False) or "80"
+        try:
+            quality = int(text)
+        except ValueError:
+            quality = 0
+        if not 1 <= quality <= 100:
+            raise CommandError(f"-quality takes a whole number from 1 to 100, got {text!r}")
+        return jpeg_bytes(rep.image, quality)
 
     def cmd_representation_get(self, command: Command) -> bytes:
         return serialize(self._representation(command))
@@ -393,6 +465,8 @@ class ContextDebug:
 
     def cmd_debug_request_list(self, command: Command) -> str:
         requests = self._mine(self.state.requests)
+        if wants_json(command):
+            return json.dumps([{"name": name, "on": r.on, "description": r.description} for name, r in sorted(requests.items())])
         return "\n".join(f"  {'on ' if r.on else 'off'} {name}  {r.description}" for name, r in sorted(requests.items())) or "  (none yet)"
 
     def cmd_debug_request_set(self, command: Command) -> str:
@@ -402,6 +476,10 @@ class ContextDebug:
 
     def cmd_modify_list(self, command: Command) -> str:
         modifies = self._mine(self.state.modifies)
+        if wants_json(command):
+            return json.dumps([{"name": name, "value": json_value(m.value), "pinned": m.pinned,
+                                "pinned_value": json_value(m.pinned_value) if m.pinned else None}
+                               for name, m in sorted(modifies.items())])
         return "\n".join(
             f"  {name} = {_short(m.value)}" + (f"  (pinned to {_short(m.pinned_value)})" if m.pinned else "")
             for name, m in sorted(modifies.items())
@@ -420,6 +498,8 @@ class ContextDebug:
         return f"{found.name} released"
 
     def cmd_stopwatch_list(self, command: Command) -> str:
+        if wants_json(command):
+            return json.dumps(self._stopwatches())
         lines = [f"loop: {self.rate():.1f} Hz, frame {self.manager.frame}"]
         lines.append(f"  {'module':<32} {'last':>9} {'mean':>9} {'max':>9} {'p95':>9}  (us)")
         for name, timing in self.manager.timings().items():
@@ -430,6 +510,16 @@ class ContextDebug:
                 p95 = sorted(times)[int(0.95 * (len(times) - 1))]
                 lines.append(f"  {name:<32} {times[-1]:9.1f} {statistics.fmean(times):9.1f} {max(times):9.1f} {p95:9.1f}")
         return "\n".join(lines)
+
+    def _stopwatches(self) -> dict[str, Any]:
+        rows = [{"name": name, "last_us": t.last_us, "mean_us": t.mean_us, "max_us": t.max_us, "p95_us": self.manager.p95_us(name)}
+                for name, t in self.manager.timings().items()]
+        for name, watch in sorted(self._mine(self.state.stopwatches).items()):
+            times = sorted(t / 1000 for t in watch.times_ns)
+            if times:
+                rows.append({"name": name, "last_us": watch.times_ns[-1] / 1000, "mean_us": statistics.fmean(times),
+                             "max_us": times[-1], "p95_us": times[int(0.95 * (len(times) - 1))]})
+        return {"rate_hz": self.rate(), "frame": self.manager.frame, "stopwatches": rows}
 
     def cmd_plot_get(self, command: Command) -> str:
         plots = self._mine(self.state.plots)
@@ -463,6 +553,8 @@ class ContextDebug:
         return [n for n in self.manager.order if getattr(self.manager.module(n), "parameters", None) is not None]
 
     def cmd_parameter_list(self, command: Command) -> str:
+        if wants_json(command):
+            return json.dumps({name: json_value(parameter_values(self.manager.module(name).parameters)) for name in self._parameter_modules()})
         lines = []
         for name in self._parameter_modules():
             values = parameter_values(self.manager.module(name).parameters)
@@ -515,6 +607,8 @@ def merge_answers(command: Command, answers: Mapping[str, tuple[str, str | bytes
         if oks:  # the name exists in several contexts (a representation on both blackboards): show each
             if any(isinstance(text, bytes) for _, text in oks):
                 return True, f"{command.name}: the name exists in {' and '.join(c for c, _ in oks)}; add -context NAME"
+            if command.args.get("format") == "json":
+                return False, json.dumps({ctx: json.loads(text) for ctx, text in oks})
             return False, "\n".join(f"[{ctx}]\n{text}" for ctx, text in oks)
         if errors:
             return True, str(errors[0][1])
@@ -527,5 +621,32 @@ def merge_answers(command: Command, answers: Mapping[str, tuple[str, str | bytes
         return True, f"unknown {kind} {name!r}: {did_you_mean(name, known)}"
     if errors and not oks:
         return True, "; ".join(f"{ctx}: {text}" for ctx, text in errors)
+    if command.args.get("format") == "json":  # one JSON object, by context
+        return False, json.dumps({**{ctx: json.loads(text) for ctx, text in oks}, **{ctx: {"error": text} for ctx, text in errors}})
     parts = [f"[{ctx}]\n{text}" for ctx, text in oks] + [f"[{ctx}] error: {text}" for ctx, text in errors]
     return False, "\n".join(parts)
+
+
+def frame_number(manager: ModuleManager) -> int:
+    """The frame's number as the platform counts it (``FrameInfo``: a replayed log's recorded numbers),
+    else as the manager does."""
+    info = manager.blackboard.get("FrameInfo") if "FrameInfo" in manager.blackboard.names() else None
+    return int(getattr(info, "frame_number", manager.frame))
+
+
+def representation_message(rep: Any, context: str, frame: int, time_ns: int | None = None) -> dict[str, Any]:
+    """A representation as the JSON of ``representation:print -format json`` and of its web topic."""
+    message = {"topic": type(rep).__name__, "context": context, "frame": frame, "value": json_value(rep)}
+    if time_ns is not None:
+        message["time_ns"] = time_ns
+    return message
+
+
+def jpeg_bytes(image: np.ndarray, quality: int = 80) -> bytes:
+    """An RGB image as JPEG."""
+    import cv2
+
+    ok, data = cv2.imencode(".jpg", np.ascontiguousarray(image[:, :, ::-1]), [cv2.IMWRITE_JPEG_QUALITY, quality])
+    if not ok:
+        raise CommandError("the image could not be encoded as JPEG")
+    return data.tobytes()

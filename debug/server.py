@@ -158,7 +158,7 @@ class DebugRouter:
 
 @dataclass
 class _Request:
-    connection: _Connection
+    connection: Session
     sequence: int
     command: Command
 
@@ -173,10 +173,17 @@ def looks_like_http(line: bytes) -> bool:
         or b" HTTP/1." in head
 
 
-class _Connection:
-    def __init__(self, server: DebugServer, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+class Session:
+    """One client of the debug server, whatever carries its lines (TCP, a WebSocket).
+
+    It parses each line, checks the token, answers stateless commands at once and queues the rest for
+    the thread that owns the data. Answers go out strictly in the order the commands came, through
+    ``_write``, which each transport supplies. Runs in the network thread.
+    """
+
+    def __init__(self, server: DebugServer, peer: Any) -> None:
         self.server = server
-        self.reader, self.writer = reader, writer
+        self.peer = peer
         self.authenticated = server.token is None
         self.next_sequence = 0
         self.next_answer = 0
@@ -185,47 +192,30 @@ class _Connection:
         self.room = asyncio.Event()
         self.closed = False
         self.reading_done = False
-        self.peer = writer.get_extra_info("peername")
-        self.frame_bytes = 0  # read in the current frame
         self.auth_times: deque[float] = deque(maxlen=AUTH_PER_SECOND)
         self.auth_failures = 0
 
-    async def serve(self) -> None:
-        decoder = TelnetDecoder(self.server.max_line)
-        try:
-            while not self.closed:
-                data = await self.reader.read(65536)
-                if not data:
-                    break
-                for line in decoder.feed(data):
-                    if line is not None and line.lstrip()[:4] == b"auth":
-                        await self._pace_auth()
-                    self._line(line)
-                while self.outstanding > MAX_OUTSTANDING and not self.closed:
-                    self.room.clear()
-                    await self.room.wait()
-                self.frame_bytes += len(data)
-                if self.frame_bytes > self.server.max_bytes_per_frame:
-                    await self.server.next_frame_started()  # read no further from it this frame
-                    self.frame_bytes = 0
-        except (ConnectionError, asyncio.IncompleteReadError):
-            self.drop()
-            return
-        # The client sent everything (it may have half-closed): answer what is open, then close.
-        self.reading_done = True
-        self._finish_if_done()
+    # ------------------------------------------------------------------ what a transport supplies
+    def _write(self, data: bytes) -> bool:
+        """Send these answer bytes; False when the client is gone or does not read (then it is dropped)."""
+        raise NotImplementedError
 
-    def _line(self, raw: bytes | None) -> None:
+    def _close_transport(self, abort: bool) -> None:
+        raise NotImplementedError
+
+    # ------------------------------------------------------------------ lines in
+    async def wait_for_room(self) -> None:
+        """Read no further while too many of this client's commands are open (back-pressure)."""
+        while self.outstanding > MAX_OUTSTANDING and not self.closed:
+            self.room.clear()
+            await self.room.wait()
+
+    def handle_line(self, raw: bytes | None) -> None:
+        """One line from the client (None: it was too long)."""
         if self.closed:
             return
         if raw is not None and not raw.strip():
             return  # an empty line is no command: telnet users press enter
-        if self.next_sequence == 0 and raw is not None and looks_like_http(raw):
-            # A web page can make a browser send a POST here; its body would run as commands. Never.
-            log.warning("debug server: closed a connection from %s that speaks HTTP (%r); nothing was run",
-                        self.peer, raw[:60])
-            self.drop()
-            return
         sequence = self.next_sequence
         self.next_sequence += 1
         if raw is None:
@@ -240,21 +230,14 @@ class _Connection:
             self.deliver(sequence, answer_bytes(f"error: {exc}"))
             return
         if command.name == "auth":
-            token = next((k for k, v in command.args.items() if v == ""), "") or command.args.get("token", "")
-            if self.server.token is None or hmac.compare_digest(str(token).encode(), self.server.token.encode()):
-                self.authenticated = True
-                self.deliver(sequence, answer_bytes("authenticated"))
-                return
-            self.auth_failures += 1
-            if self.auth_failures >= AUTH_FAILURES:
-                log.warning("debug server: closed %s after %d wrong tokens", self.peer, self.auth_failures)
-                self.deliver(sequence, answer_bytes(f"error: wrong token; {AUTH_FAILURES} wrong tokens, closing"))
-                self.close()
-            else:
-                self.deliver(sequence, answer_bytes("error: wrong token"))
+            self._authenticate(sequence, command)
             return
         if not self.authenticated:
             self.deliver(sequence, answer_bytes("error: not authenticated (send: auth TOKEN)"))
+            return
+        local = self.local_command(command)
+        if local is not None:
+            self.deliver(sequence, answer_bytes(local))
             return
         if command.name in DebugRouter.IMMEDIATE:  # stateless: answer here, in order, without waiting a frame
             ((is_error, payload),) = self.server.router.handle_batch([command])
@@ -263,13 +246,34 @@ class _Connection:
         self.outstanding += 1
         self.server.pending.put(_Request(self, sequence, command))
 
-    async def _pace_auth(self) -> None:
+    def local_command(self, command: Command) -> str | None:
+        """A command the transport answers itself (a WebSocket's subscriptions); None: not one."""
+        return None
+
+    def _authenticate(self, sequence: int, command: Command) -> None:
+        token = next((k for k, v in command.args.items() if v == ""), "") or command.args.get("token", "")
+        if self.server.token is None or hmac.compare_digest(str(token).encode(), self.server.token.encode()):
+            self.authenticated = True
+            self.deliver(sequence, answer_bytes("authenticated"))
+            return
+        self.auth_failures += 1
+        if self.auth_failures >= AUTH_FAILURES:
+            log.warning("debug server: closed %s after %d wrong tokens", self.peer, self.auth_failures)
+            self.deliver(sequence, answer_bytes(f"error: wrong token; {AUTH_FAILURES} wrong tokens, closing"))
+            self.close()
+        else:
+            self.deliver(sequence, answer_bytes("error: wrong token"))
+
+    async def pace_auth(self, raw: bytes | None) -> None:
         """At most ``AUTH_PER_SECOND`` attempts a second: guessing a token takes forever."""
+        if raw is None or raw.lstrip()[:4] != b"auth":
+            return
         now = time.monotonic()
         if len(self.auth_times) == AUTH_PER_SECOND and now - self.auth_times[0] < 1.0:
             await asyncio.sleep(1.0 - (now - self.auth_times[0]))
         self.auth_times.append(time.monotonic())
 
+    # ------------------------------------------------------------------ answers out
     def deliver(self, sequence: int, data: bytes) -> None:
         """Network thread: keep the answer and send every answer that is next in order."""
         self.deliver_many([(sequence, data)])
@@ -278,18 +282,12 @@ class _Connection:
         """Network thread: keep the answers; send, in one write, all that are next in order."""
         if self.closed:
             return
-        if self.writer.transport.is_closing():  # the client is gone (reset): stop answering it
-            self.drop()
-            return
         self.answers.update(answers)
         ready = []
         while self.next_answer in self.answers:
             ready.append(self.answers.pop(self.next_answer))
             self.next_answer += 1
-        if ready:
-            self.writer.write(b"".join(ready))
-        if self.writer.transport.get_write_buffer_size() > self.server.max_output:
-            log.warning("dropping debug client %s: it does not read its answers", self.peer)
+        if ready and not self._write(b"".join(ready)):
             self.drop()
             return
         self._finish_if_done()
@@ -301,25 +299,77 @@ class _Connection:
 
     def _finish_if_done(self) -> None:
         if self.reading_done and self.outstanding <= 0 and not self.answers and not self.closed:
-            self.closed = True
-            self.writer.close()  # graceful: what is buffered still goes out
-            self.server.connections.discard(self)
+            self.close()  # graceful: what is buffered still goes out
 
     def close(self) -> None:
         """Close after what is already written has gone out; nothing more is read or answered."""
-        if not self.closed:
-            self.closed = True
-            self.room.set()
-            self.writer.close()
-            self.server.connections.discard(self)
+        self._end(abort=False)
 
     def drop(self) -> None:
         """Close at once, discarding unsent answers (a client that does not read, or is gone)."""
+        self._end(abort=True)
+
+    def _end(self, abort: bool) -> None:
         if not self.closed:
             self.closed = True
             self.room.set()
-            self.writer.transport.abort()
+            self._close_transport(abort)
             self.server.connections.discard(self)
+
+
+class _Connection(Session):
+    """A TCP client (telnet, ``tafel console``, tools): lines in, NUL-terminated answers out."""
+
+    def __init__(self, server: DebugServer, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        super().__init__(server, writer.get_extra_info("peername"))
+        self.reader, self.writer = reader, writer
+        self.frame_bytes = 0  # read in the current frame
+
+    async def serve(self) -> None:
+        decoder = TelnetDecoder(self.server.max_line)
+        try:
+            while not self.closed:
+                data = await self.reader.read(65536)
+                if not data:
+                    break
+                for line in decoder.feed(data):
+                    await self.pace_auth(line)
+                    self.handle_line(line)
+                await self.wait_for_room()
+                self.frame_bytes += len(data)
+                if self.frame_bytes > self.server.max_bytes_per_frame:
+                    await self.server.next_frame_started()  # read no further from it this frame
+                    self.frame_bytes = 0
+        except (ConnectionError, asyncio.IncompleteReadError):
+            self.drop()
+            return
+        # The client sent everything (it may have half-closed): answer what is open, then close.
+        self.reading_done = True
+        self._finish_if_done()
+
+    def handle_line(self, raw: bytes | None) -> None:
+        if self.next_sequence == 0 and raw is not None and looks_like_http(raw) and not self.closed:
+            # A web page can make a browser send a POST here; its body would run as commands. Never.
+            log.warning("debug server: closed a connection from %s that speaks HTTP (%r); nothing was run",
+                        self.peer, raw[:60])
+            self.drop()
+            return
+        super().handle_line(raw)
+
+    def _write(self, data: bytes) -> bool:
+        if self.writer.transport.is_closing():  # the client is gone (reset): stop answering it
+            return False
+        self.writer.write(data)
+        if self.writer.transport.get_write_buffer_size() > self.server.max_output:
+            log.warning("dropping debug client %s: it does not read its answers", self.peer)
+            return False
+        return True
+
+    def _close_transport(self, abort: bool) -> None:
+        if abort:
+            self.writer.transport.abort()
+        else:
+            self.writer.close()
 
 
 class _InProcessClient:
@@ -364,9 +414,9 @@ class DebugServer:
         self._resource_errors = 0
         self._resource_logged_at = 0.0  # monotonic s of the last line about them
         self.pending: queue.SimpleQueue[_Request] = queue.SimpleQueue()
-        self._queues: dict[_Connection, deque[_Request]] = {}
-        self._turns: deque[_Connection] = deque()  # connections with queued commands, in rotation
-        self.connections: set[_Connection] = set()
+        self._queues: dict[Session, deque[_Request]] = {}
+        self._turns: deque[Session] = deque()  # connections with queued commands, in rotation
+        self.connections: set[Session] = set()
         self.answered = 0
         self._loop: asyncio.AbstractEventLoop | None = None
         self._server: asyncio.base_events.Server | None = None
@@ -374,6 +424,8 @@ class DebugServer:
         self._ready = threading.Event()
         self._error: BaseException | None = None
         self._local = _InProcessClient()
+        #: further listeners in this loop (the web page's), closed with the server
+        self.listeners: list[Any] = []
 
     @property
     def address(self) -> tuple[str, int]:
@@ -415,12 +467,9 @@ class DebugServer:
         asyncio.set_event_loop(loop)
 
         async def accept(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
-            if len(self.connections) >= self.max_connections:
-                self.refused += 1
-                if self.refused == 1 or self.refused % 100 == 0:
-                    log.warning("debug server: refused %d connection(s) over the limit of %d", self.refused, self.max_connections)
-                writer.write(answer_bytes(f"error: too many debug connections ({self.max_connections} at most); "
-                                          "close another one and connect again"))
+            refusal = self.refusal()
+            if refusal is not None:
+                writer.write(answer_bytes(refusal))
                 writer.close()
                 return
             connection = _Connection(self, reader, writer)
@@ -443,6 +492,22 @@ class DebugServer:
         finally:
             loop.run_until_complete(loop.shutdown_asyncgens())
             loop.close()
+
+    def refusal(self) -> str | None:
+        """Network thread: why a new client cannot be served (every transport counts), or None."""
+        if len(self.connections) < self.max_connections:
+            return None
+        self.refused += 1
+        if self.refused == 1 or self.refused % 100 == 0:
+            log.warning("debug server: refused %d connection(s) over the limit of %d", self.refused, self.max_connections)
+        return f"error: too many debug connections ({self.max_connections} at most); close another one and connect again"
+
+    def run_in_loop(self, coroutine: Any, timeout: float = 10.0) -> Any:
+        """Run a coroutine in the network thread's event loop and return its result (another transport
+        starts its listener this way, so that all clients share one thread and one set of rules)."""
+        if self._loop is None:
+            raise RuntimeError("the debug server is not running; start() it first")
+        return asyncio.run_coroutine_threadsafe(coroutine, self._loop).result(timeout)
 
     def _loop_error(self, loop: asyncio.AbstractEventLoop, context: dict[str, Any]) -> None:
         """asyncio's errors as one line each, never a traceback per failed accept.
@@ -491,8 +556,9 @@ class DebugServer:
         def shutdown() -> None:
             for connection in list(self.connections):
                 connection.drop()
-            if self._server is not None:
-                self._server.close()
+            for server in (self._server, *self.listeners):
+                if server is not None:
+                    server.close()
             loop.stop()
 
         loop.call_soon_threadsafe(shutdown)
@@ -560,7 +626,7 @@ class DebugServer:
             log.exception("debug commands failed")
             results = [(True, f"internal error in the debug server: {type(exc).__name__}: {exc}")] * len(requests)
         loop = self._loop
-        per_connection: dict[_Connection, list[tuple[int, bytes]]] = {}
+        per_connection: dict[Session, list[tuple[int, bytes]]] = {}
         for request, (is_error, payload) in zip(requests, results):
             data = self.encode(request.command, is_error, payload)
             if not request.connection.closed:
@@ -579,7 +645,7 @@ class DebugServer:
         return answer_bytes(payload, base64_answer=command.base64_answer)
 
     @staticmethod
-    def _deliver(per_connection: dict[_Connection, list[tuple[int, bytes]]]) -> None:
+    def _deliver(per_connection: dict[Session, list[tuple[int, bytes]]]) -> None:
         for connection, answers in per_connection.items():
             for _ in answers:
                 connection.answered()
@@ -594,7 +660,7 @@ class DebugServer:
             if batch:
                 self._answer(batch)
 
-    def serve_while_idle(self, seconds: float, reserve: float = 0.002, share: float = 0.3) -> None:
+    def serve_while_idle(self, seconds: float, reserve: float = 0.002, share: float = 0.25) -> None:
         """Between frames, while the loop would sleep anyway: answer commands as they arrive.
 
         Works in small batches for at most ``share`` of the idle time and stops ``reserve`` seconds

@@ -62,7 +62,10 @@ class LogPlatform(Platform):
             raise PlatformError(str(exc)) from None
         load_all()
         self.loop = bool(self.options.get("loop", False))
+        self.hold = bool(self.options.get("hold", False))
         replace = [n.strip() for n in str(self.options.get("replace") or "").split(",") if n.strip()]
+        if replace == ["all"]:
+            replace = sorted({c.representation for c in self.reader.channels.values() if c.metadata.get("source") != "platform"})
         classes = self._resolve_classes(self.reader, replace)
         topics = self._fed_topics(self.reader, replace)
         #: topic -> class of exactly what replay writes onto the blackboards: sensor data and --replace
@@ -79,7 +82,7 @@ class LogPlatform(Platform):
                                 + (f" ({'; '.join(self.reader.problems)})" if self.reader.problems else ""))
         self.position = 0  # the next step
         self.paused = False
-        self.steps_left: int | None = None  # frames to run before pausing again (stepping)
+        self.steps_left: int | None = 1 if self.options.get("start_paused") else None  # steps to run before pausing again
         self._pending: dict[str, _Frame] = {}
         self._lock = threading.Lock()
         codes = {name: code for code, name in self._context_names.items()}
@@ -96,7 +99,9 @@ class LogPlatform(Platform):
         parser.add_argument("--log", help="log: the MCAP file to replay")
         parser.add_argument("--loop", action="store_true", help="log: start again at the end")
         parser.add_argument("--replace", default="", metavar="A,B",
-                            help="log: also feed these recorded representations, replacing their modules")
+                            help="log: also feed these recorded representations, replacing their modules ('all': every one)")
+        parser.add_argument("--start-paused", action="store_true", help="log: replay the first frame, then wait for log:play")
+        parser.add_argument("--hold", action="store_true", help="log: pause at the end instead of ending the run")
 
     # -------------------------------------------------------------------------------- set-up
     @staticmethod
@@ -199,6 +204,9 @@ class LogPlatform(Platform):
             if self.paused:
                 return None
             if self.position >= self.steps:
+                if self.hold:
+                    self.paused = True
+                    return None
                 if not self.loop:
                     raise EndOfData(f"end of log {self.path}")
                 self.position = 0
@@ -271,7 +279,7 @@ class LogPlatform(Platform):
             self.paused, self.steps_left = False, count
 
     def goto(self, frame_number: int, context: str = "") -> None:
-        """Pause at the step holding ``frame_number`` of the main context (or of ``context``)."""
+        """Replay the step holding ``frame_number`` of the main context (or of ``context``) and pause there."""
         context = context or ("motion" if "motion" in self._by_context else "cognition")
         frames = self._by_context.get(context, np.zeros(0, np.int64))
         numbers = self.frame_number[frames]
@@ -282,8 +290,14 @@ class LogPlatform(Platform):
                 if len(numbers) else f"the log has no {context} frames"
             )
         step = int(np.searchsorted(self.step_starts, found[0], side="right")) - 1
-        with self._lock:
-            self.position, self.paused, self.steps_left = step, True, None
+        # from the latest frame of every context at or before it, so that each shows its frame of that moment
+        start = step
+        for indices in self._by_context.values():
+            before = indices[indices < self.step_starts[step + 1]]
+            if len(before):
+                start = min(start, int(np.searchsorted(self.step_starts, before[-1], side="right")) - 1)
+        with self._lock:  # replay up to that step (a seek shows the frame), then pause
+            self.position, self.paused, self.steps_left = start, False, step - start + 1
 
     def status(self) -> dict[str, Any]:
         with self._lock:
@@ -295,6 +309,16 @@ class LogPlatform(Platform):
             "steps": self.steps,
             "frames": {f.context: f.number for f in current},
         }
+
+    def timeline(self) -> dict[str, Any]:
+        """Where replay is, for a timeline: the main context's last replayed frame and the range of its frames."""
+        status = self.status()
+        context = "motion" if "motion" in self._by_context else "cognition"
+        frames = self._by_context.get(context, np.zeros(0, np.int64))  # frame indices, in time order
+        numbers = self.frame_number[frames]
+        done = int(np.searchsorted(frames, self.step_starts[min(status["step"], self.steps)], side="left")) if status["step"] else 0
+        return {**status, "context": context, "frame": int(numbers[done - 1]) if done else None,
+                "frame_range": [int(numbers.min()), int(numbers.max())] if len(numbers) else [0, 0]}
 
     def stop(self) -> None:
         self.reader.close()

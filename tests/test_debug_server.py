@@ -324,15 +324,18 @@ def test_replay_commands(tmp_path: Path) -> None:
         time.sleep(0.3)
         assert frame_of(replay, "motion") == frame  # paused
         assert replay.ask("log:goto -frame 100") == "paused at frame 100"
+        time.sleep(0.3)
+        assert frame_of(replay, "motion") == 100  # a seek shows the frame
+        assert json.loads(replay.ask("log:position"))["frame"] == 100
         assert replay.ask("log:step -count 1") == "stepping 1"
         time.sleep(0.3)
-        assert frame_of(replay, "motion") == 100
+        assert frame_of(replay, "motion") == 101
         replay.ask("log:step -count 2")
         time.sleep(0.3)
-        assert frame_of(replay, "motion") == 102
+        assert frame_of(replay, "motion") == 103
         replay.ask("log:step -count -1")
         time.sleep(0.3)
-        assert frame_of(replay, "motion") == 101
+        assert frame_of(replay, "motion") == 102
         assert replay.ask("log:goto -frame 9999").startswith("error: the log has no motion frame 9999")
         assert replay.ask("log:play") == "playing"
     finally:

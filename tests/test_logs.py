@@ -240,11 +240,12 @@ def test_stepping_the_replay(recorded: Path) -> None:
     platform.step(-1)
     again = platform.next_step()
     assert again == second and platform.next_step() is None  # back to the frame before the current one
-    platform.goto(100)
-    assert platform.paused
-    platform.play()
-    platform.next_step()
-    assert platform.status()["frames"]["motion"] == 100
+    platform.goto(100)  # replays up to frame 100 (from cognition's latest frame before it), then pauses
+    replayed = list(iter(platform.next_step, None))
+    assert 1 <= len(replayed) <= 4 and platform.status()["frames"]["motion"] == 100
+    assert {c for _, contexts in replayed for c in contexts} == {"motion", "cognition"}
+    assert platform.paused and platform.next_step() is None
+    assert platform.timeline()["frame"] == 100 and platform.timeline()["frame_range"] == [1, 600]
     with pytest.raises(PlatformError, match="no motion frame 5000; its motion frames are 1..600"):
         platform.goto(5000)
     with pytest.raises(PlatformOptionError):

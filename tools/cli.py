@@ -9,10 +9,8 @@ import importlib
 import ipaddress
 import logging
 import math
-import multiprocessing
 import os
 import pkgutil
-import queue
 import re
 import sys
 import threading
@@ -36,6 +34,7 @@ from tafel.core.runtime import (
     install_signal_handlers,
     program_fingerprint,
 )
+from tafel.debug.commands import frame_number
 from tafel.tools.debugging import (
     DEBUG_REPRESENTATIONS,
     LocalExecutor,
@@ -47,12 +46,14 @@ from tafel.tools.debugging import (
     worker_debug_setup,
     worker_setups,
 )
+from tafel.tools.live_feed import forward
 
 #: the default configuration, shipped inside the package (the repository's config/ folder)
 DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "config"
 FALLBACK_PLATFORM = "dummy"
 DEFAULT_DEBUG_PORT = 5401
 DEFAULT_FOXGLOVE_PORT = 8765
+DEFAULT_WEB_PORT = 5480
 
 
 class UsageError(Exception):
@@ -150,7 +151,11 @@ def build_parser() -> argparse.ArgumentParser:
                        help="read the token from a file (it then does not show in ps); a trailing newline is dropped")
     run.add_argument("--debug-max-connections", type=positive(int), default=32, metavar="N",
                      help="debug connections served at once; more get an error line (default: %(default)s)")
-    run.add_argument("--no-debug", action="store_true", help="run without the debug server")
+    run.add_argument("--no-debug", action="store_true", help="run without the debug server (and without the web view)")
+    run.add_argument("--web-port", type=port_number, default=DEFAULT_WEB_PORT, metavar="P",
+                     help="serve RobotControl in the browser on the debug server's address at this port "
+                          "(default %(default)s; 0 takes a free one)")
+    run.add_argument("--no-web", action="store_true", help="run without the web view")
     run.add_argument("--foxglove", nargs="?", const=f"127.0.0.1:{DEFAULT_FOXGLOVE_PORT}", metavar="[HOST:]PORT",
                      help=f"serve Foxglove and Lichtblick live over WebSocket (default 127.0.0.1:{DEFAULT_FOXGLOVE_PORT}; "
                           "with --debug-token clients must give it: ws://HOST:PORT/?token=T)")
@@ -164,6 +169,17 @@ def build_parser() -> argparse.ArgumentParser:
 
     platforms = commands.add_parser("platforms", help="list the platforms and what they provide and consume")
     platforms.add_argument("--verbose", "-v", action="store_true", help="also list each platform's options")
+
+    view = commands.add_parser("view", help="RobotControl in the browser for a recorded log: play, pause, step and scrub",
+                               epilog="The recorded representations are shown as recorded; modules whose outputs the log "
+                                      "does not hold run again on the recorded data.")
+    view.add_argument("file", type=Path, metavar="FILE.mcap")
+    view.add_argument("--web-port", type=port_number, default=DEFAULT_WEB_PORT, metavar="P",
+                      help="serve the page at this port (default %(default)s; 0 takes a free one)")
+    view.add_argument("--debug-port", type=port_number, default=0, metavar="P", help="debug server port (default: a free one)")
+    view.add_argument("--debug-host", default="127.0.0.1", metavar="H", help="the address of both (default: %(default)s)")
+    view.add_argument("--debug-token", metavar="T", help="clients and the page must send 'auth T' first")
+    view.add_argument("--speed", type=parse_speed, default=1.0, help="playing speed: a factor, or 'max'")
 
     modules = commands.add_parser("modules", help="show the module graph of both contexts")
     add_program_arguments(modules)
@@ -409,25 +425,44 @@ def start_foxglove(args: argparse.Namespace, debug: ProgramDebug | None, config:
     return live
 
 
-def concurrent_foxglove(args: argparse.Namespace) -> tuple[Any, Any]:
-    """For contexts in other processes: (the shared flags of what to hand over, the queue it comes through)."""
-    if args.foxglove is None:
+def web_representations(plans: Mapping[str, ContextPlan]) -> list[type]:
+    """Every representation of the program: what the web page may subscribe to."""
+    reps = {rep for plan in plans.values() for rep in plan.external}
+    reps |= {rep for plan in plans.values() for module in plan.modules
+             for rep in (*module.requirements().reads(), *module.requirements().provides)}
+    return sorted(reps, key=lambda rep: rep.__name__)
+
+
+def start_web(args: argparse.Namespace, debug: ProgramDebug | None, plans: Mapping[str, ContextPlan], config: dict[str, Any],
+              flags: Any = None) -> Any:
+    """The web view on the debug server's address, listening; None with --no-web or --no-debug."""
+    if debug is None or args.no_web:
+        return None
+    from tafel.tools.web import WebView
+
+    web = WebView(debug.server, web_representations(plans), host=args.debug_host, port=args.web_port,
+                  jpeg_quality=jpeg_quality(config), flags=flags)
+    try:
+        web.start()
+    except OSError as exc:
+        reason = "is taken (another tafel run?)" if exc.errno == errno.EADDRINUSE else f"cannot be opened ({exc.strerror or exc})"
+        fail(f"web port {args.debug_host}:{args.web_port} {reason}; choose another with --web-port P, "
+             "take a free one with --web-port 0, or run without it with --no-web")
+    print(f"web view at {web.url()}" + (" (the page asks for the token)" if debug.server.token else ""), flush=True)
+    return web
+
+
+def concurrent_feed(wanted: bool, reps: Sequence[type], setups: list[Any]) -> tuple[Any, Any]:
+    """For contexts in other processes: the shared flags and queue of one viewer, and the context
+    processes' set-up that feeds them; (None, None) when the viewer is off."""
+    if not wanted:
         return None, None
-    from tafel.tools.foxglove_live import FED, QUEUE_SIZE
+    from tafel.tools.live_feed import LiveFeed, shared_feed, worker_feed_setup
 
-    spawn = multiprocessing.get_context("spawn")
-    return spawn.Array("b", len(FED), lock=False), spawn.Queue(maxsize=QUEUE_SIZE)
-
-
-def forward_foxglove(live: Any, feed: Any, stop: Any) -> None:
-    """Supervisor thread: what the context processes handed over, to the bridge."""
-    while not stop.is_set():
-        try:
-            live.take(feed.get(timeout=0.2))
-        except queue.Empty:
-            continue
-        except (EOFError, OSError):
-            return
+    names = [rep.__name__ for rep in LiveFeed(reps).reps]
+    flags, feed = shared_feed(len(names))
+    setups.append((worker_feed_setup, {"names": names, "flags": flags, "queue": feed}))
+    return flags, feed
 
 
 def shutdown_grace(config: dict[str, Any]) -> float:
@@ -442,12 +477,12 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
     runtime = LockstepRuntime(plans, platform, strict=args.strict, recorder=recorder)
     debug = start_debug(args, recorder, plans, config)
     if debug is not None:
-        recorded = debug_recorded(recorder)
+        recorded = debug_recorded(recorder, [] if args.no_web else list(plans))
         for name, runner in runtime.runners.items():
             debug.add_context(name, LocalExecutor(context_debug(name, runner.manager, recorded.get(name, ()))), plans[name])
         debug.add_platform_commands(platform)
-        # between ticks a millisecond of commands; while the loop is behind, one command (no client starves)
-        runtime.after_tick.append(lambda rt: debug.server.process_pending(budget_s=0.001 if rt.behind_s < 0.001 else 0.0,
+        # between ticks half a millisecond of commands; while the loop is behind, one (no client starves)
+        runtime.after_tick.append(lambda rt: debug.server.process_pending(budget_s=0.0005 if rt.behind_s < 0.001 else 0.0,
                                                                          chunk=8 if rt.behind_s < 0.001 else 1))
         runtime.idle = debug.server.serve_while_idle
     elif recorder is not None:  # no server, but recorded debug data (drawings, module times) is still filled in
@@ -456,10 +491,12 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
             context_debug(name, runner.manager, recorded.get(name, ()))
     install_signal_handlers(runtime.stop, grace_s=shutdown_grace(config))
     listen(args, debug)
+    web = start_web(args, debug, plans, config)
     live = start_foxglove(args, debug, config)
-    if live is not None:
-        for runner in runtime.runners.values():
-            runner.after_step.append(lambda r: live.after_frame(r.name, r.manager.blackboard, r.time_ns))
+    for viewer in (web, live):
+        if viewer is not None:
+            for runner in runtime.runners.values():
+                runner.after_step.append(lambda r, feed=viewer.feed: feed.after_frame(r.name, r.manager.blackboard, r.time_ns, frame_number(r.manager)))
     started = time.monotonic()
     last = [started]
     line = StatusLine(type(platform).name, config)
@@ -475,8 +512,9 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
     try:
         stats = runtime.run(limits)
     finally:
-        if live is not None:
-            live.stop()
+        for viewer in (live, web):
+            if viewer is not None:
+                viewer.stop()
         if debug is not None:
             debug.server.stop()
     print_summary(type(platform).name, "lockstep", stats, runtime.wall_s, runtime.time_ns * 1e-9, runtime.end_reason, simulated=True)
@@ -493,14 +531,13 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
     if debug is not None:
         running = [name for name, plan in plans.items() if plan.runs]
         ours, theirs = concurrent_pipes(running)
-        setups.append((worker_debug_setup, {"connections": theirs, "recorded": debug_recorded(recorder)}))
+        setups.append((worker_debug_setup, {"connections": theirs, "recorded": debug_recorded(recorder, [] if args.no_web else list(plans))}))
         for name in running:
             debug.add_context(name, RemoteExecutor(name, ours[name]), plans[name])
-    flags, feed = concurrent_foxglove(args)
-    if feed is not None:
-        from tafel.tools.foxglove_live import worker_feed_setup
+    from tafel.tools.foxglove_live import FED
 
-        setups.append((worker_feed_setup, {"flags": flags, "queue": feed}))
+    flags, feed = concurrent_feed(args.foxglove is not None, FED, setups)
+    web_flags, web_feed = concurrent_feed(debug is not None and not args.no_web, web_representations(plans), setups)
     setup = (worker_setups, setups) if setups else None
     stall = float(config.get("runtime", {}).get("stall_timeout_s", 1.0))
     runtime = ConcurrentRuntime(plans, platform_class, options, strict=args.strict, stall_timeout_s=stall,
@@ -526,14 +563,17 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
     if debug is not None:
         listen(args, debug)
         threading.Thread(target=debug.server.dispatch_forever, args=(runtime.stop,), name="tafel-debug-dispatch", daemon=True).start()
+    web = start_web(args, debug, plans, config, web_flags)
     live = start_foxglove(args, debug, config, flags)
-    if live is not None:
-        threading.Thread(target=forward_foxglove, args=(live, feed, runtime.stop), name="tafel-foxglove-forward", daemon=True).start()
+    for viewer, source in ((web, web_feed), (live, feed)):
+        if viewer is not None:
+            threading.Thread(target=forward, args=(source, viewer.feed, runtime.stop), name="tafel-viewer-forward", daemon=True).start()
     try:
         stats = runtime.run(limits)
     finally:
-        if live is not None:
-            live.stop()
+        for viewer in (live, web):
+            if viewer is not None:
+                viewer.stop()
         if debug is not None:
             debug.server.stop()
     realtime = stats.get("motion", ContextStats("motion")).realtime
@@ -544,11 +584,14 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
     return 1 if any(s.failure for s in stats.values()) else 0
 
 
-def debug_recorded(recorder: Recorder | None) -> dict[str, list[type]]:
-    """Per context, the debug representations the recorder takes (they must be filled every frame)."""
-    if recorder is None:
-        return {}
-    return {context: [s.rep for s in selections if s.source == "debug"] for context, selections in recorder.by_context.items()}
+def debug_recorded(recorder: Recorder | None, web_contexts: Sequence[str] = ()) -> dict[str, list[type]]:
+    """Per context, the debug representations that must be filled every frame: those the recorder takes,
+    and with the web view all of them (its page subscribes to them)."""
+    recorded = {} if recorder is None else \
+        {context: [s.rep for s in selections if s.source == "debug"] for context, selections in recorder.by_context.items()}
+    for context in web_contexts:
+        recorded[context] = list(dict.fromkeys([*recorded.get(context, []), *DEBUG_REPRESENTATIONS]))
+    return recorded
 
 
 def status_print(text: str) -> None:
@@ -711,7 +754,21 @@ def command_console(args: argparse.Namespace, extra: Sequence[str]) -> int:
     return run_console(args)
 
 
-COMMANDS = {"run": command_run, "platforms": command_platforms, "modules": command_modules, "log": command_log,
+def command_view(args: argparse.Namespace, extra: Sequence[str]) -> int:
+    """``tafel view FILE``: ``tafel run`` on the log platform, every recorded representation fed as
+    recorded, paused at the first frame and at the end, with the web view's log player."""
+    if not args.file.is_file():
+        fail(f"{args.file}: no such file; tafel view takes a recorded log (FILE.mcap)")
+    argv = ["run", "--platform", "log", "--log", str(args.file), "--replace", "all", "--start-paused", "--hold",
+            "--web-port", str(args.web_port), "--debug-port", str(args.debug_port), "--debug-host", args.debug_host,
+            "--speed", "max" if args.speed is None else repr(args.speed), "--status-interval", "3600", *extra]
+    if args.debug_token is not None:
+        argv += ["--debug-token", args.debug_token]
+    run_args, run_extra = build_parser().parse_known_args(argv)
+    return command_run(run_args, run_extra)
+
+
+COMMANDS = {"run": command_run, "view": command_view, "platforms": command_platforms, "modules": command_modules, "log": command_log,
             "console": command_console}
 
 

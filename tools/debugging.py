@@ -57,16 +57,19 @@ def instrument(context: str, manager: ModuleManager, meter: RateMeter) -> None:
     """Frame hooks: tell the debug concepts which context runs, keep its drawings and plots per frame."""
     manager.before_frame.append(lambda: STATE.begin_frame(context, manager.frame + 1))
 
+    fed = set(manager.external)  # replaying a log feeds recorded debug data: it is shown as recorded
+
     def after() -> None:
         STATE.end_frame(context)
         meter.tick()
-        if DebugDrawings in manager.blackboard or DebugPlots in manager.blackboard:
+        filled = [rep for rep in DEBUG_REPRESENTATIONS if rep in manager.blackboard and rep not in fed]
+        if DebugDrawings in filled or DebugPlots in filled:
             drawings, plots = frame_debug_data(context)
-            if DebugDrawings in manager.blackboard:
+            if DebugDrawings in filled:
                 manager.blackboard.set(drawings)
-            if DebugPlots in manager.blackboard:
+            if DebugPlots in filled:
                 manager.blackboard.set(plots)
-        if ModuleTimes in manager.blackboard:
+        if ModuleTimes in filled:
             manager.blackboard.set(ModuleTimes(*manager.last_times_ms()))
 
     manager.after_frame.append(after)
@@ -264,6 +267,8 @@ class ProgramDebug:
         router.register("log:start", "start recording", "log:start [-file FILE.mcap]", self._log_start)
         router.register("log:stop", "stop recording and finish the file", "log:stop", self._log_stop)
         router.register("log:status", "whether and where recording goes, with counts", "log:status", self._log_status)
+        router.register("field:geometry", "the field's lines, circle, marks and goal posts as JSON (mm, field frame)", "field:geometry",
+                        lambda command: json.dumps(field_geometry()))
         self.handovers: list[tuple[str, str, str]] = []
 
     def add_aliases(self, aliases: Mapping[str, Any]) -> None:
@@ -324,13 +329,15 @@ class ProgramDebug:
 
     def add_platform_commands(self, platform: Any) -> None:
         """Replay stepping for the log platform, and whatever commands a platform offers."""
-        if all(hasattr(platform, m) for m in ("play", "pause", "step", "goto")):
+        if all(hasattr(platform, m) for m in ("play", "pause", "step", "goto", "timeline")):
             self.router.register("log:play", "replay: run", "log:play", lambda c: (platform.play(), "playing")[1])
             self.router.register("log:pause", "replay: pause", "log:pause", lambda c: (platform.pause(), "paused")[1])
             self.router.register("log:step", "replay: step N frames (negative: back) and pause", "log:step [-count N]",
                                  lambda c: self._replay_step(platform, c))
             self.router.register("log:goto", "replay: pause at a frame of the main context", "log:goto -frame N",
                                  lambda c: self._replay_goto(platform, c))
+            self.router.register("log:position", "replay: where it is, as JSON (frame of the main context, its range, paused)",
+                                 "log:position", lambda c: json.dumps(platform.timeline()))
         for name, (summary, handler) in platform.commands().items():
             self.router.register(name, summary, name, lambda c, h=handler: h(dict(c.args)))
 
@@ -404,6 +411,18 @@ class ProgramDebug:
         if self.recorder is None:
             return "recording: not available"
         return json.dumps(self.recorder.status())
+
+
+def field_geometry() -> dict[str, Any]:
+    """What a view needs to draw the field to scale (``tafel.representations.field``)."""
+    from tafel.representations import field
+
+    return {"length": field.LENGTH, "width": field.WIDTH, "border": field.BORDER_STRIP, "line_width": field.LINE_WIDTH,
+            "lines": [list(s) for s in field.line_segments()],
+            "circle": {"x": 0.0, "y": 0.0, "radius": field.CENTER_CIRCLE_DIAMETER / 2},
+            "marks": [list(c) for c in field.mark_centres()], "mark_size": field.MARK_SIZE,
+            "posts": [list(p) for p in field.goal_post_positions()], "post_radius": field.GOAL_POST_DIAMETER / 2,
+            "goal_depth": field.GOAL_DEPTH, "ball_radius": field.BALL_RADIUS}
 
 
 def _default(value: Any) -> str:

@@ -15,24 +15,20 @@ for clients that read too slowly.
 from __future__ import annotations
 
 import asyncio
-import copy
-import dataclasses
 import hmac
 import logging
-import queue
 import re
 import threading
-import time
 from collections.abc import Callable
 from typing import Any
 from urllib.parse import parse_qs, urlsplit
 
 import foxglove
-import numpy as np
 from foxglove import messages as fm
 from foxglove.websocket import Capability, ChannelView, Client, MessageSchema, Parameter, Service, ServiceRequest, ServiceSchema
 
 from tafel.tools.foxglove_channels import JSON_SCHEMA, NEEDS, TOPICS, FoxgloveTranslator
+from tafel.tools.live_feed import LiveFeed
 
 log = logging.getLogger("tafel.foxglove")
 #: the message of each protobuf topic (the others carry JSON)
@@ -41,43 +37,10 @@ PROTOBUF_TOPICS = {"/camera/top": fm.CompressedImage, "/camera/bottom": fm.Compr
                    "/camera/top/annotations": fm.ImageAnnotations, "/camera/bottom/annotations": fm.ImageAnnotations,
                    "/scene": fm.SceneUpdate, "/tf": fm.FrameTransforms, "/log": fm.Log}
 COMMAND_SERVICE = "/tafel/command"
-QUEUE_SIZE = 64  # representations waiting for the bridge's thread; beyond that a frame's data is dropped
 
 
-#: every representation the bridge may ask the loops for, in one fixed order (flags across processes)
+#: every representation the bridge may ask the loops for
 FED: tuple[type, ...] = tuple(sorted({rep for reps in NEEDS.values() for rep in reps}, key=lambda rep: rep.__name__))
-
-
-def hand_over(context: str, blackboard: Any, time_ns: int, wanted: Callable[[int], bool], put: Callable[[Any], None]) -> int:
-    """After a frame: a copy of each wanted representation (by index in ``FED``) to ``put``; returns how
-    many did not fit (``put`` raises ``queue.Full``)."""
-    wall, dropped = time.time_ns(), 0
-    for index, rep in enumerate(FED):
-        if wanted(index) and rep in blackboard:
-            try:
-                put((context, snapshot(blackboard[rep]), time_ns, wall))
-            except queue.Full:
-                dropped += 1
-    return dropped
-
-
-def worker_feed_setup(runner: Any, args: dict[str, Any]) -> None:
-    """Runs in a context process of the concurrent runtime: after each frame, hand the bridge in the main
-    process what its clients' subscriptions need (``flags``, shared), through a queue that drops."""
-    flags, feed = args["flags"], args["queue"]
-    runner.after_step.append(lambda r: hand_over(r.name, r.manager.blackboard, r.time_ns, flags.__getitem__, feed.put_nowait))
-
-
-def snapshot(value: Any) -> Any:
-    """A copy of a representation that the loop may go on changing: arrays and lists copied, cheaply."""
-    clone = copy.copy(value)
-    for item in dataclasses.fields(value):
-        field_value = getattr(value, item.name)
-        if isinstance(field_value, np.ndarray):
-            setattr(clone, item.name, field_value.copy())
-        elif isinstance(field_value, list):
-            setattr(clone, item.name, list(field_value))
-    return clone
 
 
 class FoxgloveLive(logging.Handler):
@@ -87,17 +50,14 @@ class FoxgloveLive(logging.Handler):
     def __init__(self, host: str, port: int, *, ask: Callable[[str], str] | None, jpeg_quality: int = 80,
                  token: str | None = None, flags: Any = None) -> None:
         super().__init__(logging.INFO)
-        #: with contexts in other processes: which of ``FED`` they hand over (a shared array)
-        self.flags = flags
+        #: what the loops hand over: with contexts in other processes, ``flags`` (shared) say which of ``FED``
+        self.feed = LiveFeed(FED, flags=flags)
         self.host, self.port = host, port
         self.token = token
         self.gate: TokenGate | None = None
         self.ask = ask
         self.subscribers: dict[str, int] = {}
-        self.needed: frozenset[type] = frozenset()
         self.translator = FoxgloveTranslator(jpeg_quality, wanted=lambda topic: self.subscribers.get(topic, 0) > 0)
-        self.queue: queue.Queue[tuple[str, Any, int, int] | None] = queue.Queue(maxsize=QUEUE_SIZE)
-        self.dropped = 0
         self.sent = 0
         self.channels: dict[str, foxglove.Channel] = {}
         self.server: Any = None
@@ -135,10 +95,7 @@ class FoxgloveLive(logging.Handler):
     def stop(self) -> None:
         logging.getLogger("tafel").removeHandler(self)
         if self.thread.is_alive():
-            try:
-                self.queue.put(None, timeout=5)
-            except queue.Full:  # the thread is stuck; it is a daemon and ends with the program
-                pass
+            self.feed.close()
             self.thread.join(timeout=5)
         if self.gate is not None:
             self.gate.stop()
@@ -148,26 +105,13 @@ class FoxgloveLive(logging.Handler):
         for channel in self.channels.values():
             channel.close()
 
-    def after_frame(self, context: str, blackboard: Any, time_ns: int) -> None:
-        """In the loop, after each frame: copies of what subscribed topics need; never waits."""
-        needed = self.needed
-        if needed:
-            self.dropped += hand_over(context, blackboard, time_ns, lambda index: FED[index] in needed, self.queue.put_nowait)
-
-    def take(self, item: tuple[str, Any, int, int]) -> None:
-        """What a context process handed over (the concurrent runtime's forwarding thread)."""
-        try:
-            self.queue.put_nowait(item)
-        except queue.Full:
-            self.dropped += 1
-
     # ------------------------------------------------------------------------------- the thread
     def _work(self) -> None:
         while True:
-            item = self.queue.get()
+            item = self.feed.get()
             if item is None:
                 return
-            context, value, time_ns, wall = item
+            context, value, time_ns, wall = item.context, item.value, item.time_ns, item.wall_ns
             try:
                 for out in self.translator.feed(context, value, time_ns, wall):
                     self._send(out.topic, out.message, out.wall_ns)
@@ -200,10 +144,7 @@ class FoxgloveLive(logging.Handler):
         self._update_needed()
 
     def _update_needed(self) -> None:
-        self.needed = frozenset(rep for topic, count in self.subscribers.items() if count for rep in NEEDS.get(topic, ()))
-        if self.flags is not None:
-            for index, rep in enumerate(FED):
-                self.flags[index] = rep in self.needed
+        self.feed.need(rep for topic, count in self.subscribers.items() if count for rep in NEEDS.get(topic, ()))
 
     def on_get_parameters(self, client: Client, param_names: list[str], request_id: str | None = None) -> list[Parameter]:
         parameters = self._parameters()

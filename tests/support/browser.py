@@ -1,0 +1,78 @@
+"""Headless Chromium for the web view's tests and benchmark, driven by Playwright.
+
+Debian's ``chromium`` package is used (``apt-get install chromium``); Playwright's own browser
+download is not needed. ``TAFEL_CHROMIUM`` may name another executable.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+import threading
+from pathlib import Path
+from typing import Any
+
+REPO = Path(__file__).resolve().parents[2]
+#: flags for a machine without display or internet: no sandbox (root), no GPU, no background traffic
+CHROMIUM_FLAGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
+                  "--disable-component-update", "--disable-sync", "--disable-dev-shm-usage"]
+
+
+def chromium_path() -> str | None:
+    return os.environ.get("TAFEL_CHROMIUM") or shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+def missing_browser() -> str | None:
+    """Why browser tests cannot run here, or None."""
+    try:
+        import playwright.sync_api  # noqa: F401
+    except ImportError:
+        return "Playwright is not installed (pip install -e '.[test]')"
+    if chromium_path() is None:
+        return "no Chromium: install Debian's package (sudo apt-get install chromium) or set TAFEL_CHROMIUM"
+    return None
+
+
+def launch(playwright: Any) -> Any:
+    return playwright.chromium.launch(executable_path=chromium_path(), args=CHROMIUM_FLAGS)
+
+
+class WebProgram:
+    """A ``tafel`` subprocess (``run`` or ``view``) with the addresses of its debug server and page."""
+
+    def __init__(self, *args: str, cwd: Path = REPO) -> None:
+        self.process = subprocess.Popen([sys.executable, "-m", "tafel.tools.cli", *args], cwd=cwd, stdout=subprocess.PIPE,
+                                        stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(REPO)})
+        self.output: list[str] = []
+        self.errors: list[str] = []
+        self.debug: tuple[str, int] | None = None
+        self.url = ""
+        for line in self.process.stdout:
+            self.output.append(line)
+            if match := re.match(r"debug server listening on ([\d.]+):(\d+)", line):
+                self.debug = (match.group(1), int(match.group(2)))
+            if match := re.match(r"web view at (http://\S+)", line):
+                self.url = match.group(1)
+                break
+        assert self.url and self.debug, "".join(self.output) + self.process.stderr.read()
+        self.readers = [threading.Thread(target=lambda s=stream, k=sink: k.extend(s), daemon=True)
+                        for stream, sink in ((self.process.stdout, self.output), (self.process.stderr, self.errors))]
+        for reader in self.readers:
+            reader.start()
+
+    def ask(self, line: str) -> str:
+        from tafel.debug.client import DebugClient
+
+        assert self.debug is not None
+        with DebugClient(*self.debug) as client:
+            return client.ask(line)
+
+    def stop(self) -> tuple[str, str]:
+        self.process.terminate()
+        self.process.wait(timeout=30)
+        for reader in self.readers:
+            reader.join(timeout=10)
+        return "".join(self.output), "".join(self.errors)

@@ -1,0 +1,5 @@
+"""RobotControl in the browser: the page the program serves, and what feeds it."""
+
+from tafel.tools.web.view import STATIC, WebView
+
+__all__ = ["STATIC", "WebView"]

@@ -1,0 +1,123 @@
+// RobotControl in the browser: panels the user arranges (kept in this browser's storage), each a view
+// that talks to the program through the debug protocol (connection.js).
+
+import { Connection } from "./connection.js";
+import { fieldView } from "./field.js";
+import { modulesView } from "./modules.js";
+import {
+  debugRequestsView, imagesView, logPlayerView, modifyView, parametersView, plotsView, remoteView,
+  representationsView, statusView, stopwatchesView,
+} from "./views.js";
+
+const VIEWS = [
+  { id: "field", title: "Field", make: fieldView, x: 0, y: 0, w: 6, h: 10 },
+  { id: "images", title: "Images", make: imagesView, x: 6, y: 0, w: 6, h: 6 },
+  { id: "status", title: "Status", make: statusView, x: 6, y: 6, w: 3, h: 4 },
+  { id: "remote", title: "Motion remote control", make: remoteView, x: 9, y: 6, w: 3, h: 4, needs: "motion:walk" },
+  { id: "log", title: "Log player", make: logPlayerView, x: 0, y: 10, w: 12, h: 2, needs: "log:play" },
+  { id: "plots", title: "Plots", make: plotsView, x: 0, y: 12, w: 6, h: 6 },
+  { id: "stopwatches", title: "Stopwatches", make: stopwatchesView, x: 6, y: 12, w: 6, h: 6 },
+  { id: "modules", title: "Modules", make: modulesView, x: 0, y: 18, w: 8, h: 10 },
+  { id: "representations", title: "Representations", make: representationsView, x: 8, y: 18, w: 4, h: 10 },
+  { id: "requests", title: "Debug requests", make: debugRequestsView, x: 0, y: 28, w: 4, h: 6 },
+  { id: "modify", title: "Modify", make: modifyView, x: 4, y: 28, w: 4, h: 6 },
+  { id: "parameters", title: "Parameters", make: parametersView, x: 8, y: 28, w: 4, h: 6 },
+];
+const LAYOUT_KEY = "tafel-layout";
+const HIDDEN_KEY = "tafel-hidden";
+
+const url = new URL("ws", location.href);
+url.protocol = location.protocol === "https:" ? "wss:" : "ws:";
+const connection = new Connection(url.href);
+const state = { commands: null, panels: {} };
+window.tafel = { connection, state };
+
+const saved = JSON.parse(localStorage.getItem(LAYOUT_KEY) || "null") || [];
+const hidden = new Set(JSON.parse(localStorage.getItem(HIDDEN_KEY) || "[]"));
+const grid = document.getElementById("grid");
+const template = document.getElementById("panel");
+const menu = document.getElementById("view-list");
+const parking = Object.assign(document.createElement("div"), { hidden: true }); // hidden panels wait here
+document.body.append(parking);
+
+for (const view of VIEWS) {
+  const place = saved.find((item) => item.id === view.id) || view;
+  const item = template.content.firstElementChild.cloneNode(true);
+  Object.entries({ "gs-id": view.id, "gs-x": place.x, "gs-y": place.y, "gs-w": place.w, "gs-h": place.h })
+    .forEach(([key, value]) => item.setAttribute(key, value));
+  item.dataset.view = view.id;
+  item.querySelector(".panel-title").textContent = view.title;
+  const info = item.querySelector(".panel-info");
+  const body = item.querySelector(".panel-body");
+  const panel = {
+    item, view, onShow: null,
+    shown: () => !item.hidden && document.visibilityState === "visible",
+    info: (text) => { info.textContent = text; },
+  };
+  state.panels[view.id] = panel;
+  item.hidden = hidden.has(view.id) || Boolean(view.needs); // a view that needs commands waits for them
+  item.querySelector(".panel-close").onclick = () => show(view.id, false);
+  (item.hidden ? parking : grid).append(item);
+  try { view.make(body, connection, state, panel); } catch (error) { body.textContent = `this view failed: ${error}`; console.error(error); }
+  const box = Object.assign(document.createElement("input"), { type: "checkbox", checked: !hidden.has(view.id), disabled: Boolean(view.needs) });
+  box.onchange = () => show(view.id, box.checked);
+  panel.box = box;
+  const label = document.createElement("label");
+  label.append(box, ` ${view.title}`);
+  menu.append(label);
+}
+
+const gridStack = GridStack.init({ cellHeight: 44, margin: 4, handle: ".panel-head", column: 12, float: false, animate: false }, grid);
+gridStack.on("change", () => localStorage.setItem(LAYOUT_KEY, JSON.stringify(gridStack.save(false))));
+
+// Show or hide a panel; remember = the user chose it (kept), not the program's commands (not kept).
+function show(id, visible, remember = true) {
+  const panel = state.panels[id];
+  if (remember) {
+    visible ? hidden.delete(id) : hidden.add(id);
+    localStorage.setItem(HIDDEN_KEY, JSON.stringify([...hidden]));
+    panel.box.checked = visible;
+  }
+  if (visible === !panel.item.hidden) return;
+  panel.item.hidden = !visible;
+  if (visible) {
+    grid.append(panel.item);
+    gridStack.makeWidget(panel.item);
+    panel.onShow?.();
+  } else {
+    gridStack.removeWidget(panel.item, false);
+    parking.append(panel.item);
+  }
+}
+
+document.getElementById("reset-layout").onclick = () => {
+  localStorage.removeItem(LAYOUT_KEY);
+  localStorage.removeItem(HIDDEN_KEY);
+  location.reload();
+};
+
+// Connection state, identity, the token form, and which views this program can serve.
+const badge = document.getElementById("connection");
+const identity = document.getElementById("identity");
+const tokenForm = document.getElementById("token-form");
+connection.on("open", async (hello) => {
+  badge.textContent = "connected"; badge.className = "badge on";
+  identity.textContent = hello;
+  tokenForm.hidden = true;
+  const help = await connection.ask("help");
+  state.commands = new Set(help.split("\n").map((line) => line.split(/\s+/)[0]).filter(Boolean));
+  for (const view of VIEWS) {
+    if (!view.needs) continue;
+    const can = state.commands.has(view.needs);
+    state.panels[view.id].box.disabled = !can;
+    show(view.id, can && !hidden.has(view.id), false);
+  }
+  state.ready = true;
+});
+connection.on("close", () => { badge.textContent = "offline"; badge.className = "badge off"; state.ready = false; });
+connection.on("auth", () => { tokenForm.hidden = false; identity.textContent = "this program needs its token"; });
+tokenForm.onsubmit = async (event) => {
+  event.preventDefault();
+  const answer = await connection.authenticate(document.getElementById("token").value);
+  if (answer !== "authenticated") identity.textContent = answer;
+};
