@@ -7,6 +7,7 @@ import subprocess
 import sys
 import sysconfig
 import tomllib
+import urllib.request
 import venv
 from pathlib import Path
 
@@ -79,3 +80,19 @@ def test_a_built_wheel_runs_from_anywhere(tmp_path: Path) -> None:
     info = subprocess.run([tafel, "log", "info", "run.mcap"], cwd=work, env=env, capture_output=True, text=True, timeout=60)
     assert info.returncode == 0, info.stderr
     assert "motion/JointSensorData" in info.stdout
+    # the web page and its vendored libraries ship too
+    served = subprocess.Popen([tafel, "run", "--platform", "dummy", "--seconds", "20", "--debug-port", "0", "--web-port", "0"],
+                              cwd=work, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        url = ""
+        for line in served.stdout:
+            if line.startswith("web view at "):
+                url = line.split()[3]
+                break
+        assert url, served.stderr.read()
+        for path in ("", "app.js", "vendor/uPlot.iife.min.js", "vendor/gridstack-all.js", "vendor/dagre.min.js", "vendor/LICENSE.uPlot"):
+            with urllib.request.urlopen(url + path, timeout=10) as answer:
+                assert answer.status == 200 and len(answer.read()) > 500, path
+    finally:
+        served.terminate()
+        served.wait(timeout=30)
