@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from tafel.core.naming import did_you_mean
+from tafel.core.runtime import name_os_thread
 from tafel.debug.commands import SPECS, CommandError, merge_answers
 from tafel.debug.protocol import Command, ParseError, TelnetDecoder, answer_bytes, parse
 
@@ -462,6 +463,7 @@ class DebugServer:
         return self.address
 
     def _run(self) -> None:
+        name_os_thread("tafel-debug")
         loop = asyncio.new_event_loop()
         self._loop = loop
         asyncio.set_event_loop(loop)

@@ -23,6 +23,7 @@ import ipaddress
 import json
 import logging
 import mimetypes
+import time
 from collections import OrderedDict, deque
 from collections.abc import Callable, Iterable
 from pathlib import Path
@@ -68,7 +69,11 @@ class WebSocketSession(Session):
         self.queued_bytes = 0
         self.out: deque[str] = deque()  # answers: never dropped
         self.latest: OrderedDict[str, str | bytes] = OrderedDict()  # streamed: the newest per topic
-        self.dropped = 0  # streamed messages replaced before they went out
+        self.intervals: dict[str, float] = {}  # topic -> s between its messages at least (subscribe -hz)
+        self.next_send: dict[str, float] = {}  # topic -> loop time its next message may go
+        self.timers: dict[str, asyncio.TimerHandle] = {}
+        self.dropped = 0  # streamed messages replaced before they went out, because the page reads slowly
+        self.skipped = 0  # streamed messages replaced before they went out, because of the topic's -hz
         self.sent = 0
         self.wake = asyncio.Event()
         self.frame_bytes = 0
@@ -98,19 +103,34 @@ class WebSocketSession(Session):
     def local_command(self, command: Command) -> str | None:
         if command.name not in LOCAL_COMMANDS:
             return None
-        names = [k for k, v in command.args.items() if v == ""] + \
-            [n for v in command.args.values() if isinstance(v, str) for n in v.split(",") if n]
+        names = [k for k, v in command.args.items() if v == ""]
+        names += [n for n in str(command.args.get("topics", "")).split(",") if n]
         if not names:
-            return f"error: usage: {command.name} NAME [NAME...]; the topics are {', '.join(self.web.topics())}"
+            return f"error: usage: {command.name} NAME [NAME...] [-hz N]; the topics are {', '.join(self.web.topics())}"
         if command.name == "unsubscribe":
+            for name in names:
+                self.intervals.pop(name, None)
+                self.latest.pop(name, None)
             self.web.unsubscribe(self, set(names) & self.topics)
             return f"unsubscribed {' '.join(names)}"
         known = self.web.topics()
         unknown = [n for n in names if n not in known]
         if unknown:
             return f"error: there is no topic {unknown[0]!r}; {did_you_mean(unknown[0], known)}"
+        hz = str(command.args.get("hz", "")) or "0"
+        try:
+            rate = float(hz)
+        except ValueError:
+            rate = -1.0
+        if not (rate == 0 or 0.1 <= rate <= 1000):
+            return f"error: -hz takes messages a second from 0.1 to 1000 (leave it out for every one), got {hz!r}"
+        for name in names:
+            if rate:
+                self.intervals[name] = 1.0 / rate
+            else:
+                self.intervals.pop(name, None)
         self.web.subscribe(self, set(names) - self.topics)
-        return f"subscribed {' '.join(names)}"
+        return f"subscribed {' '.join(names)}" + (f" at most {rate:g} a second" if rate else "")
 
     # ------------------------------------------------------------------ out
     def _write(self, data: bytes) -> bool:
@@ -129,28 +149,55 @@ class WebSocketSession(Session):
         if self.closed:
             return
         if self.latest.pop(topic, None) is not None:
-            self.dropped += 1
+            if self.next_send.get(topic, 0.0) > time.monotonic():  # the loop's clock (asyncio uses monotonic)
+                self.skipped += 1  # the page asked for fewer (subscribe -hz)
+            else:
+                self.dropped += 1  # the page reads too slowly
         self.latest[topic] = message
         self.wake.set()
 
     async def _pump(self) -> None:
-        """Send answers first, then the newest message of each topic; waits while the browser is slow."""
+        """Send answers first, then the newest message of each topic that is due; waits while the browser is slow."""
         try:
             while not self.closed:
                 await self.wake.wait()
                 self.wake.clear()
-                while not self.closed and (self.out or self.latest):
+                while not self.closed:
                     if self.out:
                         message: str | bytes = self.out.popleft()
                         self.queued_bytes -= len(message)
                     else:
-                        _, message = self.latest.popitem(last=False)
+                        topic = self._due()
+                        if topic is None:
+                            break
+                        message = self.latest.pop(topic)
+                        if topic in self.intervals:
+                            self.next_send[topic] = asyncio.get_running_loop().time() + self.intervals[topic]
                         self.sent += 1
                     await self.connection.send(message)
                 if self.reading_done and not self.out:
                     break
         except ConnectionClosed:
             pass
+        finally:
+            for timer in self.timers.values():
+                timer.cancel()
+
+    def _due(self) -> str | None:
+        """The first topic whose newest message may go now; for the others, a wake-up when they may."""
+        loop = asyncio.get_running_loop()
+        now = loop.time()
+        for topic in self.latest:
+            when = self.next_send.get(topic, 0.0)
+            if when <= now:
+                return topic
+            if topic not in self.timers:
+                self.timers[topic] = loop.call_later(when - now, self._timer_fired, topic)
+        return None
+
+    def _timer_fired(self, topic: str) -> None:
+        self.timers.pop(topic, None)
+        self.wake.set()
 
     def _close_transport(self, abort: bool) -> None:
         asyncio.ensure_future(self.connection.close(1008 if abort else 1000))
@@ -174,6 +221,7 @@ class WebServer:
         self.on_subscriptions = on_subscriptions
         self.subscribers: dict[str, set[WebSocketSession]] = {}
         self.refused_origin = 0
+        self.gone = {"sent": 0, "dropped": 0, "skipped": 0}  # counts of pages that closed
 
     def start(self) -> tuple[str, int]:
         """Listen (in the debug server's thread); raises ``OSError`` when the port cannot be had."""
@@ -201,6 +249,9 @@ class WebServer:
                 self.subscribers.pop(topic, None)
         self.on_subscriptions(self.subscribed())
 
+    def sessions(self) -> list[WebSocketSession]:
+        return [s for s in list(self.debug.connections) if isinstance(s, WebSocketSession)]
+
     def subscribed(self) -> frozenset[str]:
         return frozenset(self.subscribers)
 
@@ -224,6 +275,8 @@ class WebServer:
         session = WebSocketSession(self.debug, self, connection)
         self.debug.connections.add(session)
         await session.serve()
+        for key in self.gone:
+            self.gone[key] += getattr(session, key)
 
     def _http(self, connection: ServerConnection, request: Request) -> Response | None:
         host = request.headers.get("Host", "")

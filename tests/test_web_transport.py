@@ -145,7 +145,9 @@ def test_connections_over_the_limit_are_refused_with_a_reason(static: Path) -> N
 def test_subscribed_topics_stream_and_unknown_ones_are_an_error(served: Served) -> None:
     with connect(served.url) as socket:
         assert ask(socket, "subscribe BallModle") .startswith("error: there is no topic 'BallModle'; did you mean 'BallModel'")
-        assert ask(socket, "subscribe") .startswith("error: usage: subscribe NAME [NAME...]; the topics are BallModel, CameraImageTop")
+        assert ask(socket, "subscribe") == "error: usage: subscribe NAME [NAME...] [-hz N]; the topics are BallModel, CameraImageTop"
+        assert ask(socket, "subscribe BallModel -hz fast") == \
+            "error: -hz takes messages a second from 0.1 to 1000 (leave it out for every one), got 'fast'"
         assert ask(socket, "subscribe BallModel CameraImageTop") == "subscribed BallModel CameraImageTop"
         assert served.subscribed[-1] == {"BallModel", "CameraImageTop"}
         served.web.publish("BallModel", json.dumps({"topic": "BallModel", "value": {"x": 1.0}}))
@@ -159,6 +161,24 @@ def test_subscribed_topics_stream_and_unknown_ones_are_an_error(served: Served) 
     while served.subscribed[-1]:  # a closed page subscribes to nothing
         assert time.monotonic() < deadline
         time.sleep(0.05)
+
+
+def test_a_rate_limited_subscription_gets_the_newest_message_at_most_that_often(served: Served) -> None:
+    with connect(served.url) as socket:
+        assert ask(socket, "subscribe BallModel -hz 5") == "subscribed BallModel at most 5 a second"
+        started = time.monotonic()
+        received = []
+        for frame in range(60):  # 100 messages a second for 0.6 s
+            served.web.publish("BallModel", json.dumps({"frame": frame}))
+            time.sleep(0.01)
+        try:
+            while True:
+                received.append(json.loads(socket.recv(timeout=0.5))["frame"])
+        except TimeoutError:
+            pass
+        elapsed = time.monotonic() - started
+        assert 2 <= len(received) <= 5 * elapsed + 1, (received, elapsed)
+        assert received[-1] == 59  # the newest is never lost, only those in between
 
 
 def test_a_slow_page_gets_the_newest_message_of_each_topic_and_every_answer() -> None:

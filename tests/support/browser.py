@@ -12,6 +12,7 @@ import shutil
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 from typing import Any
 
@@ -43,9 +44,11 @@ def launch(playwright: Any) -> Any:
 class WebProgram:
     """A ``tafel`` subprocess (``run`` or ``view``) with the addresses of its debug server and page."""
 
-    def __init__(self, *args: str, cwd: Path = REPO) -> None:
+    def __init__(self, *args: str, cwd: Path = REPO, cpus: set[int] | None = None) -> None:
+        pin = (lambda: os.sched_setaffinity(0, cpus)) if cpus else None  # noqa: E731 - the program's threads inherit it
         self.process = subprocess.Popen([sys.executable, "-m", "tafel.tools.cli", *args], cwd=cwd, stdout=subprocess.PIPE,
-                                        stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(REPO)})
+                                        stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(REPO)},
+                                        preexec_fn=pin)
         self.output: list[str] = []
         self.errors: list[str] = []
         self.debug: tuple[str, int] | None = None
@@ -58,10 +61,17 @@ class WebProgram:
                 self.url = match.group(1)
                 break
         assert self.url and self.debug, "".join(self.output) + self.process.stderr.read()
-        self.readers = [threading.Thread(target=lambda s=stream, k=sink: k.extend(s), daemon=True)
-                        for stream, sink in ((self.process.stdout, self.output), (self.process.stderr, self.errors))]
+        #: when each line of ``errors`` arrived (monotonic s): status lines come at wall-clock intervals
+        self.error_times: list[float] = []
+        self.readers = [threading.Thread(target=lambda: self.output.extend(self.process.stdout), daemon=True),
+                        threading.Thread(target=self._drain_errors, daemon=True)]
         for reader in self.readers:
             reader.start()
+
+    def _drain_errors(self) -> None:
+        for line in self.process.stderr:
+            self.error_times.append(time.monotonic())
+            self.errors.append(line)
 
     def ask(self, line: str) -> str:
         from tafel.debug.client import DebugClient

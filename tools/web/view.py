@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from tafel.core.runtime import name_os_thread
 from tafel.debug.commands import jpeg_bytes, representation_message
 from tafel.debug.concepts import DebugDrawings, DebugPlots, ModuleTimes
 from tafel.debug.server import DebugServer
@@ -63,6 +64,8 @@ class WebView:
                                 on_subscriptions=self._subscribed)
         self.encoded = 0
         self.thread = threading.Thread(target=self._work, name="tafel-web", daemon=True)
+        debug.router.register("web:status", "the web view: pages connected, topics subscribed, messages encoded and sent, "
+                              "dropped for slow pages, skipped for -hz (JSON)", "web:status", lambda command: json.dumps(self.status()))
 
     def start(self) -> tuple[str, int]:
         address = self.server.start()
@@ -78,11 +81,18 @@ class WebView:
         host = self.server.host
         return f"http://{'[' + host + ']' if ':' in host else host}:{self.server.port}/"
 
+    def status(self) -> dict[str, Any]:
+        sessions = self.server.sessions()
+        return {"url": self.url(), "pages": len(sessions), "topics": sorted(self.wanted), "encoded": self.encoded,
+                **{key: sum(getattr(s, key) for s in sessions) + gone for key, gone in self.server.gone.items()},
+                "handed_over_dropped": self.feed.dropped}
+
     def _subscribed(self, topics: frozenset[str]) -> None:
         self.wanted = topics
         self.feed.need(self.by_name[name] for name in topics if name in self.by_name)
 
     def _work(self) -> None:
+        name_os_thread("tafel-web")
         while True:
             item = self.feed.get()
             if item is None:

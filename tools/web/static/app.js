@@ -49,10 +49,26 @@ for (const view of VIEWS) {
   item.querySelector(".panel-title").textContent = view.title;
   const info = item.querySelector(".panel-info");
   const body = item.querySelector(".panel-body");
+  const follows = new Set(); // the panel's subscriptions: live only while it is shown and the tab visible
   const panel = {
     item, view, onShow: null,
     shown: () => !item.hidden && document.visibilityState === "visible",
     info: (text) => { info.textContent = text; },
+    head: item.querySelector(".panel-head"),
+    follow(topic, options, callback) {
+      if (typeof options === "function") { callback = options; options = {}; }
+      const entry = { topic, options, callback, stop: null };
+      follows.add(entry);
+      if (panel.shown()) entry.stop = connection.subscribe(topic, options, callback);
+      return () => { entry.stop?.(); follows.delete(entry); };
+    },
+    activate() {
+      const live = panel.shown();
+      for (const entry of follows) {
+        if (live && !entry.stop) entry.stop = connection.subscribe(entry.topic, entry.options, entry.callback);
+        if (!live && entry.stop) { entry.stop(); entry.stop = null; }
+      }
+    },
   };
   state.panels[view.id] = panel;
   item.hidden = hidden.has(view.id) || Boolean(view.needs); // a view that needs commands waits for them
@@ -67,7 +83,10 @@ for (const view of VIEWS) {
   menu.append(label);
 }
 
-const gridStack = GridStack.init({ cellHeight: 44, margin: 4, handle: ".panel-head", column: 12, float: false, animate: false }, grid);
+const gridStack = GridStack.init({
+  cellHeight: 44, margin: 4, column: 12, float: false, animate: false, handle: ".panel-head",
+  draggable: { handle: ".panel-head", cancel: "input,textarea,button,select,option" },
+}, grid);
 gridStack.on("change", () => localStorage.setItem(LAYOUT_KEY, JSON.stringify(gridStack.save(false))));
 
 // Show or hide a panel; remember = the user chose it (kept), not the program's commands (not kept).
@@ -88,7 +107,11 @@ function show(id, visible, remember = true) {
     gridStack.removeWidget(panel.item, false);
     parking.append(panel.item);
   }
+  panel.activate();
 }
+
+// A tab in the background looks at nothing: it subscribes to nothing.
+document.addEventListener("visibilitychange", () => Object.values(state.panels).forEach((panel) => panel.activate()));
 
 document.getElementById("reset-layout").onclick = () => {
   localStorage.removeItem(LAYOUT_KEY);

@@ -9,6 +9,8 @@ export class Connection {
     this.url = url;
     this.pending = [];                 // resolvers of the commands sent, in order
     this.listeners = new Map();        // topic -> Set of callbacks
+    this.rates = new Map();            // topic -> at most this many messages a second
+    this.wanted = new Map();           // callback -> the rate it asked for (0: every message)
     this.events = new Map();           // "open" | "close" | "auth" -> Set of callbacks
     this.token = new URLSearchParams(location.search).get("token") || sessionStorage.getItem("tafel-token") || "";
     this.connected = false;
@@ -33,7 +35,7 @@ export class Connection {
       if (this.token) await this.ask(`auth ${this.token}`);
       const hello = await this.ask("hello");
       if (hello.startsWith("error: not authenticated")) { this.emit("auth"); return; }
-      for (const topic of this.listeners.keys()) this.ask(`subscribe ${topic}`);
+      for (const topic of this.listeners.keys()) this.ask(this.subscribeLine(topic));
       this.emit("open", hello);
     };
     socket.onmessage = (event) => this.receive(event.data);
@@ -51,7 +53,7 @@ export class Connection {
     sessionStorage.setItem("tafel-token", token);
     const answer = await this.ask(`auth ${token}`);
     if (answer === "authenticated") {
-      for (const topic of this.listeners.keys()) this.ask(`subscribe ${topic}`);
+      for (const topic of this.listeners.keys()) this.ask(this.subscribeLine(topic));
       this.emit("open", await this.ask("hello"));
     }
     return answer;
@@ -114,24 +116,41 @@ export class Connection {
     for (const message of value.topic ? [value] : Object.values(value)) deliver(message);
   }
 
+  subscribeLine(topic) {
+    return this.rates.has(topic) ? `subscribe ${topic} -hz ${this.rates.get(topic)}` : `subscribe ${topic}`;
+  }
+
   // Call back with every message of a topic; returns the function that stops it.
-  subscribe(topic, callback) {
+  // Options: {hz: N} asks for at most N messages a second (the newest each time), for all of the topic's listeners.
+  subscribe(topic, options, callback) {
+    if (typeof options === "function") { callback = options; options = {}; }
     const fresh = !this.listeners.has(topic);
-    if (fresh) {
-      this.listeners.set(topic, new Set());
-      if (this.connected) this.ask(`subscribe ${topic}`);
-    }
+    if (fresh) this.listeners.set(topic, new Set());
     this.listeners.get(topic).add(callback);
+    this.wanted.set(callback, options.hz || 0);
+    this.updateRate(topic, fresh);
     if (this.connected) this.current(topic, fresh ? null : callback);
     return () => {
       const set = this.listeners.get(topic);
-      if (!set) return;
-      set.delete(callback);
+      if (!set || !set.delete(callback)) return;
+      this.wanted.delete(callback);
       if (set.size === 0) {
         this.listeners.delete(topic);
+        this.rates.delete(topic);
         if (this.connected) this.ask(`unsubscribe ${topic}`);
+      } else {
+        this.updateRate(topic, false);
       }
     };
+  }
+
+  // The topic's rate is the highest its listeners ask for (none: every message); tell the program when it changes.
+  updateRate(topic, fresh) {
+    const asked = [...this.listeners.get(topic)].map((callback) => this.wanted.get(callback));
+    const rate = asked.includes(0) ? 0 : Math.max(...asked);
+    if (!fresh && rate === (this.rates.get(topic) || 0)) return;
+    rate ? this.rates.set(topic, rate) : this.rates.delete(topic);
+    if (this.connected) this.ask(this.subscribeLine(topic));
   }
 }
 

@@ -4,8 +4,9 @@
 // canvases of the debug drawings.
 
 const TAU = Math.PI * 2;
+const FIELD_FPS = 15;
 
-export function fieldView(body, connection, state) {
+export function fieldView(body, connection, state, panel) {
   body.classList.add("field-body");
   const canvas = document.createElement("canvas");
   body.append(canvas);
@@ -16,23 +17,23 @@ export function fieldView(body, connection, state) {
     try { field.geometry = await connection.json("field:geometry"); } catch (error) { console.warn(error.message); }
     schedule();
   });
-  const follow = (topic, key) => connection.subscribe(topic, (message) => { field[key] = message.value; schedule(); });
+  const follow = (topic, key) => panel.follow(topic, (message) => { field[key] = message.value; schedule(); });
   follow("RobotPose", "pose");
   follow("BallModel", "ball");
   follow("BallPercept", "percept");
   for (const camera of ["Top", "Bottom"]) {
-    connection.subscribe(`CameraMatrix${camera}`, (message) => {
+    panel.follow(`CameraMatrix${camera}`, { hz: 10 }, (message) => {
       const entry = field.cameras[camera] ||= {};
       entry.rotation = message.value.rotation;
     });
   }
-  connection.subscribe("DebugDrawings", (message) => {
+  panel.follow("DebugDrawings", { hz: 15 }, (message) => {
     field.drawings.set(message.context, message.value.primitives.filter((p) => p.canvas === "field" || p.canvas === "robot"));
     schedule();
   });
   // A simulator's ground truth, twice a second, when the platform has it.
   setInterval(async () => {
-    if (!connection.connected || state.commands?.has("sim:status") === false) return;
+    if (!connection.connected || !panel.shown() || state.commands?.has("sim:status") === false) return;
     const answer = await connection.ask("sim:status");
     const robot = /robot x=(-?\d+) y=(-?\d+) mm rotation (-?[\d.]+) rad/.exec(answer);
     const ball = /ball x=(-?\d+) y=(-?\d+) mm/.exec(answer);
@@ -41,11 +42,14 @@ export function fieldView(body, connection, state) {
   }, 500);
   state.hfov = state.hfov || {};
 
-  let queued = false;
+  // Redrawn at most FIELD_FPS times a second, whatever arrives: eyes need no more, and a browser
+  // without a graphics card pays for every redraw.
+  let queued = false, background = null, drawnAt = 0;
   function schedule() {
     if (queued) return;
     queued = true;
-    requestAnimationFrame(() => { queued = false; draw(); });
+    const wait = Math.max(0, drawnAt + 1000 / FIELD_FPS - performance.now());
+    setTimeout(() => requestAnimationFrame(() => { queued = false; drawnAt = performance.now(); draw(); }), wait);
   }
   new ResizeObserver(schedule).observe(body);
 
@@ -54,21 +58,20 @@ export function fieldView(body, connection, state) {
     const ratio = window.devicePixelRatio || 1;
     const width = body.clientWidth, height = body.clientHeight;
     if (!g || width < 10 || height < 10) return;
-    canvas.width = width * ratio; canvas.height = height * ratio;
+    if (canvas.width !== Math.round(width * ratio) || canvas.height !== Math.round(height * ratio)) {
+      canvas.width = Math.round(width * ratio); canvas.height = Math.round(height * ratio);
+      background = null;
+    }
     const ctx = canvas.getContext("2d");
     const spanX = g.length + 2 * g.border, spanY = g.width + 2 * g.border;
     const scale = Math.min(width / spanX, height / spanY) * ratio;
+    state.fieldTransform = { scale: scale / ratio, cx: width / 2, cy: height / 2 };
+    // the field itself is drawn once per size, then copied
+    if (!background) background = fieldPicture(g, canvas.width, canvas.height, scale);
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.drawImage(background, 0, 0);
     // field frame -> canvas: centre in the middle, y up
     ctx.setTransform(scale, 0, 0, -scale, canvas.width / 2, canvas.height / 2);
-    state.fieldTransform = { scale: scale / ratio, cx: width / 2, cy: height / 2 };
-    ctx.fillStyle = "#2f8a3a";
-    ctx.fillRect(-spanX / 2, -spanY / 2, spanX, spanY);
-    ctx.strokeStyle = "#fff"; ctx.lineWidth = g.line_width; ctx.lineCap = "square";
-    for (const [x1, y1, x2, y2] of g.lines) line(ctx, x1, y1, x2, y2);
-    ctx.beginPath(); ctx.arc(g.circle.x, g.circle.y, g.circle.radius, 0, TAU); ctx.stroke();
-    for (const [x, y] of g.marks) { line(ctx, x - g.mark_size / 2, y, x + g.mark_size / 2, y); line(ctx, x, y - g.mark_size / 2, x, y + g.mark_size / 2); }
-    ctx.fillStyle = "#fff";
-    for (const [x, y] of g.posts) { ctx.beginPath(); ctx.arc(x, y, g.post_radius, 0, TAU); ctx.fill(); }
 
     const truth = field.truth;
     if (truth) {
@@ -104,6 +107,22 @@ export function fieldView(body, connection, state) {
     }
     state.fieldDrawn = (state.fieldDrawn || 0) + 1;
   }
+}
+
+function fieldPicture(g, width, height, scale) {
+  const picture = new OffscreenCanvas(width, height);
+  const ctx = picture.getContext("2d");
+  const spanX = g.length + 2 * g.border, spanY = g.width + 2 * g.border;
+  ctx.setTransform(scale, 0, 0, -scale, width / 2, height / 2);
+  ctx.fillStyle = "#2f8a3a";
+  ctx.fillRect(-spanX / 2, -spanY / 2, spanX, spanY);
+  ctx.strokeStyle = "#fff"; ctx.lineWidth = g.line_width; ctx.lineCap = "square";
+  for (const [x1, y1, x2, y2] of g.lines) line(ctx, x1, y1, x2, y2);
+  ctx.beginPath(); ctx.arc(g.circle.x, g.circle.y, g.circle.radius, 0, TAU); ctx.stroke();
+  for (const [x, y] of g.marks) { line(ctx, x - g.mark_size / 2, y, x + g.mark_size / 2, y); line(ctx, x, y - g.mark_size / 2, x, y + g.mark_size / 2); }
+  ctx.fillStyle = "#fff";
+  for (const [x, y] of g.posts) { ctx.beginPath(); ctx.arc(x, y, g.post_radius, 0, TAU); ctx.fill(); }
+  return picture;
 }
 
 export function toField(pose, x, y) {

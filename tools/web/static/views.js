@@ -31,7 +31,7 @@ export function imagesView(body, connection, state, panel) {
   body.append(wrap);
   state.images = {};
   const drawings = new Map(); // canvas name -> primitives of the last cognition frame
-  connection.subscribe("DebugDrawings", (message) => {
+  panel.follow("DebugDrawings", { hz: 30 }, (message) => {
     const byCanvas = new Map();
     for (const p of message.value.primitives) {
       if (!p.canvas.startsWith("image:")) continue;
@@ -46,20 +46,24 @@ export function imagesView(body, connection, state, panel) {
     const caption = el("figcaption", { textContent: `${camera.toLowerCase()} camera` });
     const figure = el("figure", {}, caption, el("div", { className: "stack" }, canvas));
     wrap.append(figure);
-    const seen = state.images[camera.toLowerCase()] = { count: 0, times: [], width: 0, height: 0, mouse: null };
+    const seen = state.images[camera.toLowerCase()] = { count: 0, times: [], width: 0, height: 0, mouse: null, shownAt: 0 };
     let busy = false;
-    connection.subscribe(`CameraImage${camera}`, async (message) => {
+    panel.follow(`CameraImage${camera}`, async (message) => {
       seen.count += 1;
       const now = performance.now();
       seen.times.push(now);
       while (seen.times.length && now - seen.times[0] > 2000) seen.times.shift();
       state.hfov = state.hfov || {};
       if (message.horizontal_fov) state.hfov[camera] = message.horizontal_fov;
-      if (busy) return; // decoding the previous one: this one is skipped on the screen, not counted lost
+      // shown at most `fps` times a second (decoding and drawing cost the browser), and never two at once
+      if (busy || now - seen.shownAt < 1000 / Number(fps.value) - 4) return;
       busy = true;
+      seen.shownAt = now;
       try {
         const bitmap = await createImageBitmap(message.jpeg);
-        canvas.width = bitmap.width; canvas.height = bitmap.height;
+        if (canvas.width !== bitmap.width || canvas.height !== bitmap.height) {  // resizing clears and reallocates
+          canvas.width = bitmap.width; canvas.height = bitmap.height;
+        }
         seen.width = bitmap.width; seen.height = bitmap.height;
         const ctx = canvas.getContext("2d");
         ctx.drawImage(bitmap, 0, 0);
@@ -68,9 +72,11 @@ export function imagesView(body, connection, state, panel) {
         seen.drawn = (seen.drawn || 0) + 1;
         seen.frame = message.frame;
       } finally { busy = false; }
-      showCaption();
+      if (now - captionAt > 500) showCaption();  // text changes cost layout and paint: twice a second
     });
+    let captionAt = 0;
     const showCaption = () => {
+      captionAt = performance.now();
       const rate = seen.times.length > 1 ? (seen.times.length - 1) / ((seen.times.at(-1) - seen.times[0]) / 1000) : 0;
       const mouse = seen.mouse ? `, pixel (${seen.mouse[0]}, ${seen.mouse[1]})` : "";
       caption.textContent = `${camera.toLowerCase()} camera ${seen.width}x${seen.height}, ${rate.toFixed(1)} images/s${mouse}`;
@@ -86,7 +92,9 @@ export function imagesView(body, connection, state, panel) {
     });
     canvas.addEventListener("mouseleave", () => { seen.mouse = null; showCaption(); });
   }
-  panel.info("JPEG, as the program sends them");
+  const fps = el("select", { title: "images shown per second (all arrive; a browser without a graphics card pays for each one shown)" },
+    ...[5, 10, 15, 30].map((n) => el("option", { value: n, textContent: `${n} fps`, selected: n === 15 })));
+  panel.head.insertBefore(fps, panel.head.querySelector(".panel-close"));
 }
 
 // ----------------------------------------------------------------------------------------- plots
@@ -105,13 +113,22 @@ export function plotsView(body, connection, state, panel) {
   const plotNames = new Set();
   state.plots = { series };
 
-  connection.subscribe("DebugPlots", (message) => {
+  // plot() values: twice a second to learn their names, every one while one of them is plotted
+  const onPlots = (message) => {
     const t = message.time_ns / 1e9;
     message.value.names.forEach((name, i) => {
       if (!plotNames.has(name)) { plotNames.add(name); fillSources(); }
       for (const s of series) if (s.plot === name) push(s, t, message.value.values[i]);
     });
-  });
+  };
+  let stopPlots = panel.follow("DebugPlots", { hz: 2 }, onPlots), plotting = false;
+  function followPlots() {
+    const wanted = series.some((s) => s.plot);
+    if (wanted === plotting) return;
+    plotting = wanted;
+    stopPlots();
+    stopPlots = panel.follow("DebugPlots", wanted ? {} : { hz: 2 }, onPlots);
+  }
 
   let representations = [];
   async function fillSources() {
@@ -153,7 +170,7 @@ export function plotsView(body, connection, state, panel) {
       const rep = what.slice(4);
       if (!path) return;
       const s = { label: `${rep}.${path}`, xs: [], ys: [] };
-      s.stop = connection.subscribe(rep, (message) => {
+      s.stop = panel.follow(rep, (message) => {
         const value = path.split(".").reduce((v, key) => (v == null ? v : v[key]), message.value);
         if (typeof value === "number" || typeof value === "boolean") push(s, message.time_ns / 1e9, Number(value));
       });
@@ -172,6 +189,7 @@ export function plotsView(body, connection, state, panel) {
 
   let plot = null;
   function rebuild() {
+    followPlots();
     chosen.replaceChildren(...series.map((s, i) => el("button", {
       type: "button", textContent: `${s.label} ×`, title: "remove",
       onclick: () => { series[i].stop?.(); series.splice(i, 1); rebuild(); },
@@ -331,7 +349,7 @@ export function representationsView(body, connection, state, panel) {
     tree.replaceChildren();
     latest = null;
     if (!select.value) return;
-    stop = connection.subscribe(select.value, (message) => {
+    stop = panel.follow(select.value, (message) => {
       latest = message;
       state.inspected = message;
       const now = performance.now();
