@@ -367,7 +367,7 @@ class ContextDebug:
     def cmd_representation_print(self, command: Command) -> str:
         rep = self._representation(command)
         if wants_json(command):
-            return json.dumps(representation_message(rep, self.context, frame_number(self.manager)))
+            return json.dumps(representation_message(rep, self.context, frame_number(self.manager), frame_time_ns(self.manager)))
         return f"{type(rep).__name__} ({self.context}, frame {self.manager.frame}):\n{pretty(rep, '  ')}"
 
     def cmd_image_get(self, command: Command) -> bytes:
@@ -632,6 +632,12 @@ def frame_number(manager: ModuleManager) -> int:
     else as the manager does."""
     info = manager.blackboard.get("FrameInfo") if "FrameInfo" in manager.blackboard.names() else None
     return int(getattr(info, "frame_number", manager.frame))
+
+
+def frame_time_ns(manager: ModuleManager) -> int | None:
+    """The frame's time on the program's clock (``FrameInfo``), or None without one."""
+    info = manager.blackboard.get("FrameInfo") if "FrameInfo" in manager.blackboard.names() else None
+    return None if info is None else int(info.time_ns)
 
 
 def representation_message(rep: Any, context: str, frame: int, time_ns: int | None = None) -> dict[str, Any]:

@@ -555,15 +555,25 @@ class DebugServer:
         if loop is None or not loop.is_running():
             return
 
-        def shutdown() -> None:
+        async def shutdown() -> None:
             for connection in list(self.connections):
                 connection.drop()
             for server in (self._server, *self.listeners):
                 if server is not None:
                     server.close()
+            # let every connection's task end (a WebSocket says goodbye), then cancel what is left
+            for server in self.listeners:
+                try:
+                    await asyncio.wait_for(server.wait_closed(), 2.0)
+                except (asyncio.TimeoutError, OSError):
+                    pass
+            tasks = [task for task in asyncio.all_tasks() if task is not asyncio.current_task()]
+            for task in tasks:
+                task.cancel()
+            await asyncio.gather(*tasks, return_exceptions=True)
             loop.stop()
 
-        loop.call_soon_threadsafe(shutdown)
+        asyncio.run_coroutine_threadsafe(shutdown(), loop)
         if self._thread is not None:
             self._thread.join(timeout=5)
 

@@ -239,7 +239,7 @@ class WebServer:
         for topic in topics:
             self.subscribers.setdefault(topic, set()).add(session)
             session.topics.add(topic)
-        self.on_subscriptions(self.subscribed())
+        self._tell()
 
     def unsubscribe(self, session: WebSocketSession, topics: Iterable[str]) -> None:
         for topic in topics:
@@ -247,7 +247,13 @@ class WebServer:
             session.topics.discard(topic)
             if not self.subscribers.get(topic):
                 self.subscribers.pop(topic, None)
-        self.on_subscriptions(self.subscribed())
+        self._tell()
+
+    def _tell(self) -> None:
+        try:
+            self.on_subscriptions(self.subscribed())
+        except Exception:  # noqa: BLE001 - the feed's bug must not cost the page its connection
+            log.exception("web: the feed could not take the new subscriptions")
 
     def sessions(self) -> list[WebSocketSession]:
         return [s for s in list(self.debug.connections) if isinstance(s, WebSocketSession)]

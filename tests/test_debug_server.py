@@ -34,7 +34,9 @@ class Program:
 
     def __init__(self, *args: str, cwd: Path = REPO) -> None:
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "tafel.tools.cli", "run", "--debug-port", "0", *args] + ([] if "--platform" in args else ["--platform", "dummy"]),
+            [sys.executable, "-m", "tafel.tools.cli", "run", "--debug-port", "0", *args]
+            + ([] if "--platform" in args else ["--platform", "dummy"])
+            + ([] if {"--web-port", "--no-web", "--no-debug"} & set(args) else ["--web-port", "0"]),  # several may run at once
             cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
             env={**os.environ, "PYTHONPATH": str(REPO)},
         )

@@ -237,3 +237,23 @@ def test_with_a_token_the_page_asks_for_it(playwright: Any, tmp_path: Path) -> N
     finally:
         browser.close()
         running.stop()
+
+
+def test_contexts_in_their_own_processes_feed_the_page_too(playwright: Any, tmp_path: Path) -> None:
+    running = WebProgram("run", "--platform", "dummy", "--concurrent", "--debug-port", "0", "--web-port", "0", cwd=tmp_path)
+    browser = launch(playwright)
+    try:
+        page = browser.new_page(viewport={"width": 1600, "height": 1200})
+        problems: list[str] = []
+        page.on("pageerror", lambda e: problems.append(str(e)))
+        page.goto(running.url)
+        wait_for(page, "tafel.state.ready && tafel.state.robot && tafel.state.stopwatches")
+        page.select_option("[data-view=representations] select", "FrameInfo")
+        first = wait_for(page, "tafel.state.inspected && tafel.state.inspected.frame")
+        wait_for(page, f"tafel.state.inspected.frame > {first + 20}")  # streamed from the context's process
+        rates = wait_for(page, "tafel.state.stopwatches.motion && tafel.state.stopwatches.cognition && tafel.state.stopwatches")
+        assert rates["motion"]["frame"] > 0 and rates["cognition"]["frame"] > 0
+        assert problems == []
+    finally:
+        browser.close()
+        running.stop()

@@ -537,7 +537,9 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
     from tafel.tools.foxglove_live import FED
 
     flags, feed = concurrent_feed(args.foxglove is not None, FED, setups)
-    web_flags, web_feed = concurrent_feed(debug is not None and not args.no_web, web_representations(plans), setups)
+    from tafel.tools.web import web_topics
+
+    web_flags, web_feed = concurrent_feed(debug is not None and not args.no_web, web_topics(web_representations(plans)), setups)
     setup = (worker_setups, setups) if setups else None
     stall = float(config.get("runtime", {}).get("stall_timeout_s", 1.0))
     runtime = ConcurrentRuntime(plans, platform_class, options, strict=args.strict, stall_timeout_s=stall,

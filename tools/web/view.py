@@ -33,6 +33,11 @@ DEFAULT_WEB_PORT = 5480
 DEBUG_TOPICS = (DebugDrawings, DebugPlots, ModuleTimes)
 
 
+def web_topics(reps: Iterable[type]) -> list[type]:
+    """What a page may subscribe to: these representations and the debug topics, in the feed's order."""
+    return list(LiveFeed([*reps, *DEBUG_TOPICS]).reps)
+
+
 def is_image(value: Any) -> bool:
     image = getattr(value, "image", None)
     return isinstance(image, np.ndarray) and image.ndim == 3 and image.shape[2] == 3
@@ -56,7 +61,7 @@ class WebView:
 
     def __init__(self, debug: DebugServer, reps: Iterable[type], *, host: str = "127.0.0.1", port: int = DEFAULT_WEB_PORT,
                  jpeg_quality: int = 80, flags: Any = None) -> None:
-        self.feed = LiveFeed([*reps, *DEBUG_TOPICS], flags=flags)
+        self.feed = LiveFeed(web_topics(reps), flags=flags)
         self.by_name = {rep.__name__: rep for rep in self.feed.reps}
         self.jpeg_quality = jpeg_quality
         self.wanted: frozenset[str] = frozenset()

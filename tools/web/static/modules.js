@@ -15,11 +15,13 @@ export function modulesView(body, connection, state, panel) {
   body.classList.add("graph-body");
   const context = el("select");
   const store = el("button", { type: "button", textContent: "store choices", title: "write providers and disabled modules to the private configuration" });
+  const fit = el("input", { type: "checkbox" });
+  fit.onchange = () => { const root = picture.querySelector("svg"); if (root) root.style.width = fit.checked ? "100%" : `${root.getAttribute("width")}px`; };
   const note = el("div");
   const detail = el("div", { className: "row" });
   const providers = el("table");
   const picture = el("div", { style: "overflow:auto" });
-  body.append(el("div", { className: "row" }, context, store, note), detail, providers, picture);
+  body.append(el("div", { className: "row" }, context, store, el("label", {}, fit, " fit the graph to the view"), note), detail, providers, picture);
   let graphs = {}, shape = "", selected = "";
   state.modules = { graphs };
 
@@ -84,7 +86,9 @@ export function modulesView(body, connection, state, panel) {
     }
     dagre.layout(g);
     const { width, height } = g.graph();
-    const root = svg("svg", { viewBox: `0 0 ${width} ${height}`, style: `width:100%;max-width:${width}px;height:auto` });
+    const root = svg("svg", { viewBox: `0 0 ${width} ${height}`, width, height });
+    root.style.width = fit.checked ? "100%" : `${width}px`;
+    root.style.height = "auto";
     for (const e of g.edges()) {
       const points = g.edge(e).points;
       root.append(svg("path", { d: `M${points.map((p) => `${p.x},${p.y}`).join("L")}`, class: g.edge(e).kind }));

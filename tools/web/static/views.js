@@ -181,7 +181,7 @@ export function plotsView(body, connection, state, panel) {
   state.plots.add = addSeries;
 
   function push(s, t, v) {
-    if (pause.checked) return;
+    if (pause.checked || !Number.isFinite(t) || (s.xs.length && t <= s.xs.at(-1))) return;
     s.xs.push(t); s.ys.push(v);
     const keep = Number(windowInput.value) || 10;
     while (s.xs.length && s.xs[0] < t - keep) { s.xs.shift(); s.ys.shift(); }
