@@ -49,16 +49,21 @@ CALLS: dict[str, dict[str, str]] = {
     "motion:stand": {},
     "motion:sit": {},
     "motion:release": {},
+    "image:get": {"name": "CameraImageTop", "quality": "70"},
+    "field:geometry": {},
+    "web:status": {},
 }
 #: commands that undo what another did: that one runs before each call
 PRECEDED = {"log:stop": "log:start -file stop.mcap", "representation:release": "motion:stand", "motion:release": "motion:stand"}
+#: the dummy platform has no cameras: the same error either way shows the arguments arrived alike
+ERROR_HERE = {"image:get"}
 #: answers that change from frame to frame: compared by kind (error or not) only
 VARYING = {"hello", "log:start", "log:status", "log:stop", "modules:list", "plot:get", "representation:get", "representation:print", "stopwatch:list",
-           "drawings:get", "modules:store", "parameter:store"}
+           "drawings:get", "modules:store", "parameter:store", "web:status"}
 
 
 def line(name: str, args: dict[str, str], encoded: str | None = None) -> str:
-    parts = ["+" + name if name == "representation:get" else name]  # it answers with bytes
+    parts = ["+" + name if name in ("representation:get", "image:get") else name]  # they answer with bytes
     for key, value in args.items():
         if key == encoded:
             parts.append(f"+{key} {base64.b64encode(value.encode()).decode()}")
@@ -90,12 +95,12 @@ def test_each_argument_in_base64_gives_the_plain_answer(program: Program, name: 
         if name in PRECEDED:
             client.ask(PRECEDED[name])
         plain = client.ask(line(name, args))
-        assert not plain.startswith("error:"), plain
+        assert not plain.startswith("error:") or name in ERROR_HERE, plain
         for key in args:
             if name in PRECEDED:
                 client.ask(PRECEDED[name])
             encoded = client.ask(line(name, args, key))
-            assert not encoded.startswith("error:"), f"{name} with +{key}: {encoded}"
+            assert not encoded.startswith("error:") or name in ERROR_HERE, f"{name} with +{key}: {encoded}"
             if name not in VARYING:
                 assert encoded == plain, f"{name} with +{key}"
             if name == "log:start":
