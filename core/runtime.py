@@ -182,6 +182,8 @@ class StopFlag:
 
 #: s a clean stop may take before the program dumps every thread's stack and exits anyway
 SHUTDOWN_GRACE_S = 15.0
+#: s the lockstep loop waits at most before it looks at its stop flag again
+MAX_IDLE_S = 0.1
 
 
 def install_signal_handlers(stop: Any, on_force: Callable[[], None] | None = None, grace_s: float = SHUTDOWN_GRACE_S) -> None:
@@ -329,6 +331,9 @@ class LockstepRuntime:
                 if limits.speed:
                     delay = start + time_ns * 1e-9 / limits.speed - time.monotonic()
                     self.behind_s = max(0.0, -delay)
+                    if delay > MAX_IDLE_S:  # a long wait in slices: a stop is seen within one
+                        self.idle(MAX_IDLE_S)
+                        continue
                     if delay > 0:
                         self.idle(delay)
                 self.tick()
@@ -360,8 +365,9 @@ class LockstepRuntime:
                 if origin is None or time_ns < origin[1]:
                     origin = (time.monotonic(), time_ns)
                 delay = origin[0] + (time_ns - origin[1]) * 1e-9 / limits.speed - time.monotonic()
-                if delay > 0:
-                    self.idle(delay)
+                while delay > 0 and not self.stop.is_set():  # a long wait in slices: a stop is seen within one
+                    self.idle(min(delay, MAX_IDLE_S))
+                    delay = origin[0] + (time_ns - origin[1]) * 1e-9 / limits.speed - time.monotonic()
             self.time_ns = time_ns
             if "motion" in contexts:
                 self._update_cognition_status(time_ns)

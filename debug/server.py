@@ -414,7 +414,9 @@ class DebugServer:
         self._throttled = 0
         self._resource_errors = 0
         self._resource_logged_at = 0.0  # monotonic s of the last line about them
-        self.pending: queue.SimpleQueue[_Request] = queue.SimpleQueue()
+        # queue.Queue, not SimpleQueue: in Python 3.11 a signal that arrives during SimpleQueue.get(timeout)
+        # can leave it waiting forever (the loop thread then never sees its stop flag)
+        self.pending: queue.Queue[_Request] = queue.Queue()
         self._queues: dict[Session, deque[_Request]] = {}
         self._turns: deque[Session] = deque()  # connections with queued commands, in rotation
         self.connections: set[Session] = set()

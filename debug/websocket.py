@@ -36,6 +36,7 @@ from websockets.exceptions import ConnectionClosed
 from websockets.http11 import Request, Response
 
 from tafel.core.naming import did_you_mean
+from tafel.debug.commands import CommandError
 from tafel.debug.protocol import Command
 from tafel.debug.server import DebugServer, Session
 
@@ -44,12 +45,13 @@ WEBSOCKET_PATH = "/ws"
 LOCAL_COMMANDS = ("subscribe", "unsubscribe")
 
 
-def host_allowed(host_header: str, bound: str) -> bool:
+def host_allowed(host_header: str, bound: str, names: bool = False) -> bool:
     """Whether an HTTP ``Host`` names this server: an address, ``localhost``, or the name it was bound to.
 
-    Any other name may be an attacker's DNS name that resolves to this machine (DNS rebinding)."""
+    Any other name may be an attacker's DNS name that resolves to this machine (DNS rebinding); with
+    ``names`` (the program has a token, which such a page cannot know) every name is taken."""
     host = urlsplit(f"//{host_header}").hostname or ""
-    if host in ("localhost", bound):
+    if host in ("localhost", bound) or (names and host):
         return True
     try:
         ipaddress.ip_address(host)
@@ -225,6 +227,10 @@ class WebServer:
 
     def start(self) -> tuple[str, int]:
         """Listen (in the debug server's thread); raises ``OSError`` when the port cannot be had."""
+        for name, summary in (("subscribe", "stream representations as they are produced (WebSocket clients only)"),
+                              ("unsubscribe", "stop streaming representations (WebSocket clients only)")):
+            self.debug.router.register(name, summary, f"{name} NAME [NAME...]" + (" [-hz N]" if name == "subscribe" else ""),
+                                       self._streams_only)
         async def listen() -> Any:
             return await serve(self._session, self.host, self.port, process_request=self._http,
                                max_size=self.debug.max_line, compression=None)
@@ -233,6 +239,10 @@ class WebServer:
         self.debug.listeners.append(server)
         self.port = server.sockets[0].getsockname()[1]
         return self.host, self.port
+
+    def _streams_only(self, command: Command) -> str:
+        raise CommandError(f"{command.name} streams over the web page's WebSocket (ws://{self.host}:{self.port}{WEBSOCKET_PATH}); "
+                           "here, ask representation:print -name NAME (or -format json) when you want a value")
 
     # ------------------------------------------------------------------ subscriptions
     def subscribe(self, session: WebSocketSession, topics: Iterable[str]) -> None:
@@ -286,9 +296,10 @@ class WebServer:
 
     def _http(self, connection: ServerConnection, request: Request) -> Response | None:
         host = request.headers.get("Host", "")
-        if not host_allowed(host, self.host):
+        if not host_allowed(host, self.host, names=self.debug.token is not None):
             log.warning("web: refused a request for host %r (only addresses and localhost are served)", host)
-            return connection.respond(403, f"this program answers requests for its address, not for {host!r}\n")
+            return connection.respond(403, f"this program answers requests for its address, not for {host!r} "
+                                           "(with --debug-token, names are taken too)\n")
         path = urlsplit(request.path).path
         if path == WEBSOCKET_PATH:
             origin = request.headers.get("Origin")

@@ -65,10 +65,14 @@ class Program:
             return client.ask(line)
 
     def stop(self) -> tuple[str, str]:
+        started = time.monotonic()
         self.process.terminate()
         self.process.wait(timeout=30)
         for reader in self.readers:
             reader.join(timeout=10)
+        took = time.monotonic() - started
+        # a program must go away when told; after its grace period it dumps every thread's stack: show it
+        assert took < 10.0, f"the program took {took:.1f} s to stop:\n" + "".join(self.errors)[-6000:]
         return "".join(self.output), "".join(self.errors)
 
 

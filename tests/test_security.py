@@ -156,7 +156,7 @@ def _few_descriptors() -> None:
 @pytest.mark.slow
 def test_running_out_of_file_descriptors_logs_one_line_not_tracebacks(tmp_path: Path) -> None:
     process = subprocess.Popen(
-        [*TAFEL, "run", "--platform", "dummy", "--debug-port", "0", "--debug-max-connections", "500", "--seconds", "8"],
+        [*TAFEL, "run", "--platform", "dummy", "--debug-port", "0", "--no-web", "--debug-max-connections", "500", "--seconds", "8"],
         cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=_few_descriptors,
         env={**os.environ, "PYTHONPATH": str(REPO)})
     port = int(re.search(r":(\d+)", process.stdout.readline()).group(1))

@@ -110,6 +110,11 @@ def test_commands_are_the_text_protocols_and_answers_come_in_order(served: Serve
         assert ask(socket, "stopwatch:list -format xml") == "error: cognition: -format takes text or json, got 'xml'"
 
 
+def test_telnet_clients_learn_that_streaming_is_the_websockets(served: Served) -> None:
+    assert served.server.ask("subscribe BallModel").startswith("error: subscribe streams over the web page's WebSocket (ws://")
+    assert "subscribe NAME [NAME...] [-hz N]" in served.server.ask("help subscribe")
+
+
 def test_switching_a_provider_over_the_websocket_is_seen_by_telnet_clients_too(served: Served) -> None:
     with connect(served.url) as socket:
         assert ask(socket, "modules:provider -representation BallModel -module SimpleBallModeler") == \
@@ -234,6 +239,7 @@ def test_a_foreign_host_or_origin_is_refused(served: Served) -> None:
                                                ("10.0.0.7", True), ("robot.local:5480", False), ("evil.example", False), ("", False)])
 def test_only_addresses_and_localhost_are_our_host(host: str, allowed: bool) -> None:
     assert host_allowed(host, "127.0.0.1") is allowed
+    assert host_allowed(host, "127.0.0.1", names=True) is bool(host)  # with a token, robot names work too
 
 
 # ------------------------------------------------------------------------------------------- JSON
