@@ -15,13 +15,13 @@ export function modulesView(body, connection, state, panel) {
   body.classList.add("graph-body");
   const context = el("select");
   const store = el("button", { type: "button", textContent: "store choices", title: "write providers and disabled modules to the private configuration" });
-  const fit = el("input", { type: "checkbox" });
+  const fit = el("input", { type: "checkbox", checked: true });
   fit.onchange = () => { const root = picture.querySelector("svg"); if (root) root.style.width = fit.checked ? "100%" : `${root.getAttribute("width")}px`; };
   const note = el("div");
   const detail = el("div", { className: "row" });
   const providers = el("table");
   const picture = el("div", { style: "overflow:auto" });
-  body.append(el("div", { className: "row" }, context, store, el("label", {}, fit, " fit the graph to the view"), note), detail, providers, picture);
+  body.append(el("div", { className: "row" }, context, store, el("label", {}, fit, " fit the graph to the view (off: full size, scroll)"), note), detail, providers, picture);
   let graphs = {}, shape = "", selected = "";
   state.modules = { graphs };
 
