@@ -360,7 +360,7 @@ def test_the_tools_package_knows_no_representation_by_name() -> None:
     discover_modules()
     names = set(registered_representations()) - {"DebugDrawings", "DebugPlots", "ModuleTimes"}  # the debug data tools record
     offenders = []
-    for path in (REPO / "tools").glob("*.py"):
+    for path in (REPO / "tools").rglob("*.py"):
         # the two tools whose job is to know them: Foxglove's schema for each, and the scenes that feed
         # perception modules the images and camera matrices they read
         if path.name in ("foxglove_channels.py", "scene_frames.py"):

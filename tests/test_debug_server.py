@@ -24,6 +24,7 @@ from tafel.core.serialization import deserialize
 from tafel.debug.client import DebugClient
 from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler
 from tafel.representations.modeling import BallModel
+from tests.support.processes import stop_program
 from tests.test_cli_runtime import REPO, tafel
 
 DEBUG_USER = "tests.support.debug_user:DebugUser"
@@ -65,15 +66,7 @@ class Program:
             return client.ask(line)
 
     def stop(self) -> tuple[str, str]:
-        started = time.monotonic()
-        self.process.terminate()
-        self.process.wait(timeout=30)
-        for reader in self.readers:
-            reader.join(timeout=10)
-        took = time.monotonic() - started
-        # a program must go away when told; after its grace period it dumps every thread's stack: show it
-        assert took < 10.0, f"the program took {took:.1f} s to stop:\n" + "".join(self.errors)[-6000:]
-        return "".join(self.output), "".join(self.errors)
+        return stop_program(self.process, self.readers, self.output, self.errors)
 
 
 @pytest.fixture(scope="module")

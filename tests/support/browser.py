@@ -16,6 +16,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+from tests.support.processes import stop_program
+
 REPO = Path(__file__).resolve().parents[2]
 #: flags for a machine without display or internet: no sandbox (root), no GPU, no background traffic
 CHROMIUM_FLAGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
@@ -81,11 +83,4 @@ class WebProgram:
             return client.ask(line)
 
     def stop(self) -> tuple[str, str]:
-        started = time.monotonic()
-        self.process.terminate()
-        self.process.wait(timeout=30)
-        for reader in self.readers:
-            reader.join(timeout=10)
-        took = time.monotonic() - started
-        assert took < 10.0, f"the program took {took:.1f} s to stop:\n" + "".join(self.errors)[-6000:]
-        return "".join(self.output), "".join(self.errors)
+        return stop_program(self.process, self.readers, self.output, self.errors)
