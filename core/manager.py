@@ -58,6 +58,11 @@ class Blackboard:
             raise KeyError(f"no representation {name!r} on this blackboard; {did_you_mean(name, self._by_name)}")
         return self._by_type[self._by_name[name]]
 
+    def find(self, name: str) -> Any:
+        """The instance of the representation named ``name``, or None when the blackboard has none."""
+        rep = self._by_name.get(name)
+        return None if rep is None else self._by_type[rep]
+
     def names(self) -> list[str]:
         return sorted(self._by_name)
 

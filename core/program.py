@@ -55,6 +55,15 @@ class ContextPlan:
         """A context runs when the platform feeds it: its frames are driven by the platform's data."""
         return bool(self.platform_provides)
 
+    def representations(self) -> set[type]:
+        """Every representation the context's blackboard may hold: from outside, and what its modules
+        read or provide (disabled ones included: they may be switched on)."""
+        reps = set(self.external)
+        for module in self.modules:
+            requirements = module.requirements()
+            reps.update(requirements.reads(), requirements.provides)
+        return reps
+
     def active_modules(self) -> list[type]:
         off = set(self.disabled) | set(self.pruned) | set(self.replaced)
         return [m for m in self.modules if m.__name__ not in off]

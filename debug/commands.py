@@ -630,13 +630,12 @@ def merge_answers(command: Command, answers: Mapping[str, tuple[str, str | bytes
 def frame_number(manager: ModuleManager) -> int:
     """The frame's number as the platform counts it (``FrameInfo``: a replayed log's recorded numbers),
     else as the manager does."""
-    info = manager.blackboard.get("FrameInfo") if "FrameInfo" in manager.blackboard.names() else None
-    return int(getattr(info, "frame_number", manager.frame))
+    return int(getattr(manager.blackboard.find("FrameInfo"), "frame_number", manager.frame))
 
 
 def frame_time_ns(manager: ModuleManager) -> int | None:
     """The frame's time on the program's clock (``FrameInfo``), or None without one."""
-    info = manager.blackboard.get("FrameInfo") if "FrameInfo" in manager.blackboard.names() else None
+    info = manager.blackboard.find("FrameInfo")  # by name: debug knows no representation
     return None if info is None else int(info.time_ns)
 
 

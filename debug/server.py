@@ -197,8 +197,9 @@ class Session:
         self.auth_failures = 0
 
     # ------------------------------------------------------------------ what a transport supplies
-    def _write(self, data: bytes) -> bool:
-        """Send these answer bytes; False when the client is gone or does not read (then it is dropped)."""
+    def _write(self, answers: list[bytes]) -> bool:
+        """Send these answers (each as ``answer_bytes`` made it), in order; False when the client is gone
+        or does not read (then it is dropped)."""
         raise NotImplementedError
 
     def _close_transport(self, abort: bool) -> None:
@@ -288,7 +289,7 @@ class Session:
         while self.next_answer in self.answers:
             ready.append(self.answers.pop(self.next_answer))
             self.next_answer += 1
-        if ready and not self._write(b"".join(ready)):
+        if ready and not self._write(ready):
             self.drop()
             return
         self._finish_if_done()
@@ -357,10 +358,10 @@ class _Connection(Session):
             return
         super().handle_line(raw)
 
-    def _write(self, data: bytes) -> bool:
+    def _write(self, answers: list[bytes]) -> bool:
         if self.writer.transport.is_closing():  # the client is gone (reset): stop answering it
             return False
-        self.writer.write(data)
+        self.writer.write(b"".join(answers))
         if self.writer.transport.get_write_buffer_size() > self.server.max_output:
             log.warning("dropping debug client %s: it does not read its answers", self.peer)
             return False

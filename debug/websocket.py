@@ -135,9 +135,9 @@ class WebSocketSession(Session):
         return f"subscribed {' '.join(names)}" + (f" at most {rate:g} a second" if rate else "")
 
     # ------------------------------------------------------------------ out
-    def _write(self, data: bytes) -> bool:
-        for answer in data.split(b"\0")[:-1]:
-            text = json.dumps({"answer": answer.decode("utf-8", "replace").rstrip("\n")})
+    def _write(self, answers: list[bytes]) -> bool:
+        for answer in answers:
+            text = json.dumps({"answer": answer.rstrip(b"\0").decode("utf-8", "replace").rstrip("\n")})
             self.out.append(text)
             self.queued_bytes += len(text)
         self.wake.set()

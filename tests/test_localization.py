@@ -103,7 +103,7 @@ def test_the_pose_stays_right_along_a_route_and_after_a_kidnapping(localizing_ro
             assert truth["time"] < start + 25.0, f"did not reach {target}: {truth}"
             robot.run_for(0.25)
     assert worst[0] < WIDE_POSITION_LIMIT
-    assert sum(1 for e in excursions) * 0.25 < 2.0, excursions  # at most about 2 s in all, of a route of about 50 s
+    assert len(excursions) * 0.25 < 2.0, excursions  # at most about 2 s in all, of a route of about 50 s
 
     # carried elsewhere in its own half, turned round: lost, then right again within 15 s
     robot.ask("motion:stand")

@@ -197,7 +197,7 @@ def test_a_slow_page_gets_the_newest_message_of_each_topic_and_every_answer() ->
     session.stream("RobotPose", "pose 0")
     assert list(session.latest.items()) == [("BallModel", "ball 4"), ("RobotPose", "pose 0")]
     assert session.dropped == 4
-    assert session._write(b"pong\0error: x\0")
+    assert session._write([b"pong\n\0", b"error: x\n\0"])
     assert [json.loads(m)["answer"] for m in session.out] == ["pong", "error: x"]
 
 

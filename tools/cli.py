@@ -427,10 +427,7 @@ def start_foxglove(args: argparse.Namespace, debug: ProgramDebug | None, config:
 
 def web_representations(plans: Mapping[str, ContextPlan]) -> list[type]:
     """Every representation of the program: what the web page may subscribe to."""
-    reps = {rep for plan in plans.values() for rep in plan.external}
-    reps |= {rep for plan in plans.values() for module in plan.modules
-             for rep in (*module.requirements().reads(), *module.requirements().provides)}
-    return sorted(reps, key=lambda rep: rep.__name__)
+    return sorted({rep for plan in plans.values() for rep in plan.representations()}, key=lambda rep: rep.__name__)
 
 
 def start_web(args: argparse.Namespace, debug: ProgramDebug | None, plans: Mapping[str, ContextPlan], config: dict[str, Any],
@@ -457,9 +454,9 @@ def concurrent_feed(wanted: bool, reps: Sequence[type], setups: list[Any]) -> tu
     processes' set-up that feeds them; (None, None) when the viewer is off."""
     if not wanted:
         return None, None
-    from tafel.tools.live_feed import LiveFeed, shared_feed, worker_feed_setup
+    from tafel.tools.live_feed import feed_order, shared_feed, worker_feed_setup
 
-    names = [rep.__name__ for rep in LiveFeed(reps).reps]
+    names = [rep.__name__ for rep in feed_order(reps)]
     flags, feed = shared_feed(len(names))
     setups.append((worker_feed_setup, {"names": names, "flags": flags, "queue": feed}))
     return flags, feed

@@ -322,9 +322,7 @@ class ProgramDebug:
         self.executors[name] = executor
         names = None
         if plan is not None:
-            reps = {r.__name__ for r in plan.external}
-            reps |= {r.__name__ for m in plan.modules for r in (*m.requirements().reads(), *m.requirements().provides)}
-            names = {m.__name__ for m in plan.modules} | reps
+            names = {m.__name__ for m in plan.modules} | {r.__name__ for r in plan.representations()}
         self.router.add_context(name, executor, names)
 
     def add_platform_commands(self, platform: Any) -> None:

@@ -58,12 +58,17 @@ def hand_over(context: str, blackboard: Any, time_ns: int, frame: int, reps: Seq
     return dropped
 
 
+def feed_order(reps: Iterable[type]) -> tuple[type, ...]:
+    """Representations in the order a feed's flags follow, the same in every process: by name."""
+    return tuple(sorted(set(reps), key=lambda rep: rep.__name__))
+
+
 class LiveFeed:
     """The loops' side of one viewer: which representations it needs, and the queue its copies go to."""
 
     def __init__(self, reps: Iterable[type], *, flags: Any = None, queue_size: int = QUEUE_SIZE) -> None:
         #: every representation the viewer may ask for, in one fixed order (the flags' order)
-        self.reps: tuple[type, ...] = tuple(sorted(set(reps), key=lambda rep: rep.__name__))
+        self.reps = feed_order(reps)
         self.index = {rep: i for i, rep in enumerate(self.reps)}
         self.flags = flags  # with contexts in other processes: a shared array, one flag per representation
         self.needed: frozenset[type] = frozenset()

@@ -24,7 +24,7 @@ from tafel.debug.commands import jpeg_bytes, representation_message
 from tafel.debug.concepts import DebugDrawings, DebugPlots, ModuleTimes
 from tafel.debug.server import DebugServer
 from tafel.debug.websocket import WebServer
-from tafel.tools.live_feed import Handed, LiveFeed
+from tafel.tools.live_feed import Handed, LiveFeed, feed_order
 
 log = logging.getLogger("tafel.web")
 STATIC = Path(__file__).resolve().parent / "static"
@@ -35,7 +35,7 @@ DEBUG_TOPICS = (DebugDrawings, DebugPlots, ModuleTimes)
 
 def web_topics(reps: Iterable[type]) -> list[type]:
     """What a page may subscribe to: these representations and the debug topics, in the feed's order."""
-    return list(LiveFeed([*reps, *DEBUG_TOPICS]).reps)
+    return list(feed_order([*reps, *DEBUG_TOPICS]))
 
 
 def is_image(value: Any) -> bool:
