@@ -85,6 +85,11 @@ class Platform:
         """Frame rates (Hz) the platform imposes per context, or None to use the configured ones."""
         return None
 
+    def configure(self, config: Mapping[str, Any]) -> None:
+        """Take what the platform needs of the merged configuration (called once, before ``start``).
+
+        What it keeps must go into ``options``: a context process makes its platform anew from them."""
+
     def start(self, contexts: frozenset[str]) -> None:
         """Open devices and files for ``contexts`` (called in the process that runs them)."""
 

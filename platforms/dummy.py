@@ -16,23 +16,24 @@ import numpy as np
 
 from tafel.core.manager import Blackboard
 from tafel.core.platform import Platform, seed_number
+from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS, NetworkedPlatform
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import RobotPose
-from tafel.representations.motion import HEAD_YAW, JOINT_COUNT, FsrData, InertialSensorData, JointCommand, JointSensorData
+from tafel.representations.motion import HEAD_YAW, JOINT_COUNT, FsrData, InertialSensorData, JointCommand, JointSensorData, TouchSensorData
 from tafel.representations.perception import BallPercept
 
 GRAVITY = 9.81
 
 
-class DummyPlatform(Platform):
+class DummyPlatform(NetworkedPlatform, Platform):
     name = "dummy"
     description = "deterministic clock, synthetic joints, IMU, ball percepts and pose, no physics"
     clock = "simulated"
     provides: ClassVar[Mapping[str, tuple[type, ...]]] = {
-        "motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData),
-        "cognition": (FrameInfo, BallPercept, RobotPose),
+        "motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData, TouchSensorData),
+        "cognition": (FrameInfo, BallPercept, RobotPose, *NETWORK_INPUTS),
     }
-    consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {"motion": (JointCommand,)}
+    consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {"motion": (JointCommand,), "cognition": NETWORK_OUTPUTS}
 
     #: s, time constant of the ideal joint servos
     SERVO_TIME_CONSTANT = 0.05
@@ -58,6 +59,14 @@ class DummyPlatform(Platform):
 
     def start(self, contexts: frozenset[str]) -> None:
         self.simulates_joints = "motion" in contexts
+        if "cognition" in contexts:
+            self.network.open()
+
+    def stop(self) -> None:
+        self.network.close()
+
+    def commands(self) -> Mapping[str, tuple[str, Any]]:
+        return self.network.commands()
 
     def advance(self, time_ns: int) -> None:
         dt = max(0, time_ns - self.time_ns) * 1e-9
@@ -83,6 +92,7 @@ class DummyPlatform(Platform):
             inertial.gyroscope = np.zeros(3)
             inertial.angles = np.zeros(2)
             blackboard[FsrData].pressure = np.full(8, 5.36 / 8)
+            blackboard.set(TouchSensorData())
         elif context == "cognition":
             x, y = self.ball_position(time_ns)
             head_yaw = self.joints[HEAD_YAW] if self.simulates_joints else math.atan2(y, x)
@@ -94,8 +104,11 @@ class DummyPlatform(Platform):
             pose = blackboard[RobotPose]  # the robot never moves: it stands where the simulators start it
             pose.valid, pose.lost, pose.deviation, pose.rotation_deviation = True, False, 0.0, 0.0
             pose.x, pose.y, pose.rotation = self.POSE
+            self.network.receive(blackboard, time_ns)
 
     def act(self, context: str, blackboard: Blackboard) -> None:
+        if context == "cognition":
+            self.network.send(blackboard)
         if context == "motion":
             command = blackboard[JointCommand]
             self.command = np.asarray(command.position, dtype=float).copy()

@@ -89,6 +89,7 @@ class MujocoPlatform(SimulatedRobotPlatform):
             print(f"mujoco: cannot open the viewer ({exc}); running headless", file=sys.stderr)
 
     def stop(self) -> None:
+        super().stop()
         for renderer in self.renderers.values():
             try:
                 renderer.close()

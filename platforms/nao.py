@@ -31,6 +31,7 @@ from tafel.core import clock
 from tafel.core.manager import Blackboard
 from tafel.core.platform import Platform, PlatformError
 from tafel.platforms.actuators import ActuatorGuard
+from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS, NetworkedPlatform
 from tafel.platforms.v4l2 import image_time_ns
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import (
@@ -104,15 +105,15 @@ def parse_sensors(packet: Any) -> dict[str, np.ndarray]:
     return values
 
 
-class NaoPlatform(Platform):
+class NaoPlatform(NetworkedPlatform, Platform):
     name = "nao"
     description = "the real NAO V6: LoLA (msgpack over /tmp/robocup) and both cameras through V4L2"
     clock = "own"
     provides: ClassVar[Mapping[str, tuple[type, ...]]] = {
         "motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData, TouchSensorData, BatteryData),
-        "cognition": (FrameInfo, CameraImageTop, CameraImageBottom),
+        "cognition": (FrameInfo, CameraImageTop, CameraImageBottom, *NETWORK_INPUTS),
     }
-    consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {"motion": (JointCommand, LedRequest)}
+    consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {"motion": (JointCommand, LedRequest), "cognition": NETWORK_OUTPUTS}
 
     def __init__(self, options: Mapping[str, Any] | None = None) -> None:
         super().__init__(options)
@@ -169,6 +170,8 @@ class NaoPlatform(Platform):
                 self.connection.close()
                 self.connection = None
                 raise PlatformError(f"cannot connect to LoLA at {self.socket_path}: {exc.strerror or exc}") from None
+        if "cognition" in contexts:
+            self.network.open()
         if "cognition" in contexts and self.cameras:
             for camera, device in self.camera_devices.items():
                 capture = cv2.VideoCapture(device, cv2.CAP_V4L2)
@@ -177,6 +180,7 @@ class NaoPlatform(Platform):
                 self.captures[camera] = capture
 
     def stop(self) -> None:
+        self.network.close()
         for capture in self.captures.values():
             capture.release()
         self.captures = {}
@@ -267,6 +271,7 @@ class NaoPlatform(Platform):
         elif context == "cognition":
             self.time_ns = clock.now_ns()
             blackboard.set(FrameInfo(frame_number=frame_number, time_ns=self.time_ns))
+            self.network.receive(blackboard, self.time_ns)
             if not self.captures:
                 time.sleep(1.0 / 30.0)  # no cameras: keep cognition at its usual pace
                 return
@@ -284,7 +289,12 @@ class NaoPlatform(Platform):
     def frame_time_ns(self, context: str) -> int | None:
         return self.time_ns
 
+    def commands(self) -> Mapping[str, tuple[str, Any]]:
+        return self.network.commands()
+
     def act(self, context: str, blackboard: Blackboard) -> None:
+        if context == "cognition":
+            self.network.send(blackboard)
         if context != "motion" or not self.pending_answer:
             return
         command, leds = blackboard[JointCommand], blackboard[LedRequest]

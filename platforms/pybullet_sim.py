@@ -155,6 +155,7 @@ class PybulletPlatform(SimulatedRobotPlatform):
         self.move_ball(*self.initial_ball)
 
     def stop(self) -> None:
+        super().stop()
         if self.client is not None:
             try:
                 pybullet.disconnect(physicsClientId=self.client)

@@ -21,16 +21,26 @@ from tafel.core.manager import Blackboard
 from tafel.core.platform import Platform, PlatformOptionError, seed_number
 from tafel.platforms.actuators import ActuatorGuard
 from tafel.platforms.field_world import BALL_COLORS
+from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS, NetworkedPlatform
 from tafel.platforms.robot_model import STANDING_HEIGHT
 from tafel.representations import field
 from tafel.representations.infrastructure import FrameInfo
-from tafel.representations.motion import JOINT_NAMES, FsrData, InertialSensorData, JointCommand, JointSensorData
+from tafel.representations.motion import (
+    CHEST_BUTTON,
+    JOINT_NAMES,
+    FsrData,
+    InertialSensorData,
+    JointCommand,
+    JointSensorData,
+    TouchSensorData,
+)
 from tafel.representations.nao import VERTICAL_FOV
 from tafel.representations.perception import CameraImageBottom, CameraImageTop
 
 GRAVITY = 9.81
 TIMESTEP = 0.002  # s of physics per step
 PUSH_SECONDS = 0.1  # how long sim:push pushes
+BUTTON_SECONDS = 0.1  # how long sim:button holds the chest button
 LYING_HEIGHT = 0.12  # m of the torso above the ground when put down lying (it drops the last bit)
 
 
@@ -93,16 +103,16 @@ def number(args: Mapping[str, Any], name: str, default: float = 0.0, limit: floa
     return value
 
 
-class SimulatedRobotPlatform(Platform):
+class SimulatedRobotPlatform(NetworkedPlatform, Platform):
     """Base of the simulator platforms: one world feeds both contexts in lockstep."""
 
     clock = "simulated"
     concurrent = False  # images and joints must come from the same simulated world
     provides: ClassVar[Mapping[str, tuple[type, ...]]] = {
-        "motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData),
-        "cognition": (FrameInfo, CameraImageTop, CameraImageBottom),
+        "motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData, TouchSensorData),
+        "cognition": (FrameInfo, CameraImageTop, CameraImageBottom, *NETWORK_INPUTS),
     }
-    consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {"motion": (JointCommand,)}
+    consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {"motion": (JointCommand,), "cognition": NETWORK_OUTPUTS}
     #: the engine's name in help texts
     engine = ""
 
@@ -131,6 +141,7 @@ class SimulatedRobotPlatform(Platform):
         self.camera_latency_ns = int(round(latency * 1e6))
         #: (time_ns, engine state) of the recent physics steps, while images arrive late
         self.history: deque[tuple[int, Any]] = deque()
+        self.button_until_ns = -1  # the chest button is held down until then (sim:button)
 
     @classmethod
     def add_arguments(cls, parser: argparse.ArgumentParser) -> None:
@@ -238,6 +249,11 @@ class SimulatedRobotPlatform(Platform):
             print(f"{self.name}: --viewer needs a display (DISPLAY is not set); running headless", file=sys.stderr)
         self.build(contexts, viewer)
         self.move_robot(*self.initial_pose)
+        if "cognition" in contexts:
+            self.network.open()
+
+    def stop(self) -> None:
+        self.network.close()
 
     def advance(self, time_ns: int) -> None:
         steps = int(round((time_ns - self.time_ns) * 1e-9 / TIMESTEP))
@@ -277,7 +293,12 @@ class SimulatedRobotPlatform(Platform):
             inertial.gyroscope = gyroscope + self.rng.normal(0.0, 0.002, 3)
             inertial.angles = np.array(self.torso_angles())
             blackboard[FsrData].pressure = self.foot_forces() / GRAVITY
-        elif context == "cognition" and self.cameras:
+            touch = np.zeros(len(TouchSensorData().pressed))
+            touch[CHEST_BUTTON] = float(time_ns < self.button_until_ns)
+            blackboard.set(TouchSensorData(pressed=touch))
+            return
+        self.network.receive(blackboard, time_ns)
+        if context == "cognition" and self.cameras:
             taken_ns, images = self.images(time_ns)
             for camera, rep in (("top", CameraImageTop), ("bottom", CameraImageBottom)):
                 image = blackboard[rep]
@@ -299,6 +320,8 @@ class SimulatedRobotPlatform(Platform):
         return taken_ns, self.render_state(state, cameras)
 
     def act(self, context: str, blackboard: Blackboard) -> None:
+        if context == "cognition":
+            self.network.send(blackboard)
         if context != "motion":
             return
         command = blackboard[JointCommand]
@@ -380,7 +403,13 @@ class SimulatedRobotPlatform(Platform):
             return (f"time {self.time_ns * 1e-9:.3f} s{' (paused)' if self.paused else ''}; robot x={x:.0f} y={y:.0f} mm "
                     f"rotation {heading:.3f} rad, torso height {self.torso_height():.0f} mm, {self.posture()}; ball x={bx:.0f} y={by:.0f} mm")
 
+        def button(args: Mapping[str, Any]) -> str:
+            self.button_until_ns = self.time_ns + int(BUTTON_SECONDS * 1e9)
+            return f"chest button pressed for {BUTTON_SECONDS} s"
+
         return {
+            **self.network.commands(),
+            "sim:button": ("press the chest button once (the rules' manual mode steps the game state without a GameController)", button),
             "sim:move_ball": ("put the ball at -x X -y Y (mm, field)", ball),
             "sim:move_robot": ("put the robot at -x X -y Y (mm, field) -rotation R (rad) [-lying front|back]", robot),
             "sim:push": ("push the torso for 0.1 s with -x FX -y FY (N, field frame)", push),

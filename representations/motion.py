@@ -198,12 +198,24 @@ class TorsoPose:
     translation: np.ndarray = array((3,))
 
 
+CHEST_BUTTON = 0  # index of the chest button in TouchSensorData.pressed
+
+
 @representation
 class TouchSensorData:
     """Touch sensors and bumpers (1 pressed, 0 not): chest button, head front/middle/rear, left foot
     bumper left/right, left hand back/left/right, right foot bumper left/right, right hand back/left/right."""
 
     pressed: np.ndarray = array((14,))
+
+
+@representation
+class ChestButton:
+    """The chest button, debounced: ``pressed`` now, and ``presses`` counted since the start (a press
+    ends when the button is let go), so that a reader at any rate misses none."""
+
+    pressed: bool = False
+    presses: int = 0
 
 
 @representation

@@ -90,7 +90,8 @@ def test_platforms_lists_what_each_provides_and_consumes() -> None:
     result = tafel("platforms")
     assert result.returncode == 0
     assert "dummy: deterministic clock" in result.stdout
-    assert "motion: provides FrameInfo, JointSensorData, InertialSensorData, FsrData; consumes JointCommand" in result.stdout
+    assert "motion: provides FrameInfo, JointSensorData, InertialSensorData, FsrData, TouchSensorData; consumes JointCommand" in result.stdout
+    assert "consumes GameControllerReturn, OutgoingTeamMessage" in result.stdout
     verbose = tafel("platforms", "--verbose")
     assert "option --seed: dummy: seed of the synthetic sensor noise" in verbose.stdout
     assert "option --lola: nao: LoLA's Unix socket" in verbose.stdout
@@ -100,7 +101,7 @@ def test_modules_shows_order_providers_and_hand_overs() -> None:
     result = tafel("modules", "--platform", "dummy")
     assert result.returncode == 0, result.stderr
     out = result.stdout
-    assert ("order: InertialFilter -> CameraMatrixProvider -> CameraMatrixBufferProvider -> FallDetector -> MotionSelector -> "
+    assert ("order: InertialFilter -> ChestButtonProvider -> CameraMatrixProvider -> CameraMatrixBufferProvider -> FallDetector -> MotionSelector -> "
             "StandMotion -> WalkingEngine -> KeyframePlayer -> HeadMotion -> MotionCombinator -> StatusLeds") in out
     assert "provider BallModel: KalmanBallModeler (alternatives: SimpleBallModeler)" in out
     assert "hand-over in: HeadMotionRequest from cognition" in out

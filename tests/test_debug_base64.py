@@ -52,6 +52,7 @@ CALLS: dict[str, dict[str, str]] = {
     "image:get": {"name": "CameraImageTop", "quality": "70"},
     "field:geometry": {},
     "web:status": {},
+    "network:status": {},
     "subscribe": {"topics": "BallModel", "hz": "5"},
     "unsubscribe": {"topics": "BallModel"},
 }

@@ -6,20 +6,35 @@ from __future__ import annotations
 import math
 import struct
 
+import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tafel.platforms.game_controller import (
+from tafel.core.testing import ModuleHarness
+from tafel.modules.communication.game_controller_reporter import GameControllerReporter
+from tafel.modules.communication.game_state_provider import GameStateProvider
+from tafel.modules.motion.chest_button_provider import ChestButtonProvider
+from tafel.representations.game import (
     GAME_SIZE,
+    Datagram,
+    GameControllerPackets,
+    GameControllerReturn,
+    GamePhase,
+    GameState,
     PacketError,
+    Penalty,
     ReturnPacket,
+    SetPlay,
+    State,
     decode_game_state,
     decode_return,
     encode_game_state,
     encode_return,
 )
-from tafel.representations.game import GamePhase, Penalty, SetPlay, State
+from tafel.representations.modeling import BallModel, RobotPose
+from tafel.representations.motion import ChestButton, TouchSensorData
+from tafel.representations.motion_control import FallState
 
 # the header's layout: "<4s10Bhh", then two teams of "<6BHH40B"; 118 bytes
 GAME = struct.Struct("<4s10Bhh")
@@ -104,3 +119,100 @@ def test_return_packets_follow_the_published_layout() -> None:
     for bad in (data[:-1], b"RGme" + data[4:], data[:4] + b"\x03" + data[5:]):
         with pytest.raises(PacketError, match="not a version 4 return packet"):
             decode_return(bad)
+
+
+# ----------------------------------------------------------------------------- GameStateProvider
+def received(*datagrams: bytes, team: int = 12, player: int = 3, at_ns: int = 0) -> GameControllerPackets:
+    return GameControllerPackets(datagrams=[Datagram(data=d, host="10.0.0.9", port=3838, received_ns=at_ns) for d in datagrams],
+                                 team_number=team, player_number=player)
+
+
+def test_the_packet_for_this_team_becomes_the_game_state() -> None:
+    harness = ModuleHarness(GameStateProvider, received(packet(penalties={(0, 2): (6, 25)})))
+    game = harness.execute()[GameState]
+    assert game.heard and not game.manual and game.source == "10.0.0.9" and game.state is State.playing
+    assert (game.team_number, game.player_number) == (12, 3)
+    assert game.penalized and game.own_player().secs_till_unpenalised == 25 and game.ignored_packets == 0
+
+
+@pytest.mark.parametrize("bad", [
+    b"", b"RGme", b"XXXX" + packet()[4:], packet(version=17), packet() + b"\0", packet()[:-1],
+    packet(teams=((1, 0, 0, 1, 0, 0, 0, 100), (2, 0, 0, 1, 0, 0, 0, 100))),  # other teams' game
+    packet(state=9),
+])
+def test_bad_packets_and_other_teams_games_are_ignored_and_counted(bad: bytes) -> None:
+    harness = ModuleHarness(GameStateProvider, received(bad), parameters={"start_state": "initial"})
+    game = harness.execute()[GameState]
+    assert game.ignored_packets == 1 and not game.heard and game.state is State.initial
+    harness.set(received(bad, packet(), bad, at_ns=harness.time_ns))  # the good one among them still counts
+    game = harness.execute()[GameState]
+    assert game.ignored_packets == 3 and game.heard and game.state is State.playing
+
+
+def test_two_seconds_without_a_packet_say_the_game_controller_is_not_heard_and_the_state_stays() -> None:
+    harness = ModuleHarness(GameStateProvider, received(packet(state=1)))
+    assert harness.execute()[GameState].heard
+    harness.set(received())
+    harness.advance(1.9)
+    assert harness.blackboard[GameState].heard
+    harness.advance(0.2)
+    game = harness.blackboard[GameState]
+    assert not game.heard and game.seconds_since_packet >= 2.0 and game.state is State.ready
+
+
+def test_without_a_game_controller_the_chest_button_steps_through_the_manual_mode() -> None:
+    harness = ModuleHarness(GameStateProvider, received(), parameters={"start_state": "initial"})
+    seen = []
+    for presses in range(4):
+        harness.set(ChestButton(presses=presses))
+        game = harness.execute()[GameState]
+        seen.append((game.state, game.penalized, game.manual))
+    assert seen == [(State.initial, False, False), (State.playing, True, True), (State.playing, False, True), (State.playing, True, True)]
+    harness.set(ChestButton(presses=5))  # two presses between two frames: both count (free, penalized)
+    assert harness.execute()[GameState].penalized
+
+
+def test_the_chest_button_does_nothing_while_a_game_controller_is_heard() -> None:
+    harness = ModuleHarness(GameStateProvider, received(packet(state=0)))
+    harness.execute()
+    harness.set(received(), ChestButton(presses=1))
+    game = harness.execute()[GameState]
+    assert game.state is State.initial and not game.penalized and not game.manual
+
+
+def test_an_unknown_start_state_is_an_error_that_lists_the_states() -> None:
+    harness = ModuleHarness(GameStateProvider, received(), parameters={"start_state": "kickoff"})
+    with pytest.raises(ValueError, match="start_state is 'kickoff'; it takes initial, ready, set, playing, finished, standby"):
+        harness.execute()
+
+
+def test_chest_presses_are_counted_once_held_long_enough_and_let_go() -> None:
+    pressed, free = TouchSensorData(pressed=np.eye(14)[0]), TouchSensorData()
+    harness = ModuleHarness(ChestButtonProvider, free)
+    harness.feed({TouchSensorData: [pressed, free, free, *[pressed] * 10, free]})  # a 10 ms blip, then 100 ms
+    harness.execute(14)
+    assert [b.presses for b in harness.history(ChestButton)] == [0] * 13 + [1]
+
+
+# ------------------------------------------------------------------------ GameControllerReporter
+def test_return_packets_carry_the_robot_and_come_at_the_configured_interval() -> None:
+    game = GameState(heard=True, source="10.0.0.9", team_number=12, player_number=3)
+    pose = RobotPose(valid=True, x=-1200.0, y=300.0, rotation=0.5)
+    harness = ModuleHarness(GameControllerReporter, game, pose, BallModel(valid=True, x=800.0, y=-100.0, time_since_seen=0.2),
+                            FallState(), parameters={"interval": 0.5})
+    harness.execute(61)  # 2 s at 30 Hz
+    sent = [r for r in harness.history(GameControllerReturn) if r.data]
+    assert len(sent) == 5 and all(r.host == "10.0.0.9" for r in sent)  # at 0, 0.5, 1.0, 1.5 and 2.0 s
+    header, version, player, team, fallen, x, y, rotation, age, ball_x, ball_y = RETURN.unpack(sent[0].data)
+    assert (header, version, player, team, fallen) == (b"RGrt", 4, 3, 12, 0)
+    assert (x, y, ball_x, ball_y) == (-1200.0, 300.0, 800.0, -100.0) and rotation == pytest.approx(0.5)
+    assert age == pytest.approx(0.2, abs=1e-6)
+
+
+def test_no_return_packet_without_a_game_controller_and_ball_age_minus_one_before_a_ball() -> None:
+    harness = ModuleHarness(GameControllerReporter, GameState(heard=False, source="10.0.0.9"))
+    harness.execute(40)
+    assert not any(r.data for r in harness.history(GameControllerReturn))
+    harness.set(GameState(heard=True, source="10.0.0.9", team_number=1, player_number=1))
+    data = harness.execute()[GameControllerReturn].data
+    assert RETURN.unpack(data)[8] == -1.0

@@ -32,8 +32,6 @@ ROUTE = [(-2000.0, -1500.0), (-1200.0, -800.0), (-1200.0, 300.0), (-2200.0, 900.
 # PyBullet renders at a third of real time: it walks the first half of the route, at half its size
 ROUTES = {"mujoco": ROUTE, "pybullet": [(-3000.0 + (x + 3000.0) / 2, -1500.0 + (y + 1500.0) / 2) for x, y in ROUTE[:4]]}
 POSITION_LIMIT, ANGLE_LIMIT = 200.0, math.radians(10.0)  # what "the pose stays right" means throughout
-MAX_OFF_S = 2.0  # s the pose may be outside those limits or marked lost at a time (see the route test)
-WIDE_POSITION_LIMIT, WIDE_ANGLE_LIMIT = 400.0, math.radians(35.0)  # and never beyond these while valid
 
 
 def believed(robot: Robot) -> dict[str, float | bool]:
@@ -74,9 +72,6 @@ def localizing_robot(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator
 def test_the_pose_stays_right_along_a_route_and_after_a_kidnapping(localizing_robot: tuple[Robot, str]) -> None:
     robot, engine = localizing_robot
     wait_until_valid(robot, 10.0)
-    worst = (0.0, 0.0)
-    off_since: float | None = None
-    excursions: list[tuple[float, int, float, bool]] = []  # (s, mm, degrees, valid) outside the issue's limits
     for target in ROUTES[engine]:
         truth = robot.status()
         c, s = math.cos(truth["heading"]), math.sin(truth["heading"])
@@ -85,25 +80,11 @@ def test_the_pose_stays_right_along_a_route_and_after_a_kidnapping(localizing_ro
         start = truth["time"]
         while True:
             distance, angle, pose, truth = pose_error(robot)
-            # Known weakness (issue 17 is not resolved for it): in about one run in three, the heading
-            # lags the truth by 10 to 30 degrees for a moment during the sharp turn towards (-1200, 300),
-            # or the pose is marked lost there. Such a moment may last MAX_OFF_S and stay within the
-            # wider limits; everywhere else the issue's 200 mm and 10 degrees hold.
-            if pose["valid"] and distance < POSITION_LIMIT and angle < ANGLE_LIMIT:
-                off_since = None
-            else:
-                off_since = truth["time"] if off_since is None else off_since
-                assert truth["time"] - off_since < MAX_OFF_S, (target, pose, truth)
-                assert not pose["valid"] or (distance < WIDE_POSITION_LIMIT and angle < WIDE_ANGLE_LIMIT), (target, pose, truth)
-                excursions.append((truth["time"], round(distance), round(math.degrees(angle), 1), pose["valid"]))
-            if pose["valid"]:
-                worst = (max(worst[0], distance), max(worst[1], angle))
+            assert pose["valid"] and distance < POSITION_LIMIT and angle < ANGLE_LIMIT, (target, pose, truth)
             if math.hypot(truth["x"] - target[0], truth["y"] - target[1]) < 150.0:
                 break
             assert truth["time"] < start + 25.0, f"did not reach {target}: {truth}"
             robot.run_for(0.25)
-    assert worst[0] < WIDE_POSITION_LIMIT
-    assert len(excursions) * 0.25 < 2.0, excursions  # at most about 2 s in all, of a route of about 50 s
 
     # carried elsewhere in its own half, turned round: lost, then right again within 15 s
     robot.ask("motion:stand")

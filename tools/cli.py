@@ -225,8 +225,9 @@ def prepare(args: argparse.Namespace, extra: Sequence[str]) -> tuple[Platform, d
     overrides = [f"runtime.{context}_hz={hz}" for context, hz in (platform.rates() or {}).items()]
     config = load_config(config_dirs(args), platform.config_layers(), args.robot, [*overrides, *args.overrides])
     config = edit_modules(config, args.add_module, args.remove_module)
+    platform.configure(config)
     plans = plan_program(config, platform, strict=args.strict)
-    return platform, vars(options), plans, config
+    return platform, platform.options, plans, config
 
 
 # ----------------------------------------------------------------------------------------- run

@@ -53,6 +53,14 @@ class FieldModel:
     def own_half(self, rng: np.random.Generator, count: int) -> np.ndarray:
         return self.uniform(rng, count, (-field.LENGTH / 2, 0.0))
 
+    def penalty_return(self, rng: np.random.Generator, count: int) -> np.ndarray:
+        """Where a referee puts a robot back after a penalty: on a touchline of its own half, facing the
+        field (the rules name the spot; this covers the whole own half's touchlines, either side)."""
+        side = rng.choice([-1.0, 1.0], count)
+        return np.column_stack([rng.uniform(-field.LENGTH / 2 + 500.0, -500.0, count),
+                                side * field.WIDTH / 2 + rng.normal(0.0, 100.0, count),
+                                -side * math.pi / 2 + rng.normal(0.0, 0.15, count)])
+
     def poses_from_percepts(self, rng: np.random.Generator, count: int, lines: LinePercept, posts: GoalPostPercept) -> np.ndarray:
         """``count`` poses that explain one of this frame's percepts (sensor resetting):
 

@@ -11,6 +11,7 @@ from tafel.core import Module, bounded, provides, requires, uses
 from tafel.debug import drawing, plot, request
 from tafel.modules.modeling.field_model import FIELD_MODEL, OWN_HALF, mirror
 from tafel.representations import field
+from tafel.representations.game import GameState
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import RobotPose
 from tafel.representations.motion_control import FallState, Odometry
@@ -20,7 +21,7 @@ DRAW_PARTICLES = request("SelfLocator:draw_particles", "every particle and the e
 
 
 @requires(Odometry, LinePercept, GoalPostPercept, FrameInfo)
-@uses(FallState)
+@uses(FallState, GameState)
 @provides(RobotPose)
 class SelfLocator(Module):
     """Monte Carlo localization.
@@ -39,6 +40,8 @@ class SelfLocator(Module):
       or slipped), part of the particles are made anew from what is seen (sensor resetting): around
       a seen post at its measured distance, on the centre circle's position, or on a field line.
       ``RobotPose.lost`` says so.
+    - When a penalty ends, the referee has carried the robot to a touchline of its own half: the
+      particles start anew there, facing the field.
     """
 
     @dataclass
@@ -96,10 +99,16 @@ class SelfLocator(Module):
         self.estimate: np.ndarray | None = None  # the last published pose, moved by odometry since
         self.concentrated_since: float | None = None  # s since when the particles agree on one pose
         self.evidence: set[str] = set()  # what was seen since: one line alone fits many places
+        self.was_penalized = False
 
     def execute(self) -> None:
         if len(self.particles) != self.parameters.particles:
             self.particles = FIELD_MODEL.own_half(self.rng, self.parameters.particles)
+        penalized = self.game_state.penalized
+        if self.was_penalized and not penalized:
+            self.particles = FIELD_MODEL.penalty_return(self.rng, self.parameters.particles)
+            self.trusted = self.estimate = self.concentrated_since = None
+        self.was_penalized = penalized
         self.predict()
         upright = self.fall_state.upright
         if upright and self.was_upright:  # percepts of a lying robot come through a wrong camera matrix
@@ -206,10 +215,11 @@ class SelfLocator(Module):
     # ---------------------------------------------------------------------------------- estimate
     def publish(self) -> None:
         p, pose = self.parameters, self.robot_pose
-        # around this frame's best particle, or, with nothing seen, around the last estimate moved on
-        centre = self.best if self.best is not None else self.estimate if self.estimate is not None else self.particles.mean(axis=0)
-        near = (np.hypot(self.particles[:, 0] - centre[0], self.particles[:, 1] - centre[1]) < 600.0) & (
-            np.abs(np.remainder(self.particles[:, 2] - centre[2] + math.pi, math.tau) - math.pi) < 0.6)
+        # around the last estimate moved on, or around this frame's best particle if more particles are
+        # there: one frame's best can be a lone particle when little was seen, but after a kidnap the new
+        # place gathers the particles
+        centres = [c for c in (self.estimate, self.best) if c is not None] or [self.particles.mean(axis=0)]
+        near = max((self.near(c) for c in centres), key=np.count_nonzero)
         cluster = self.particles[near] if near.sum() >= 3 else self.particles
         pose.x, pose.y = float(cluster[:, 0].mean()), float(cluster[:, 1].mean())
         pose.rotation = float(math.atan2(np.sin(cluster[:, 2]).mean(), np.cos(cluster[:, 2]).mean()))
@@ -236,6 +246,11 @@ class SelfLocator(Module):
                 canvas.line(x, y, x + 120 * math.cos(heading), y + 120 * math.sin(heading), color="gray")
             canvas.robot_pose(pose.x, pose.y, pose.rotation, color="blue" if pose.valid else "red", width=2)
 
+
+    def near(self, centre: np.ndarray) -> np.ndarray:
+        """Which particles are within 600 mm and 0.6 rad of ``centre``."""
+        return (np.hypot(self.particles[:, 0] - centre[0], self.particles[:, 1] - centre[1]) < 600.0) & (
+            np.abs(np.remainder(self.particles[:, 2] - centre[2] + math.pi, math.tau) - math.pi) < 0.6)
 
     def evidence_seen(self, rotation: float) -> set[str]:
         """What this frame saw that pins a pose down: the circle, a post, lines along or across the field."""

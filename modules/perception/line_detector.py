@@ -40,6 +40,20 @@ def white_runs(white: np.ndarray, step: int) -> tuple[np.ndarray, np.ndarray, np
     return start_columns * step, start_rows, end_rows - 1
 
 
+def green_on_both_sides(green: np.ndarray, line: np.ndarray, first: np.ndarray, last: np.ndarray, reach: int) -> np.ndarray:
+    """Whether each run (down column ``line`` of ``green``, rows ``first`` to ``last``) has green within
+    ``reach`` pixels above and below it. Lines lie on the field; a white run with no green on one
+    side is the field's edge (the carpet's end, a wall), a robot or a goal."""
+    rows = green.shape[0]
+    above = np.zeros(len(line), bool)
+    below = np.zeros(len(line), bool)
+    for offset in range(1, reach + 1):
+        up, down = first - offset, last + offset
+        above |= (up >= 0) & green[np.clip(up, 0, rows - 1), line]
+        below |= (down < rows) & green[np.clip(down, 0, rows - 1), line]
+    return above & below
+
+
 def longest_arc(angles: np.ndarray, max_gap: float) -> float:
     """The longest span (rad) of ``angles`` (rad) on the circle without a gap wider than ``max_gap``."""
     if len(angles) < 2:
@@ -59,7 +73,7 @@ def longest_arc(angles: np.ndarray, max_gap: float) -> float:
 @provides(LinePercept)
 class LineDetector(Module):
     """Scan lines find thin white runs on the field; their middles, put on the ground through the
-    camera matrix, are line points. A run is kept if its extent on the ground fits a 50 mm line seen at
+    camera matrix, are line points. A run is kept if green borders it on both sides and its extent on the ground fits a 50 mm line seen at
     a slant, which rules out robots and the ball; the own feet, goal posts and ball candidates are
     masked out before. Then, on the ground: the centre circle (points on a
     circle of the known radius, found by RANSAC), then straight segments, greedily, by RANSAC too."""
@@ -73,6 +87,8 @@ class LineDetector(Module):
         max_distance: float = bounded(500.0, 10000.0, 5000.0)
         """mm: points farther away are too imprecise to use"""
         saturation_max: int = bounded(0, 255, 70)
+        green_reach: int = bounded(1, 20, 3)
+        """px: a line run needs green this close above and below it (left and right across)"""
         white_share: float = bounded(0.3, 1.0, 0.7)
         """a pixel is white above this share of the field's brightest non-green value"""
         inlier_distance: float = bounded(5.0, 300.0, 60.0)
@@ -123,6 +139,7 @@ class LineDetector(Module):
             cut = hsv[grid]
             white = ~green[grid] & ~ignored[grid] & (cut[..., 1] <= p.saturation_max) & (cut[..., 2] >= threshold)
             line, first, last = white_runs(white.T if transposed else white, 1)
+            bordered = green_on_both_sides(green[grid].T if transposed else green[grid], line, first, last, p.green_reach)
             line = line * p.step
             xs0, ys0, xs1, ys1 = (first, line, last, line) if transposed else (line, first, line, last)
             if len(xs0) == 0:
@@ -131,7 +148,7 @@ class LineDetector(Module):
             ends, hit1 = projection.to_ground(xs1.astype(float), ys1.astype(float))
             middles, hit = projection.to_ground((xs0 + xs1) / 2.0, (ys0 + ys1) / 2.0)
             extent = np.linalg.norm(ends - starts, axis=1)
-            keep = hit0 & hit1 & hit & (extent <= p.max_run_ground) & (np.linalg.norm(middles, axis=1) <= p.max_distance)
+            keep = bordered & hit0 & hit1 & hit & (extent <= p.max_run_ground) & (np.linalg.norm(middles, axis=1) <= p.max_distance)
             found.append(middles[keep])
             if DRAW_POINTS:
                 canvas = drawing(f"image:{camera}")

@@ -32,7 +32,9 @@ class Simulation:
             options = {"start": "0,0,0", "ball": "1000,300", **options}
             overrides = [*STANDING, *(overrides or [])]
         self.platform = load_platform(platform)(options)
-        self.plans = plan_program(load_config(DEFAULT_CONFIG, self.platform.config_layers(), overrides=overrides or []), self.platform)
+        config = load_config(DEFAULT_CONFIG, self.platform.config_layers(), overrides=overrides or [])
+        self.platform.configure(config)
+        self.plans = plan_program(config, self.platform)
         self.runtime = LockstepRuntime(self.plans, self.platform)
         self.runtime.open()
 

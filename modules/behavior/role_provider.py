@@ -1,0 +1,74 @@
+"""RoleProvider: who keeps the goal, who goes to the ball and who supports, agreed through team messages."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from tafel.core import Module, bounded, provides, requires, uses
+from tafel.representations.game import GameState, State
+from tafel.representations.modeling import BallModel
+from tafel.representations.motion_control import FallState
+from tafel.representations.team import Intention, PlayerRole, Role, TeamMates
+
+
+@requires(GameState, TeamMates)
+@uses(BallModel, FallState)
+@provides(PlayerRole)
+class RoleProvider(Module):
+    """Every robot computes the same assignment from what the team said, so exactly one field player goes
+    to the ball:
+
+    - The goalkeeper is the team's goalkeeper by the GameController (player 1 by default). A robot
+      that is its team's only player on the field plays striker instead.
+    - The striker is the field player with the shortest time to the ball (each robot's own estimate,
+      shared in its messages). The current striker counts ``stay_bonus`` s quicker, so that the role
+      does not flicker between two robots at about the same distance. A robot that does not know where
+      the ball is has no time; if nobody knows, the last striker stays, or the lowest player number.
+    - The next quickest is the supporter; the others defend.
+
+    Teammates heard within ``mate_timeout`` s that are neither penalized nor fallen take part.
+    """
+
+    @dataclass
+    class Parameters:
+        walk_speed: float = bounded(50.0, 1000.0, 200.0)
+        """mm/s the walk makes on average, for the time to the ball"""
+        turn_speed: float = bounded(0.1, 5.0, 0.8)
+        """rad/s"""
+        stay_bonus: float = bounded(0.0, 20.0, 2.0)
+        """s the current striker counts quicker"""
+        mate_timeout: float = bounded(0.5, 30.0, 4.0)
+        """s after a teammate's last message that it still takes part"""
+
+    def execute(self) -> None:
+        game, out = self.game_state, self.player_role
+        out.time_to_ball = self.time_to_ball()
+        if game.penalized or game.state in (State.initial, State.finished):
+            out.role, out.intention = Role.none, Intention.none
+            return
+        team = game.own_team()
+        keeper = team.goalkeeper if team is not None and team.goalkeeper else 1
+        mates = [m.message for m in self.team_mates.fresh(self.parameters.mate_timeout) if not (m.message.penalized or m.message.fallen)]
+        if game.player_number == keeper and mates:
+            out.role, out.intention = Role.goalkeeper, Intention.keep_goal
+            return
+        me = (game.player_number, out.time_to_ball, out.role is Role.striker)
+        field_players = [me, *((m.player, m.time_to_ball, m.role is Role.striker) for m in mates if m.player != keeper)]
+        order = sorted(field_players, key=lambda player: self.rank(*player))
+        place = [player for player, _, _ in order].index(game.player_number)
+        out.role = Role.striker if place == 0 else Role.supporter if place == 1 else Role.defender
+        out.intention = (Intention.play_ball if self.ball_model.valid else Intention.search_ball) if place == 0 else Intention.take_position
+
+    def rank(self, player: int, time_to_ball: float, striker: bool) -> tuple[float, int, int]:
+        """Sort key: time to the ball (unknown last), the striker's bonus, then the last striker, then the number."""
+        seconds = time_to_ball - (self.parameters.stay_bonus if striker else 0.0) if time_to_ball >= 0 else math.inf
+        return seconds, 0 if striker else 1, player
+
+    def time_to_ball(self) -> float:
+        """s this robot needs to reach the ball: walk and turn, plus the time to get up; -1 if no ball."""
+        ball, p = self.ball_model, self.parameters
+        if not ball.valid:
+            return -1.0
+        seconds = math.hypot(ball.x, ball.y) / p.walk_speed + abs(math.atan2(ball.y, ball.x)) / p.turn_speed
+        return seconds + (5.0 if not self.fall_state.upright else 0.0)

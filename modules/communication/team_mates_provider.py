@@ -1,0 +1,47 @@
+"""TeamMatesProvider: what each teammate said last, from the team messages received."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from tafel.core import Module, bounded, provides, requires
+from tafel.representations.game import GameState
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.team import IncomingTeamMessages, TeamMate, TeamMates, TeamMessageError, unpack_message
+
+
+@requires(IncomingTeamMessages, GameState, FrameInfo)
+@provides(TeamMates)
+class TeamMatesProvider(Module):
+    """Unpacks every message on the team port. Messages that are not ours (broken, another format,
+    another team) are ignored and counted in ``TeamMates.malformed``; this robot's own broadcasts come
+    back too and are left out. A teammate not heard for ``forget_after`` s is dropped."""
+
+    @dataclass
+    class Parameters:
+        forget_after: float = bounded(1.0, 600.0, 10.0)
+        """s after a teammate's last message"""
+
+    def __init__(self) -> None:
+        self.heard: dict[int, tuple[int, TeamMate]] = {}  # player -> (received ns, what it said)
+
+    def execute(self) -> None:
+        mates, game, now_ns = self.team_mates, self.game_state, self.frame_info.time_ns
+        for datagram in self.incoming_team_messages.datagrams:
+            try:
+                message = unpack_message(datagram.data)
+            except TeamMessageError:
+                mates.malformed += 1
+                continue
+            if message.team != game.team_number:
+                mates.malformed += 1
+                continue
+            if message.player == game.player_number:
+                continue
+            mates.received += 1
+            self.heard[message.player] = (datagram.received_ns, TeamMate(message=message))
+        for player, (received_ns, mate) in list(self.heard.items()):
+            mate.age = max(0.0, (now_ns - received_ns) * 1e-9)
+            if mate.age > self.parameters.forget_after:
+                del self.heard[player]
+        mates.mates = [mate for _, (_, mate) in sorted(self.heard.items())]

@@ -1,0 +1,85 @@
+"""TeamMessageSender: tells the team where this robot is, where the ball is and what it is doing,
+paced so that the team's message budget lasts the game."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from tafel.core import Module, bounded, provides, requires, uses
+from tafel.representations.game import SEND_SLACK_S, GamePhase, GameState, Penalty, State
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.modeling import BallModel, RobotPose
+from tafel.representations.motion_control import FallState
+from tafel.representations.team import OutgoingTeamMessage, PlayerRole, TeamMessage, pack_message
+
+HALF_S = 600.0  # s of one half in the SPL
+
+
+def send_interval(budget: int, players: int, remaining_s: float, reserve: int, min_interval: float) -> float:
+    """s between one robot's messages so that ``players`` robots sending alike spend at most
+    ``budget - reserve`` messages in ``remaining_s``: each robot gets its share, spread evenly; inf
+    when nothing may be sent."""
+    usable = budget - reserve
+    if usable <= 0:
+        return math.inf
+    return max(min_interval, max(1, players) * max(remaining_s, 0.0) / usable)
+
+
+def remaining_game_s(game: GameState) -> float:
+    """s of playing time left in the game: this half, and the second half while in the first."""
+    rest = max(0.0, float(game.secs_remaining))
+    return rest + HALF_S if game.first_half and game.game_phase is GamePhase.normal else rest
+
+
+@requires(GameState, PlayerRole, FrameInfo)
+@uses(RobotPose, BallModel, FallState)
+@provides(OutgoingTeamMessage)
+class TeamMessageSender(Module):
+    """Sends while PLAYING. With a GameController, the interval is this robot's share of the team's
+    ``messageBudget`` over the playing time left (``send_interval``): the players on the field (not
+    substitutes) share it, and ``reserve`` messages are kept back for the end. Without one (manual
+    mode) it sends every ``interval_without_game_controller`` s."""
+
+    @dataclass
+    class Parameters:
+        reserve: int = bounded(0, 1000, 20)
+        """messages of the budget never spent"""
+        min_interval: float = bounded(0.1, 60.0, 1.0)
+        """s: never more often than this"""
+        interval_without_game_controller: float = bounded(0.1, 60.0, 2.0)
+
+    def __init__(self) -> None:
+        self.last_sent_s = -math.inf
+        self.ball_seen_s: float | None = None
+
+    def execute(self) -> None:
+        game, out, now = self.game_state, self.outgoing_team_message, self.frame_info.time_s
+        p, ball = self.parameters, self.ball_model
+        if ball.valid:
+            self.ball_seen_s = now - ball.time_since_seen
+        out.data = b""
+        if game.state is not State.playing:
+            return
+        team = game.own_team()
+        if game.heard and team is not None:
+            players = sum(1 for robot in team.players[: max(1, game.players_per_team)] if robot.penalty is not Penalty.substitute)
+            interval = send_interval(team.message_budget, players, remaining_game_s(game), p.reserve, p.min_interval)
+        else:
+            interval = p.interval_without_game_controller
+        if now - self.last_sent_s < interval - SEND_SLACK_S:
+            return
+        self.last_sent_s = now
+        out.data = pack_message(self.message(game, now))
+        out.sent += 1
+
+    def message(self, game: GameState, now: float) -> TeamMessage:
+        pose, ball, role = self.robot_pose, self.ball_model, self.player_role
+        ball_x, ball_y = ball.field_position(pose)
+        c, s = math.cos(pose.rotation), math.sin(pose.rotation)
+        return TeamMessage(team=game.team_number, player=game.player_number, sent_ms=int(now * 1000), pose_valid=pose.valid,
+                           fallen=not self.fall_state.upright, penalized=game.penalized, x=pose.x, y=pose.y, rotation=pose.rotation,
+                           ball_seen=ball.valid, ball_x=ball_x, ball_y=ball_y, ball_vx=c * ball.vx - s * ball.vy,
+                           ball_vy=s * ball.vx + c * ball.vy,
+                           ball_age=-1.0 if self.ball_seen_s is None else now - self.ball_seen_s,
+                           role=role.role, intention=role.intention, time_to_ball=role.time_to_ball)
