@@ -30,6 +30,107 @@ GL_BACKEND = choose_gl_backend()
 import mujoco  # noqa: E402 - MUJOCO_GL must be set before mujoco is imported
 
 
+class MujocoRobot:
+    """One robot of a MuJoCo model, found by its names' prefix (``robot_model.robot_prefix``): its joints,
+    servos, sensors, torso and cameras. The one-robot platform has one; a match's world has several."""
+
+    def __init__(self, model: Any, prefix: str = "") -> None:
+        self.model, self.prefix = model, prefix
+        joints = [model.joint(prefix + name).id for name in JOINT_NAMES]
+        self.joint_qpos = np.array([model.jnt_qposadr[j] for j in joints])
+        self.joint_dof = np.array([model.jnt_dofadr[j] for j in joints])
+        self.actuator = np.array([model.actuator(prefix + name).id for name in JOINT_NAMES])
+        self.stall_torque, self.no_load_speed = np.array([joint_motor(name) for name in JOINT_NAMES]).T
+        self.sensor = {name: model.sensor(prefix + name).adr[0] for name in ("accelerometer", "gyroscope")}
+        self.fsr = [model.sensor(prefix + name).adr[0] for side in "LR" for name, _ in fsr_sites(side)]
+        self.torso = model.body(prefix + "torso").id
+        self.root_qpos = model.jnt_qposadr[model.joint(prefix + "root").id]
+        self.root_qvel = model.jnt_dofadr[model.joint(prefix + "root").id]
+        self.set_gains(np.zeros(len(JOINT_NAMES)))
+
+    def camera(self, name: str) -> str:
+        """The MuJoCo name of the ``top`` or ``bottom`` camera."""
+        return f"{self.prefix}{name}_camera"
+
+    def joint_angles(self, data: Any) -> np.ndarray:
+        return data.qpos[self.joint_qpos].copy()
+
+    def joint_torques(self, data: Any) -> np.ndarray:
+        return data.actuator_force[self.actuator].copy()
+
+    def imu(self, data: Any) -> tuple[np.ndarray, np.ndarray]:
+        acc, gyro = self.sensor["accelerometer"], self.sensor["gyroscope"]
+        return data.sensordata[acc : acc + 3].copy(), data.sensordata[gyro : gyro + 3].copy()
+
+    def foot_forces(self, data: Any) -> np.ndarray:
+        return data.sensordata[self.fsr].copy()
+
+    def torso_pose(self, data: Any) -> tuple[np.ndarray, np.ndarray]:
+        return data.xpos[self.torso].copy(), data.xmat[self.torso].reshape(3, 3).copy()
+
+    def drive(self, data: Any, targets: np.ndarray, stiffness: np.ndarray) -> None:
+        if not np.array_equal(stiffness, self._gains_for):
+            self.set_gains(stiffness)
+        data.ctrl[self.actuator] = targets
+
+    def set_gains(self, stiffness: np.ndarray) -> None:
+        """Stiffness 0..1 per joint -> servo gains (0: the joint is limp)."""
+        self._gains_for = stiffness.copy()
+        kp = stiffness * SERVO_GAIN
+        self.model.actuator_gainprm[self.actuator, 0] = kp
+        self.model.actuator_biasprm[self.actuator, 1] = -kp
+        self.model.actuator_biasprm[self.actuator, 2] = -kp * SERVO_DAMPING_RATIO
+
+    def limit_torques(self, data: Any) -> None:
+        """The motors' torque falls with their speed: set this step's limits (call before every step)."""
+        low, high = torque_range(data.qvel[self.joint_dof], self.stall_torque, self.no_load_speed)
+        self.model.actuator_forcerange[self.actuator, 0] = low
+        self.model.actuator_forcerange[self.actuator, 1] = high
+
+    def place(self, data: Any, position_m: np.ndarray, quaternion_wxyz: np.ndarray) -> None:
+        """Put the torso at ``position_m`` turned by ``quaternion_wxyz``, at rest (call mj_forward after)."""
+        q, v = self.root_qpos, self.root_qvel
+        data.qpos[q : q + 3] = position_m
+        data.qpos[q + 3 : q + 7] = quaternion_wxyz
+        data.qvel[v : v + 6] = 0.0
+
+
+class MujocoBall:
+    """The ball of a MuJoCo model (its free joint and body are named ``ball``)."""
+
+    def __init__(self, model: Any) -> None:
+        self.model = model
+        self.qpos = model.jnt_qposadr[model.joint("ball").id]
+        self.qvel = model.jnt_dofadr[model.joint("ball").id]
+        self.body = model.body("ball").id
+
+    def position(self, data: Any) -> tuple[float, float]:
+        """On the field (mm)."""
+        x, y = data.qpos[self.qpos : self.qpos + 2] * 1000.0
+        return float(x), float(y)
+
+    def velocity(self, data: Any) -> tuple[float, float]:
+        """Over the ground (mm/s)."""
+        vx, vy = data.qvel[self.qvel : self.qvel + 2] * 1000.0
+        return float(vx), float(vy)
+
+    def place(self, data: Any, x_mm: float, y_mm: float) -> None:
+        """Lay it still at (x, y) on the ground."""
+        data.qpos[self.qpos : self.qpos + 7] = [x_mm / 1000.0, y_mm / 1000.0, 0.05, 1.0, 0.0, 0.0, 0.0]
+        data.qvel[self.qvel : self.qvel + 6] = 0.0
+        mujoco.mj_forward(self.model, data)
+
+
+def close_renderers(renderers: dict[str, Any]) -> None:
+    """Close MuJoCo renderers; closing must never raise (it also runs after errors)."""
+    for renderer in renderers.values():
+        try:
+            renderer.close()
+        except Exception:  # noqa: BLE001 - the GL stack raises several kinds
+            pass
+    renderers.clear()
+
+
 class MujocoPlatform(SimulatedRobotPlatform):
     name = "mujoco"
     engine = "MuJoCo"
@@ -46,20 +147,8 @@ class MujocoPlatform(SimulatedRobotPlatform):
         xml = mjcf(offscreen=(max(self.width, 640), max(self.height, 480)), timestep=TIMESTEP, ball_color=self.ball_color)
         self.model = mujoco.MjModel.from_xml_string(xml, mjcf_assets(self.ball_color))
         self.data = mujoco.MjData(self.model)
-        model = self.model
-        self.joint_qpos = np.array([model.jnt_qposadr[model.joint(name).id] for name in JOINT_NAMES])
-        self.actuator = np.array([model.actuator(name).id for name in JOINT_NAMES])
-        self.joint_dof = np.array([model.jnt_dofadr[model.joint(name).id] for name in JOINT_NAMES])
-        self.stall_torque, self.no_load_speed = np.array([joint_motor(name) for name in JOINT_NAMES]).T
-        self.sensor = {name: model.sensor(name).adr[0] for name in ("accelerometer", "gyroscope")}
-        self.fsr = [model.sensor(name).adr[0] for side in "LR" for name, _ in fsr_sites(side)]
-        self.torso = model.body("torso").id
-        self.ball_qpos = model.jnt_qposadr[model.joint("ball").id]
-        self.ball_body = model.body("ball").id
-        self.ball_qvel = model.jnt_dofadr[model.joint("ball").id]
-        self.root_qpos = model.jnt_qposadr[model.joint("root").id]
-        self.root_qvel = model.jnt_dofadr[model.joint("root").id]
-        self.set_gains(self.stiffness)
+        self.robot = MujocoRobot(self.model)
+        self.ball = MujocoBall(self.model)
         self.move_ball(*self.initial_ball)
         if self.cameras and "cognition" in contexts:
             self._open_renderers()
@@ -90,12 +179,7 @@ class MujocoPlatform(SimulatedRobotPlatform):
 
     def stop(self) -> None:
         super().stop()
-        for renderer in self.renderers.values():
-            try:
-                renderer.close()
-            except Exception:  # noqa: BLE001 - closing must never raise
-                pass
-        self.renderers = {}
+        close_renderers(self.renderers)
         if self.viewer is not None:
             try:
                 self.viewer.close()
@@ -106,37 +190,36 @@ class MujocoPlatform(SimulatedRobotPlatform):
     # ---------------------------------------------------------------------------------- engine
 
     def joint_angles(self) -> np.ndarray:
-        return self.data.qpos[self.joint_qpos].copy()
+        return self.robot.joint_angles(self.data)
 
     def joint_torques(self) -> np.ndarray:
-        return self.data.actuator_force[self.actuator].copy()
+        return self.robot.joint_torques(self.data)
 
     def imu(self) -> tuple[np.ndarray, np.ndarray]:
-        acc, gyro = self.sensor["accelerometer"], self.sensor["gyroscope"]
-        return self.data.sensordata[acc : acc + 3].copy(), self.data.sensordata[gyro : gyro + 3].copy()
+        return self.robot.imu(self.data)
 
     def foot_forces(self) -> np.ndarray:
-        return self.data.sensordata[self.fsr].copy()
+        return self.robot.foot_forces(self.data)
 
     def render(self, camera: str) -> np.ndarray:
         renderer = self.renderers[camera]
-        renderer.update_scene(self.data, camera=f"{camera}_camera")
+        renderer.update_scene(self.data, camera=self.robot.camera(camera))
         return renderer.render().copy()
 
     def pose_joints(self, angles: np.ndarray) -> None:
-        self.data.qpos[self.joint_qpos] = angles
-        self.data.qvel[self.joint_dof] = 0.0
+        self.data.qpos[self.robot.joint_qpos] = angles
+        self.data.qvel[self.robot.joint_dof] = 0.0
         mujoco.mj_forward(self.model, self.data)
 
     def ball_mask(self, camera: str) -> np.ndarray:
         renderer = self.renderers[camera]
         renderer.enable_segmentation_rendering()
         try:
-            renderer.update_scene(self.data, camera=f"{camera}_camera")
+            renderer.update_scene(self.data, camera=self.robot.camera(camera))
             segments = renderer.render()
         finally:
             renderer.disable_segmentation_rendering()
-        ball_geoms = [g for g in range(self.model.ngeom) if self.model.geom_bodyid[g] == self.ball_body]
+        ball_geoms = [g for g in range(self.model.ngeom) if self.model.geom_bodyid[g] == self.ball.body]
         return (segments[:, :, 1] == mujoco.mjtObj.mjOBJ_GEOM) & np.isin(segments[:, :, 0], ball_geoms)
 
     def world_state(self) -> np.ndarray:
@@ -155,47 +238,28 @@ class MujocoPlatform(SimulatedRobotPlatform):
         return images
 
     def drive(self, targets: np.ndarray, stiffness: np.ndarray) -> None:
-        if not np.array_equal(stiffness, self._gains_for):
-            self.set_gains(stiffness)
-        self.data.ctrl[self.actuator] = targets
-
-    def set_gains(self, stiffness: np.ndarray) -> None:
-        """Stiffness 0..1 per joint -> servo gains (0: the joint is limp)."""
-        self._gains_for = stiffness.copy()
-        kp = stiffness * SERVO_GAIN
-        self.model.actuator_gainprm[self.actuator, 0] = kp
-        self.model.actuator_biasprm[self.actuator, 1] = -kp
-        self.model.actuator_biasprm[self.actuator, 2] = -kp * SERVO_DAMPING_RATIO
+        self.robot.drive(self.data, targets, stiffness)
 
     def torso_pose(self) -> tuple[np.ndarray, np.ndarray]:
-        return self.data.xpos[self.torso].copy(), self.data.xmat[self.torso].reshape(3, 3).copy()
+        return self.robot.torso_pose(self.data)
 
     def ball_position(self) -> tuple[float, float]:
-        x, y = self.data.qpos[self.ball_qpos : self.ball_qpos + 2] * 1000.0
-        return float(x), float(y)
+        return self.ball.position(self.data)
 
     def move_ball(self, x_mm: float, y_mm: float) -> None:
-        q, v = self.ball_qpos, self.ball_qvel
-        self.data.qpos[q : q + 7] = [x_mm / 1000.0, y_mm / 1000.0, 0.05, 1.0, 0.0, 0.0, 0.0]
-        self.data.qvel[v : v + 6] = 0.0
-        mujoco.mj_forward(self.model, self.data)
+        self.ball.place(self.data, x_mm, y_mm)
 
     def place_robot(self, position_m: np.ndarray, quaternion_wxyz: np.ndarray) -> None:
-        q, v = self.root_qpos, self.root_qvel
-        self.data.qpos[q : q + 3] = position_m
-        self.data.qpos[q + 3 : q + 7] = quaternion_wxyz
-        self.data.qvel[v : v + 6] = 0.0
+        self.robot.place(self.data, position_m, quaternion_wxyz)
         mujoco.mj_forward(self.model, self.data)
 
     def apply_push(self, force_n: np.ndarray) -> None:
-        self.data.xfrc_applied[self.torso, :3] = force_n
+        self.data.xfrc_applied[self.robot.torso, :3] = force_n
 
     def step_physics(self, steps: int) -> None:
         for _ in range(steps):
-            low, high = torque_range(self.data.qvel[self.joint_dof], self.stall_torque, self.no_load_speed)
-            self.model.actuator_forcerange[self.actuator, 0] = low
-            self.model.actuator_forcerange[self.actuator, 1] = high
+            self.robot.limit_torques(self.data)
             mujoco.mj_step(self.model, self.data)
-        self.data.xfrc_applied[self.torso, :3] = 0.0  # a push lasts the steps it was applied for
+        self.data.xfrc_applied[self.robot.torso, :3] = 0.0  # a push lasts the steps it was applied for
         if self.viewer is not None and self.viewer.is_running():
             self.viewer.sync()

@@ -22,6 +22,7 @@ from typing import Any
 from tafel.core.config import ConfigError
 from tafel.core.manager import Blackboard
 from tafel.representations.game import GAME_CONTROLLER_PORT, RETURN_PORT, Datagram, GameControllerPackets, GameControllerReturn
+from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.team import MAX_MESSAGE_BYTES, TEAM_PORT_BASE, IncomingTeamMessages, OutgoingTeamMessage
 
 log = logging.getLogger("tafel.network")
@@ -93,6 +94,7 @@ class GameNetwork:
         self.settings = settings
         self.game_controller: socket.socket | None = None
         self.team: socket.socket | None = None
+        self.collected: tuple[list[Datagram], list[Datagram]] | None = None  # with collect(): what receive() hands on
         self.last_return = -MIN_RETURN_INTERVAL_S
         self.returns_sent = self.returns_refused = self.messages_sent = self.messages_refused = self.send_errors = 0
 
@@ -112,11 +114,23 @@ class GameNetwork:
                 sock.close()
         self.game_controller = self.team = None
 
+    def collect(self, time_ns: int) -> None:
+        """Take what has arrived now, for the next ``receive``: a platform in lockstep with others calls it
+        when a tick begins, so that a frame hears what was sent during the last tick, however the
+        processes are scheduled meanwhile."""
+        game_controller, team = self.collected or ([], [])
+        self.collected = (game_controller + self.drain(self.game_controller, time_ns), team + self.drain(self.team, time_ns))
+
     def receive(self, blackboard: Blackboard, time_ns: int) -> None:
-        """Everything that arrived since the last frame, into the input representations."""
-        blackboard.set(GameControllerPackets(datagrams=self.drain(self.game_controller, time_ns), team_number=self.settings.team_number,
+        """Everything that arrived since the last frame (or was collected), into the input representations."""
+        if self.collected is not None:
+            game_controller, team = self.collected
+            self.collected = ([], [])
+        else:
+            game_controller, team = self.drain(self.game_controller, time_ns), self.drain(self.team, time_ns)
+        blackboard.set(GameControllerPackets(datagrams=game_controller, team_number=self.settings.team_number,
                                              player_number=self.settings.player_number))
-        blackboard.set(IncomingTeamMessages(datagrams=self.drain(self.team, time_ns)))
+        blackboard.set(IncomingTeamMessages(datagrams=team))
 
     @staticmethod
     def drain(sock: socket.socket | None, time_ns: int) -> list[Datagram]:
@@ -137,7 +151,8 @@ class GameNetwork:
         (at most 128 bytes); anything beyond the limits is refused and counted, never sent."""
         answer = blackboard[GameControllerReturn] if GameControllerReturn in blackboard else None
         if answer is not None and answer.data and answer.host and self.game_controller is not None:
-            now = time.monotonic()
+            # the platform's time: the wall clock on a robot, simulated time in a simulation at any speed
+            now = blackboard[FrameInfo].time_ns * 1e-9 if FrameInfo in blackboard else time.monotonic()
             if now - self.last_return < MIN_RETURN_INTERVAL_S * 0.98:
                 self.returns_refused += 1
             elif self.transmit(self.game_controller, answer.data, (answer.host, self.settings.return_port)):

@@ -9,6 +9,7 @@ shapes, IMU and foot pressure sites, both cameras, position servos) on an SPL fi
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from xml.sax.saxutils import quoteattr
 
@@ -204,11 +205,11 @@ def _body_xml(link: str, children: dict[str, list], indent: str) -> list[str]:
     return lines
 
 
-def _field_xml(ball_color: str) -> list[str]:
+def _field_xml(ball_color: str, robot_bits: int = ROBOT_GROUP) -> list[str]:
     lines = []
     for part in field_parts(ball_color=ball_color):
         rgba = _vec(part.rgba)
-        groups = f'contype="{WORLD_GROUP}" conaffinity="{WORLD_GROUP | ROBOT_GROUP}"' if part.collides else 'contype="0" conaffinity="0"'
+        groups = f'contype="{WORLD_GROUP}" conaffinity="{WORLD_GROUP | robot_bits}"' if part.collides else 'contype="0" conaffinity="0"'
         if part.kind == "plane":
             lines.append(f'<geom name="{part.name}" type="plane" size="{_vec(part.size)}" pos="{_vec(part.position)}" rgba="{rgba}" '
                          f'{groups} friction="1.0 0.02 0.002"/>')
@@ -259,15 +260,34 @@ def mjcf_assets(ball_color: str = "spl") -> dict[str, bytes]:
 BALL_FRICTION = "0.6 0.01 0.002"
 
 
-def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002, ball_color: str = "spl") -> str:
-    """MuJoCo XML of the robot on the field with the ball (``ball_color`` spl or orange; see ``mjcf_assets``)."""
+def robot_prefix(index: int, robots: int) -> str:
+    """The names of robot ``index``'s bodies, joints, sites, cameras, actuators and sensors start with this:
+    nothing when it is alone (``torso``, ``top_camera``), ``r3_`` for the fourth of several."""
+    return "" if robots == 1 else f"r{index}_"
+
+
+def robot_collision_bits(index: int, robots: int) -> tuple[int, int]:
+    """(contype, conaffinity) of robot ``index``'s geoms: it touches the world and the other robots,
+    never itself (its links overlap at the joints)."""
+    if robots == 1:
+        return ROBOT_GROUP, WORLD_GROUP
+    own = ROBOT_GROUP << (index + 1)
+    every = sum(ROBOT_GROUP << (k + 1) for k in range(robots))
+    return own, WORLD_GROUP | (every & ~own)
+
+
+_NAMED = re.compile(r'\b(name|joint|site|joint1|joint2)="([^"]+)"')
+
+
+def _robot_xml(index: int, robots: int, position: tuple[float, float]) -> tuple[list[str], list[str], list[str], list[str]]:
+    """Robot ``index``'s body, actuators, equalities and sensors, its names prefixed (``robot_prefix``)."""
     children: dict[str, list] = {}
     for joint in JOINTS:
         children.setdefault(joint.parent, []).append(joint)
     torso_shapes = shapes("torso")
     center, diagonal = inertia(TORSO_MASS, torso_shapes)
-    robot = [
-        f'<body name="torso" pos="0 0 {STANDING_HEIGHT + 0.002:.7g}">',
+    body = [
+        f'<body name="torso" pos="{position[0]:.6g} {position[1]:.6g} {STANDING_HEIGHT + 0.002:.7g}">',
         '  <freejoint name="root"/>',
         f'  <inertial pos="{_vec(center)}" mass="{TORSO_MASS}" diaginertia="{_vec(diagonal)}"/>',
         "  " + _geom_xml(torso_shapes[0], "torso_geom0"),
@@ -282,6 +302,24 @@ def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002, ba
     equalities = [f'<joint joint1="{follower}" joint2="{leader}" polycoef="0 1 0 0 0"/>' for follower, leader in COUPLED_JOINTS.items()]
     sensors = ['<accelerometer name="accelerometer" site="accelerometer"/>', '<gyro name="gyroscope" site="gyroscope"/>']
     sensors += [f'<touch name="{name}" site="{name}"/>' for side in "LR" for name, _ in fsr_sites(side)]
+    prefix = robot_prefix(index, robots)
+    contype, conaffinity = robot_collision_bits(index, robots)
+    groups = f'contype="{ROBOT_GROUP}" conaffinity="{WORLD_GROUP}"'
+
+    def named(lines: list[str]) -> list[str]:
+        return [_NAMED.sub(lambda m: f'{m.group(1)}="{prefix}{m.group(2)}"', line).replace(groups, f'contype="{contype}" conaffinity="{conaffinity}"')
+                for line in lines]
+
+    return named(body), named(actuators), named(equalities), named(sensors)
+
+
+def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002, ball_color: str = "spl",
+         robots: list[tuple[float, float]] | None = None) -> str:
+    """MuJoCo XML of the field with the ball (``ball_color`` spl or orange; see ``mjcf_assets``) and one
+    robot at the centre spot, or several at the given places (m) named by ``robot_prefix``."""
+    places = robots or [(0.0, 0.0)]
+    parts = [_robot_xml(index, len(places), place) for index, place in enumerate(places)]
+    every_robot = sum(robot_collision_bits(k, len(places))[0] for k in range(len(places)))
     width, height = offscreen
     return "\n".join([
         '<mujoco model="tafel-nao-spl">',
@@ -292,12 +330,12 @@ def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002, ba
         "  <asset>", *("    " + a for a in _ball_assets(ball_color)), "  </asset>",
         "  <worldbody>",
         '    <light name="sun" pos="0 0 6" dir="0 0 -1" directional="true" diffuse="0.6 0.6 0.6" castshadow="false"/>',
-        *("    " + line for line in _field_xml(ball_color)),
-        *("    " + line for line in robot),
+        *("    " + line for line in _field_xml(ball_color, every_robot)),
+        *("    " + line for body, _, _, _ in parts for line in body),
         "  </worldbody>",
-        "  <equality>", *("    " + e for e in equalities), "  </equality>",
-        "  <actuator>", *("    " + a for a in actuators), "  </actuator>",
-        "  <sensor>", *("    " + s for s in sensors), "  </sensor>",
+        "  <equality>", *("    " + e for _, _, equalities, _ in parts for e in equalities), "  </equality>",
+        "  <actuator>", *("    " + a for _, actuators, _, _ in parts for a in actuators), "  </actuator>",
+        "  <sensor>", *("    " + s for _, _, _, sensors in parts for s in sensors), "  </sensor>",
         "</mujoco>",
     ]) + "\n"
 

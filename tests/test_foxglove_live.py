@@ -72,16 +72,16 @@ def test_parameters_and_debug_requests_are_set_through_the_protocol(clients: tup
     client, debug = clients
     try:
         listed = client.get_parameters()
-        assert listed["/Striker/search_turn"] == pytest.approx(0.6)
+        assert listed["/SoccerBehavior/search_turn"] == pytest.approx(0.6)
         assert listed["/debug_request/BallDetector:draw_candidates"] is False
-        answer = client.set_parameters({"/Striker/search_turn": 0.45, "/debug_request/BallDetector:draw_candidates": True})
-        assert answer == {"/Striker/search_turn": pytest.approx(0.45), "/debug_request/BallDetector:draw_candidates": True}
-        assert "search_turn = 0.45" in debug.ask("parameter:get -module Striker")  # the program changed
+        answer = client.set_parameters({"/SoccerBehavior/search_turn": 0.45, "/debug_request/BallDetector:draw_candidates": True})
+        assert answer == {"/SoccerBehavior/search_turn": pytest.approx(0.45), "/debug_request/BallDetector:draw_candidates": True}
+        assert "search_turn = 0.45" in debug.ask("parameter:get -module SoccerBehavior")  # the program changed
         assert re.search(r"^\s+on +BallDetector:draw_candidates", debug.ask("debug_request:list"), re.MULTILINE)
-        refused = client.set_parameters({"/Striker/search_turn": 1e9})  # out of its declared range: unchanged
-        assert refused["/Striker/search_turn"] == pytest.approx(0.45)
+        refused = client.set_parameters({"/SoccerBehavior/search_turn": 1e9})  # out of its declared range: unchanged
+        assert refused["/SoccerBehavior/search_turn"] == pytest.approx(0.45)
     finally:
-        client.set_parameters({"/Striker/search_turn": 0.6, "/debug_request/BallDetector:draw_candidates": False})
+        client.set_parameters({"/SoccerBehavior/search_turn": 0.6, "/debug_request/BallDetector:draw_candidates": False})
 
 
 @pytest.mark.slow
@@ -137,8 +137,8 @@ def test_contexts_in_their_own_processes_are_served_too() -> None:
         client = FoxgloveClient(foxglove_url(program))
         client.subscribe("/joints", "/scene", "/rates")
         client.wait_for(lambda: len(client.received.get("/joints", [])) >= 50 and client.received.get("/scene"), 20)
-        assert client.set_parameters({"/Striker/search_turn": 0.5}) == {"/Striker/search_turn": pytest.approx(0.5)}
-        assert "search_turn = 0.5" in program.ask("parameter:get -module Striker")
+        assert client.set_parameters({"/SoccerBehavior/search_turn": 0.5}) == {"/SoccerBehavior/search_turn": pytest.approx(0.5)}
+        assert "search_turn = 0.5" in program.ask("parameter:get -module SoccerBehavior")
         client.close()
     finally:
         program.stop()

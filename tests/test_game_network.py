@@ -14,17 +14,13 @@ import pytest
 from tafel.core.manager import Blackboard
 from tafel.platforms.network import GameNetwork, NetworkSettings
 from tafel.representations.game import GameControllerReturn
+from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.team import OutgoingTeamMessage
+from tafel.tools.match import free_udp_port
 from tests.test_debug_server import Program
 from tests.test_game_controller import RETURN, packet
 
 pytestmark = pytest.mark.slow
-
-
-def free_udp_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
 
 
 def fields(text: str) -> dict[str, str]:
@@ -141,8 +137,9 @@ def test_the_network_refuses_what_the_rules_forbid_and_survives_a_taken_port(por
     network.open()
     try:
         board = Blackboard()
-        board.ensure(GameControllerReturn)
-        board.ensure(OutgoingTeamMessage)
+        for rep in (GameControllerReturn, OutgoingTeamMessage, FrameInfo):
+            board.ensure(rep)
+        board.set(FrameInfo(time_ns=10**9))  # the platform's clock decides the rate, not the wall clock
         board.set(GameControllerReturn(data=b"x" * 32, host="127.0.0.1"))
         board.set(OutgoingTeamMessage(data=b"y" * 129))
         for _ in range(10):  # ten frames within a few milliseconds: one answer
@@ -150,7 +147,7 @@ def test_the_network_refuses_what_the_rules_forbid_and_survives_a_taken_port(por
         assert returns(receiver) == [b"x" * 32]
         assert (network.returns_sent, network.returns_refused, network.messages_refused, network.messages_sent) == (1, 9, 10, 0)
         board.set(GameControllerReturn(data=b"z", host="no.such.host.invalid"))
-        time.sleep(0.55)
+        board.set(FrameInfo(time_ns=int(1.5e9)))
         network.send(board)  # cannot be resolved: counted, not raised
         assert network.send_errors == 1
     finally:

@@ -166,6 +166,9 @@ def build_parser() -> argparse.ArgumentParser:
     from tafel.tools.console import add_console_command
 
     add_console_command(commands)
+    from tafel.tools.match import add_match_command
+
+    add_match_command(commands)
 
     platforms = commands.add_parser("platforms", help="list the platforms and what they provide and consume")
     platforms.add_argument("--verbose", "-v", action="store_true", help="also list each platform's options")
@@ -768,8 +771,14 @@ def command_view(args: argparse.Namespace, extra: Sequence[str]) -> int:
     return command_run(run_args, run_extra)
 
 
+def command_match(args: argparse.Namespace, extra: Sequence[str]) -> int:
+    from tafel.tools.match import command_match as run_match
+
+    return run_match(args, extra)
+
+
 COMMANDS = {"run": command_run, "view": command_view, "platforms": command_platforms, "modules": command_modules, "log": command_log,
-            "console": command_console}
+            "console": command_console, "match": command_match}
 
 
 class PipeSafeStream:

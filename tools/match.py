@@ -1,0 +1,270 @@
+"""``tafel match``: a simulated game. One MuJoCo world, one program per robot in a process of its own,
+the simulated GameController (``referee.py``), all in lockstep.
+
+Every motion tick (10 ms) the world waits for the joint commands of every robot, steps the physics,
+lets the referee judge and send its packet, and hands every robot its sensors of the new tick. The
+robots' programs are ``tafel run --platform match``: each has its own contexts, blackboards, debug
+server (its port is listed at the start) and, with ``--record-dir``, its own log. A match with a
+seed is deterministic; it uses every core, as the programs run in parallel between the world's ticks.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import re
+import secrets
+import socket
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from multiprocessing.connection import Connection, Listener, wait
+from pathlib import Path
+from typing import Any, TextIO
+
+from tafel.platforms.match_robot import AUTHKEY_ENV
+from tafel.platforms.match_world import TICK_NS, MatchWorld, Side
+from tafel.tools.referee import Player, Referee
+
+MAX_PLAYERS_PER_TEAM = 5
+TEAM_NUMBERS = (1, 2)
+#: where robots enter (team frame, mm and rad): on the own half's touchline, facing the field
+ENTRY = [(-3600.0 + 700.0 * k, -3000.0, math.pi / 2) for k in range(MAX_PLAYERS_PER_TEAM)]
+CONNECT_TIMEOUT_S = 120.0  # robots import, plan and open their cameras before they join
+STOP_TIMEOUT_S = 20.0
+
+
+def parse_teams(text: str) -> tuple[int, int]:
+    """``--teams``: NvM with N, M from 0 to 5 and at least one robot, e.g. 2v2 or 1v0."""
+    match = re.fullmatch(r"(\d)v(\d)", text.strip().lower())
+    if not match or int(match[1]) > MAX_PLAYERS_PER_TEAM or int(match[2]) > MAX_PLAYERS_PER_TEAM or match[1] == match[2] == "0":
+        raise argparse.ArgumentTypeError(f"--teams takes NvM with 0 to {MAX_PLAYERS_PER_TEAM} robots a team (1v1, 2v2, 5v5, 1v0), got {text!r}")
+    return int(match[1]), int(match[2])
+
+
+def add_match_command(commands: Any) -> None:
+    from tafel.core.platform import seed_number
+    from tafel.tools.cli import parse_speed, positive
+
+    match = commands.add_parser("match", help="play a simulated game: several robots in MuJoCo, refereed by a simulated GameController")
+    match.add_argument("--teams", type=parse_teams, default=(1, 1), metavar="NvM", help="robots per team, 1v1 to 5v5 or e.g. 1v0 (default 1v1)")
+    match.add_argument("--seconds", type=positive(float), default=600.0, help="playing time of the whole game, both halves (default 600)")
+    match.add_argument("--cameras", choices=["on", "off"], default="on",
+                       help="on: every robot renders its cameras and sees through them; off: perception from ground truth")
+    match.add_argument("--speed", type=parse_speed, default=1.0, help="pace against the wall clock: a factor, or 'max'")
+    match.add_argument("--seed", type=seed_number, default=0, help="seed of every robot's sensor noise")
+    match.add_argument("--record-dir", type=Path, metavar="DIR", help="every robot records its log here (TEAM_PLAYER.mcap)")
+    match.add_argument("--record-reps", metavar="A,B", help="record only these representations (as tafel run --record-reps)")
+    match.add_argument("--result", type=Path, metavar="FILE.json", help="also write the result's JSON object here")
+    match.add_argument("--resolution", default="320x240", help="camera image size WIDTHxHEIGHT")
+    match.add_argument("--ready-seconds", type=positive(float), default=30.0, help="longest READY (default 30)")
+    match.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                       help="a configuration override for every robot's program (repeatable)")
+    for team in (1, 2):
+        match.add_argument(f"--team{team}-set", dest=f"team{team}_overrides", action="append", default=[], metavar="KEY=VALUE",
+                           help=f"a configuration override for team {team}'s robots only, after --set (repeatable)")
+
+
+@dataclass
+class Robot:
+    """One robot's program: its process, where its debug server is, what it printed."""
+
+    player: Player
+    process: subprocess.Popen
+    debug: str = ""
+    log: Path | None = None
+    connection: Connection | None = None
+    errors: list[str] | None = None
+    cameras: bool = False
+    """whether it renders its cameras (then it gets the world's positions every tick)"""
+
+
+def free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def drain(stream: TextIO, sink: list[str] | None) -> None:
+    for line in stream:
+        if sink is not None:
+            sink.append(line)
+            del sink[:-40]  # the last lines are what an error needs
+
+
+class Match:
+    def __init__(self, args: argparse.Namespace) -> None:
+        self.args = args
+        sizes = args.teams
+        self.players = [Player(team=t, number=n + 1, index=0, side=Side(1.0 if t == 0 else -1.0)) for t in (0, 1) for n in range(sizes[t])]
+        for index, player in enumerate(self.players):
+            player.index = index
+        places = [player.side.to_world(*ENTRY[player.number - 1]) for player in self.players]
+        width, height = (int(v) for v in str(args.resolution).lower().split("x"))
+        self.world = MatchWorld([(x, y) for x, y, _ in places], offscreen=(max(width, 640), max(height, 480)))
+        for player, (x, y, heading) in zip(self.players, places):
+            self.world.move_robot(player.index, x, y, heading)
+        self.ports = {"game_controller_port": free_udp_port(), "return_port": free_udp_port()}
+        self.team_ports = (free_udp_port(), free_udp_port())
+        self.referee = Referee(self.world, TEAM_NUMBERS, self.players, args.seconds / 2, self.ports["game_controller_port"],
+                               self.ports["return_port"], self.team_ports, ready_s=args.ready_seconds)
+        self.key = secrets.token_hex(16)
+        self.listener = Listener(("127.0.0.1", 0), authkey=self.key.encode())
+        self.robots: list[Robot] = []
+
+    # ---------------------------------------------------------------------------------- robots
+    def start_robots(self) -> None:
+        host, port = self.listener.address
+        for player in self.players:
+            team = TEAM_NUMBERS[player.team]
+            settings = {**self.ports, "team_port": self.team_ports[player.team], "team_number": team, "player_number": player.number,
+                        "broadcast": "127.255.255.255"}
+            command = [sys.executable, "-m", "tafel.tools.cli", "run", "--platform", "match", "--world", f"{host}:{port}",
+                       "--index", str(player.index), f"--side={'+x' if player.side.sign > 0 else '-x'}", "--cameras", self.args.cameras,
+                       "--resolution", self.args.resolution, "--seed", str(self.args.seed + player.index), "--speed", "max",
+                       "--debug-port", "0", "--no-web", "--status-interval", "3600",
+                       "--set", "parameters.GameStateProvider.start_state=initial",
+                       *(a for key, value in settings.items() for a in ("--set", f"game.{key}={json.dumps(value)}")),
+                       *(a for override in self.args.overrides for a in ("--set", override)),
+                       *(a for override in getattr(self.args, f"team{player.team + 1}_overrides") for a in ("--set", override))]
+            log = None
+            if self.args.record_dir is not None:
+                self.args.record_dir.mkdir(parents=True, exist_ok=True)
+                log = self.args.record_dir / f"team{team}_player{player.number}.mcap"
+                command += ["--record", str(log), *(["--record-reps", self.args.record_reps] if self.args.record_reps else [])]
+            process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                       env={**os.environ, AUTHKEY_ENV: self.key})
+            self.robots.append(Robot(player, process, log=log, errors=[]))
+        for robot in self.robots:
+            first = robot.process.stdout.readline()
+            found = re.match(r"debug server listening on (\S+)", first)
+            if not found:
+                raise RuntimeError(f"robot {self.name(robot)} did not start: {first}{robot.process.stderr.read()[-3000:]}")
+            robot.debug = found[1]
+            threading.Thread(target=drain, args=(robot.process.stdout, None), daemon=True).start()
+            threading.Thread(target=drain, args=(robot.process.stderr, robot.errors), daemon=True).start()
+
+    def connect(self) -> None:
+        """Accept every robot's connection and give it the world's model (to render its cameras from)."""
+        by_index = {robot.player.index: robot for robot in self.robots}
+        self.listener._listener._socket.settimeout(CONNECT_TIMEOUT_S)  # noqa: SLF001 - Listener has no timeout of its own
+        for _ in self.robots:
+            try:
+                connection = self.listener.accept()
+            except (TimeoutError, socket.timeout):
+                late = [self.name(r) for r in self.robots if r.connection is None]
+                raise RuntimeError(f"robots {', '.join(late)} did not join within {CONNECT_TIMEOUT_S:g} s") from None
+            _, index, cameras = connection.recv()
+            by_index[index].connection = connection
+            connection.send(("model", self.world.xml, self.world.ball_color, len(self.robots)))
+            by_index[index].cameras = cameras
+
+    @staticmethod
+    def name(robot: Robot) -> str:
+        return f"team {TEAM_NUMBERS[robot.player.team]} player {robot.player.number}"
+
+    # ------------------------------------------------------------------------------------- play
+    def play(self) -> str:
+        """Tick until the game is over; the reason it ended."""
+        speed = self.args.speed
+        started, time_ns, last_score = time.monotonic(), 0, self.referee.score()
+        connections = {robot.connection: robot for robot in self.robots}
+        while True:
+            waiting, commands = set(connections), {}
+            while waiting:
+                for connection in wait(list(waiting), timeout=60.0) or []:
+                    robot = connections[connection]
+                    try:
+                        kind, robot_time, targets, stiffness = connection.recv()
+                    except (EOFError, OSError):
+                        return f"the program of {self.name(robot)} ended: {''.join(robot.errors or [])[-2000:]}"
+                    commands[robot.player.index] = (robot_time, targets, stiffness)
+                    waiting.discard(connection)
+                if waiting and all(r.process.poll() is not None for r in (connections[c] for c in waiting)):
+                    return "robot programs ended"
+            for index, (_, targets, stiffness) in commands.items():
+                self.world.drive(index, targets, stiffness)
+            previous = self.world.time_ns
+            self.world.step_to(time_ns)
+            self.referee.tick(time_ns * 1e-9, (time_ns - previous) * 1e-9)
+            if self.referee.score() != last_score:
+                last_score = self.referee.score()
+                print(f"[match] t={time_ns * 1e-9:.1f}s goal: {TEAM_NUMBERS[0]}:{TEAM_NUMBERS[1]} {last_score}", flush=True)
+            if self.referee.over:
+                return "the game is over"
+            for robot in self.robots:
+                robot.connection.send(("sensors", self.world.snapshot(robot.player.index, robot.cameras)))
+            time_ns += TICK_NS
+            if speed:
+                delay = started + time_ns * 1e-9 / speed - time.monotonic()
+                if delay > 0:
+                    time.sleep(delay)
+
+    def finish(self, reason: str) -> dict[str, Any]:
+        for robot in self.robots:
+            if robot.connection is not None:
+                try:
+                    robot.connection.send(("end", "the match is over"))
+                except OSError:
+                    pass
+        deadline = time.monotonic() + STOP_TIMEOUT_S
+        for robot in self.robots:
+            try:
+                robot.process.wait(timeout=max(0.1, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                robot.process.kill()
+                robot.process.wait()
+        self.referee.close()
+        self.listener.close()
+        referee = self.referee
+        sent = sum(referee.messages)
+        return {
+            "teams": [{"team": TEAM_NUMBERS[t], "robots": self.args.teams[t], "score": referee.game.teams[t].score,
+                       "team_messages": referee.messages[t], "message_budget_left": referee.game.teams[t].message_budget} for t in (0, 1)],
+            "score": referee.score(),
+            "ended": reason,
+            "simulated_s": round(self.world.time_ns * 1e-9, 2),
+            "events": [{"time_s": round(e.time_s, 2), "event": e.what} for e in referee.events],
+            "bytes_per_team_message": round(referee.message_bytes / sent, 1) if sent else 0,
+            "robots": [{"team": TEAM_NUMBERS[r.player.team], "player": r.player.number, "debug": r.debug, "returns": r.player.returns,
+                        "exit_status": r.process.returncode, **({"log": str(r.log)} if r.log else {})} for r in self.robots],
+        }
+
+
+def command_match(args: argparse.Namespace, extra: Sequence[str]) -> int:
+    """Run a match; print its events as they come and its result as one JSON object at the end."""
+    if extra:
+        print(f"tafel match: error: unrecognized arguments: {' '.join(extra)}", file=sys.stderr)
+        return 2
+    match = Match(args)
+    started = kickoff = final_whistle = time.monotonic()
+    reason = "interrupted"
+    try:
+        match.start_robots()
+        match.connect()
+        for robot in match.robots:
+            print(f"[match] team {TEAM_NUMBERS[robot.player.team]} player {robot.player.number}: debug server {robot.debug}"
+                  + (f", log {robot.log}" if robot.log else ""), flush=True)
+        kickoff = time.monotonic()
+        reason = match.play()
+        final_whistle = time.monotonic()
+    except KeyboardInterrupt:
+        reason = "interrupted"
+    except RuntimeError as exc:
+        reason = str(exc)
+    finally:
+        result = match.finish(reason)
+    result["wall_s"] = round(time.monotonic() - started, 2)
+    result["startup_s"] = round(kickoff - started, 2)
+    result["realtime_factor"] = round(result["simulated_s"] / max(1e-9, final_whistle - kickoff), 3)  # start-up and shutdown apart
+    line = json.dumps(result)
+    if args.result is not None:
+        args.result.write_text(line + "\n")
+    print(f"[match] {reason}; score {TEAM_NUMBERS[0]}:{TEAM_NUMBERS[1]} {result['score']}", flush=True)
+    print(line, flush=True)
+    return 0 if reason == "the game is over" else 1
