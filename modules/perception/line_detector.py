@@ -87,8 +87,9 @@ class LineDetector(Module):
         max_distance: float = bounded(500.0, 10000.0, 5000.0)
         """mm: points farther away are too imprecise to use"""
         saturation_max: int = bounded(0, 255, 70)
-        green_reach: int = bounded(1, 20, 3)
-        """px: a line run needs green this close above and below it (left and right across)"""
+        green_reach: int = bounded(1, 20, 8)
+        """px: a line run needs green this close above and below it (left and right across); blurred edges, a
+        ball or a foot beside a line take a few pixels"""
         white_share: float = bounded(0.3, 1.0, 0.7)
         """a pixel is white above this share of the field's brightest non-green value"""
         inlier_distance: float = bounded(5.0, 300.0, 60.0)
