@@ -114,7 +114,7 @@ class Match:
         self.referee = Referee(self.world, TEAM_NUMBERS, self.players, args.seconds / 2, self.ports["game_controller_port"],
                                self.ports["return_port"], self.team_ports, ready_s=args.ready_seconds)
         self.key = secrets.token_hex(16)
-        self.listener = Listener(("127.0.0.1", 0), authkey=self.key.encode())
+        self.listener = Listener(("127.0.0.1", 0), backlog=2 * MAX_PLAYERS_PER_TEAM, authkey=self.key.encode())  # all join at once
         self.robots: list[Robot] = []
 
     # ---------------------------------------------------------------------------------- robots
