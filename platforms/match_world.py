@@ -104,9 +104,6 @@ class MatchWorld:
         v = self.robots[index].root_qvel
         return float(self.data.qvel[v]) * 1000.0, float(self.data.qvel[v + 1]) * 1000.0
 
-    def upright(self, index: int) -> bool:
-        return bool(self.robots[index].torso_pose(self.data)[1][2, 2] > 0.7)
-
     def ball_position(self) -> tuple[float, float]:
         return self.ball.position(self.data)
 
