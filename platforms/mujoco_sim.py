@@ -12,6 +12,7 @@ import numpy as np
 from tafel.core.platform import PlatformError
 from tafel.platforms.robot_model import SERVO_GAIN, fsr_sites, joint_motor, mjcf, mjcf_assets, torque_range
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
+from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import JOINT_NAMES
 
 SERVO_DAMPING_RATIO = 0.02  # kv = ratio * kp (s): damps the servos without making them sluggish
@@ -114,10 +115,11 @@ class MujocoBall:
         vx, vy = data.qvel[self.qvel : self.qvel + 2] * 1000.0
         return float(vx), float(vy)
 
-    def place(self, data: Any, x_mm: float, y_mm: float) -> None:
-        """Lay it still at (x, y) on the ground."""
+    def place(self, data: Any, x_mm: float, y_mm: float, velocity_mm_s: tuple[float, float] = (0.0, 0.0)) -> None:
+        """Put it at (x, y) on the ground, still or rolling (spinning as it rolls) at ``velocity_mm_s``."""
+        vx, vy = velocity_mm_s[0] / 1000.0, velocity_mm_s[1] / 1000.0
         data.qpos[self.qpos : self.qpos + 7] = [x_mm / 1000.0, y_mm / 1000.0, 0.05, 1.0, 0.0, 0.0, 0.0]
-        data.qvel[self.qvel : self.qvel + 6] = 0.0
+        data.qvel[self.qvel : self.qvel + 6] = [vx, vy, 0.0, -vy / (BALL_RADIUS / 1000.0), vx / (BALL_RADIUS / 1000.0), 0.0]
         mujoco.mj_forward(self.model, data)
 
 
@@ -149,7 +151,7 @@ class MujocoPlatform(SimulatedRobotPlatform):
         self.data = mujoco.MjData(self.model)
         self.robot = MujocoRobot(self.model)
         self.ball = MujocoBall(self.model)
-        self.move_ball(*self.initial_ball)
+        self.move_ball(*self.initial_ball, self.initial_ball_velocity)
         if self.cameras and "cognition" in contexts:
             self._open_renderers()
         if viewer:
@@ -246,8 +248,8 @@ class MujocoPlatform(SimulatedRobotPlatform):
     def ball_position(self) -> tuple[float, float]:
         return self.ball.position(self.data)
 
-    def move_ball(self, x_mm: float, y_mm: float) -> None:
-        self.ball.place(self.data, x_mm, y_mm)
+    def move_ball(self, x_mm: float, y_mm: float, velocity_mm_s: tuple[float, float] = (0.0, 0.0)) -> None:
+        self.ball.place(self.data, x_mm, y_mm, velocity_mm_s)
 
     def place_robot(self, position_m: np.ndarray, quaternion_wxyz: np.ndarray) -> None:
         self.robot.place(self.data, position_m, quaternion_wxyz)

@@ -19,6 +19,7 @@ from tafel.core.platform import PlatformError
 from tafel.platforms.field_world import FieldPart, ball_mesh, ball_texture, cylinder_mesh, field_parts
 from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, fsr_sites, joint_motor, urdf
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
+from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import JOINT_NAMES
 from tafel.representations.nao import ACCELEROMETER_POSITION, CAMERAS, COUPLED_JOINTS, SOLE_BACK, SOLE_FRONT, VERTICAL_FOV
 
@@ -152,7 +153,7 @@ class PybulletPlatform(SimulatedRobotPlatform):
             # of 0.5 lets hands and seat slide away in a get-up
             spinning = 0.02 if link in self.foot_links.values() else 0.0
             pybullet.changeDynamics(self.robot, link, lateralFriction=1.0, spinningFriction=spinning, physicsClientId=c)
-        self.move_ball(*self.initial_ball)
+        self.move_ball(*self.initial_ball, self.initial_ball_velocity)
 
     def stop(self) -> None:
         super().stop()
@@ -278,10 +279,11 @@ class PybulletPlatform(SimulatedRobotPlatform):
         position, _ = pybullet.getBasePositionAndOrientation(self.bodies["ball"], physicsClientId=self.client)
         return position[0] * 1000.0, position[1] * 1000.0
 
-    def move_ball(self, x_mm: float, y_mm: float) -> None:
+    def move_ball(self, x_mm: float, y_mm: float, velocity_mm_s: tuple[float, float] = (0.0, 0.0)) -> None:
         ball = self.bodies["ball"]
+        vx, vy = velocity_mm_s[0] * M, velocity_mm_s[1] * M
         pybullet.resetBasePositionAndOrientation(ball, [x_mm * M, y_mm * M, 0.05], [0, 0, 0, 1], physicsClientId=self.client)
-        pybullet.resetBaseVelocity(ball, [0, 0, 0], [0, 0, 0], physicsClientId=self.client)
+        pybullet.resetBaseVelocity(ball, [vx, vy, 0], [-vy / (BALL_RADIUS * M), vx / (BALL_RADIUS * M), 0], physicsClientId=self.client)
 
     def place_robot(self, position_m: np.ndarray, quaternion_wxyz: np.ndarray) -> None:
         w, x, y, z = (float(v) for v in quaternion_wxyz)

@@ -54,6 +54,31 @@ def parse_pair(text: str, what: str) -> tuple[float, float]:
     return x, y
 
 
+#: mm/s of the fastest ball a scene may start with (a strong kick rolls off at about 5 m/s)
+MAX_BALL_SPEED = 10000.0
+
+
+def parse_velocity(text: str) -> tuple[float, float]:
+    try:
+        vx, vy = (float(v) for v in str(text).split(","))
+    except ValueError:
+        raise PlatformOptionError(f"--ball-velocity takes VX,VY in mm/s, e.g. 500,0; got {text!r}") from None
+    if not (math.isfinite(vx) and math.isfinite(vy) and math.hypot(vx, vy) <= MAX_BALL_SPEED):
+        raise PlatformOptionError(f"--ball-velocity takes VX,VY in mm/s up to {MAX_BALL_SPEED:g} mm/s; got {text!r}")
+    return vx, vy
+
+
+def parse_noise(value: Any) -> float:
+    """``--sensor-noise``: a factor from 0 to 100 (None: 1, the NAO's noise)."""
+    try:
+        factor = 1.0 if value is None else float(value)
+    except (TypeError, ValueError):
+        factor = math.nan
+    if not (math.isfinite(factor) and 0.0 <= factor <= 100.0):
+        raise PlatformOptionError(f"--sensor-noise takes a factor from 0 to 100 (1: the NAO's noise, 0: none), got {value!r}")
+    return factor
+
+
 #: the default scene: the robot in its own half facing the opponent goal, the ball on the centre spot
 DEFAULT_START = "-1500,0,0"
 DEFAULT_BALL = "0,0"
@@ -122,6 +147,8 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         self.cameras = str(self.options.get("cameras", "on")).lower() not in ("off", "false", "0", "no")
         self.width, self.height = parse_resolution(self.options.get("resolution") or "320x240")
         self.initial_ball = parse_pair(self.options.get("ball") or DEFAULT_BALL, "--ball")
+        self.initial_ball_velocity = parse_velocity(self.options.get("ball_velocity") or "0,0")
+        self.sensor_noise = parse_noise(self.options.get("sensor_noise"))
         self.ball_color = str(self.options.get("ball_color") or "spl").lower()
         if self.ball_color not in BALL_COLORS:
             raise PlatformOptionError(f"--ball-color takes {' or '.join(BALL_COLORS)}, got {self.options.get('ball_color')!r}")
@@ -150,6 +177,10 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         parser.add_argument("--cameras", choices=["on", "off"], default="on", help=f"{name}: render the cameras")
         parser.add_argument("--resolution", default="320x240", help=f"{name}: camera image size WIDTHxHEIGHT")
         parser.add_argument("--ball", default=DEFAULT_BALL, help=f"{name}: ball start X,Y in mm on the field (default: the centre spot)")
+        parser.add_argument("--ball-velocity", default="0,0", metavar="VX,VY",
+                            help=f"{name}: the ball rolls off at VX,VY mm/s on the field (default: it lies still)")
+        parser.add_argument("--sensor-noise", type=float, default=1.0, metavar="FACTOR",
+                            help=f"{name}: scale of the joint, IMU and foot sensors' noise (default 1: the NAO's; 0: none)")
         parser.add_argument("--ball-color", choices=BALL_COLORS, default="spl",
                             help=f"{name}: spl (white with black patches, the default) or orange (the ball before 2016)")
         parser.add_argument("--start", default=DEFAULT_START, metavar="X,Y,ROT",
@@ -214,7 +245,8 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         """The ball on the field (mm)."""
         raise NotImplementedError
 
-    def move_ball(self, x_mm: float, y_mm: float) -> None:
+    def move_ball(self, x_mm: float, y_mm: float, velocity_mm_s: tuple[float, float] = (0.0, 0.0)) -> None:
+        """Put the ball at (x, y) on the ground, lying still or rolling off at ``velocity_mm_s``."""
         raise NotImplementedError
 
     def place_robot(self, position_m: np.ndarray, quaternion_wxyz: np.ndarray) -> None:
@@ -282,15 +314,15 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         blackboard.set(FrameInfo(frame_number=frame_number, time_ns=time_ns))
         if context == "motion":
             joints = blackboard[JointSensorData]
-            joints.position = self.joint_angles() + self.rng.normal(0.0, 0.0005, len(JOINT_NAMES))
+            joints.position = self.joint_angles() + self.rng.normal(0.0, 0.0005 * self.sensor_noise, len(JOINT_NAMES))
             self.guard.hold(joints.position)
             joints.stiffness = self.stiffness.copy()
             joints.current = np.abs(self.joint_torques()) / 10.0  # a rough N m -> A of the NAO's motors
             joints.temperature = np.full(len(JOINT_NAMES), 30.0)
             accelerometer, gyroscope = self.imu()
             inertial = blackboard[InertialSensorData]
-            inertial.accelerometer = accelerometer + self.rng.normal(0.0, 0.02, 3)
-            inertial.gyroscope = gyroscope + self.rng.normal(0.0, 0.002, 3)
+            inertial.accelerometer = accelerometer + self.rng.normal(0.0, 0.02 * self.sensor_noise, 3)
+            inertial.gyroscope = gyroscope + self.rng.normal(0.0, 0.002 * self.sensor_noise, 3)
             inertial.angles = np.array(self.torso_angles())
             blackboard[FsrData].pressure = self.foot_forces() / GRAVITY
             touch = np.zeros(len(TouchSensorData().pressed))
@@ -371,8 +403,9 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
     def commands(self) -> Mapping[str, tuple[str, Any]]:
         def ball(args: Mapping[str, Any]) -> str:
             x, y = number(args, "x", limit=CARPET_X), number(args, "y", limit=CARPET_Y)
-            self.move_ball(x, y)
-            return f"ball at x={x:.0f} y={y:.0f} mm"
+            velocity = number(args, "vx", limit=MAX_BALL_SPEED), number(args, "vy", limit=MAX_BALL_SPEED)
+            self.move_ball(x, y, velocity)
+            return f"ball at x={x:.0f} y={y:.0f} mm" + (f", rolling at {velocity[0]:.0f},{velocity[1]:.0f} mm/s" if any(velocity) else "")
 
         def robot(args: Mapping[str, Any]) -> str:
             x, y = number(args, "x", limit=CARPET_X), number(args, "y", limit=CARPET_Y)
@@ -410,7 +443,7 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         return {
             **self.network.commands(),
             "sim:button": ("press the chest button once (the rules' manual mode steps the game state without a GameController)", button),
-            "sim:move_ball": ("put the ball at -x X -y Y (mm, field)", ball),
+            "sim:move_ball": ("put the ball at -x X -y Y (mm, field), rolling at -vx VX -vy VY (mm/s) if given", ball),
             "sim:move_robot": ("put the robot at -x X -y Y (mm, field) -rotation R (rad) [-lying front|back]", robot),
             "sim:push": ("push the torso for 0.1 s with -x FX -y FY (N, field frame)", push),
             "sim:pause": ("stop the physics (the loops go on)", pause),

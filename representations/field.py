@@ -49,6 +49,14 @@ def goal_post_positions() -> list[tuple[float, float]]:
     return [(x, y), (x, -y), (-x, y), (-x, -y)]
 
 
+def goal_of(x_mm: float, y_mm: float) -> int:
+    """Where a ball at (x, y) is: 1 wholly over the opponent goal line between the posts (a goal for
+    the team attacking +x), -1 the same at the own goal, 0 anywhere else."""
+    if abs(x_mm) > LENGTH / 2 + BALL_RADIUS and abs(y_mm) < GOAL_INNER_WIDTH / 2:
+        return 1 if x_mm > 0 else -1
+    return 0
+
+
 def mark_segments() -> list[tuple[float, float, float, float]]:
     """Both strokes of every mark's cross as (x1, y1, x2, y2) in mm."""
     half = MARK_SIZE / 2

@@ -14,14 +14,12 @@ import re
 from collections.abc import Iterator
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from tafel.modules.behavior.striker import Striker
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType, Odometry
-from tests.support.simulation import Simulation
 from tests.test_debug_server import Program
 from tests.test_walking import Robot
 
@@ -97,39 +95,6 @@ def test_the_pose_stays_right_along_a_route_and_after_a_kidnapping(localizing_ro
         assert truth["time"] < moved_at + 15.0, f"not relocalized 15 s after the kidnapping: {pose} vs {truth}"
         robot.run_for(0.25)
     robot.ask("motion:release")
-
-
-def scores(engine: str, start: tuple[float, float, float], ball: tuple[float, float], seconds: float = 90.0) -> float | None:
-    """Simulated seconds until the ball is in the opponent goal, or None."""
-    sim = Simulation(engine, scene="default", start=",".join(f"{v:.3f}" for v in start), ball=f"{ball[0]:.0f},{ball[1]:.0f}")
-    scored: list[float] = []
-
-    def goal(s: Simulation) -> None:
-        bx, by = s.platform.ball_position()
-        if not scored and bx > 4500.0 + 50.0 and abs(by) < 750.0:
-            scored.append(s.time)
-
-    try:
-        for _ in range(int(seconds)):
-            sim.run(1.0, goal)
-            if scored:
-                return scored[0]
-        return None
-    finally:
-        sim.close()
-
-
-def random_starts(seed: int, count: int) -> list[tuple[tuple[float, float, float], tuple[float, float]]]:
-    """Robot poses anywhere in the own half and balls between it and the halfway line."""
-    rng = np.random.default_rng(seed)
-    return [((rng.uniform(-4000, -800), rng.uniform(-2500, 2500), rng.uniform(-math.pi, math.pi)),
-             (rng.uniform(-2500, 500), rng.uniform(-2000, 2000))) for _ in range(count)]
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize(("start", "ball"), random_starts(17, 5))
-def test_the_striker_scores_from_its_own_half(start: tuple[float, float, float], ball: tuple[float, float]) -> None:
-    assert scores("mujoco", start, ball) is not None
 
 
 def test_striker_aims_at_the_goal_from_anywhere(run_module) -> None:

@@ -169,6 +169,12 @@ def build_parser() -> argparse.ArgumentParser:
     from tafel.tools.match import add_match_command
 
     add_match_command(commands)
+    from tafel.tools.scenarios import add_scenario_commands
+
+    add_scenario_commands(commands)
+    from tafel.tools.replay_batch import add_replay_batch_command
+
+    add_replay_batch_command(commands)
 
     platforms = commands.add_parser("platforms", help="list the platforms and what they provide and consume")
     platforms.add_argument("--verbose", "-v", action="store_true", help="also list each platform's options")
@@ -611,23 +617,29 @@ def make_recorder(args: argparse.Namespace, plans: dict[str, ContextPlan], confi
         if args.record_reps:
             fail("--record-reps needs --record FILE.mcap (or the debug server's log:start)")
         return None
-    names = (
-        [n.strip() for n in args.record_reps.split(",") if n.strip()] if args.record_reps
-        else list(config.get("recording", {}).get("representations", []))
-    )
-    selections = select(plans, names, extra=DEBUG_REPRESENTATIONS,
-                        strict=bool(args.record_reps))
-    # the layers, so that a replay runs the program that was recorded (an orange ball's detector, say)
+    names = [n.strip() for n in args.record_reps.split(",") if n.strip()] if args.record_reps else None
+    # Without a beat to keep (lockstep at --speed max) recording waits for the writer rather than drop.
+    recorder = program_recorder(plans, config, platform, names, blocking=args.speed is None and not args.concurrent)
+    if args.record is not None:
+        recorder.start(args.record)
+    return recorder
+
+
+def program_recorder(plans: dict[str, ContextPlan], config: dict[str, Any], platform: Platform, names: list[str] | None = None,
+                     blocking: bool = True) -> Recorder:
+    """A recorder of ``names`` (default: the configuration's ``[recording]`` list and all sensor data), not started.
+
+    The log's metadata names the platform and its configuration layers, so that a replay runs the
+    program that was recorded (an orange ball's detector, say).
+    """
+    wanted = names if names is not None else list(config.get("recording", {}).get("representations", []))
+    selections = select(plans, wanted, extra=DEBUG_REPRESENTATIONS, strict=names is not None)
     metadata = {"platform": type(platform).name, "config_layers": ",".join(platform.config_layers()),
                 **{f"{c}_hz": str(p.rate_hz) for c, p in plans.items()}}
     recorder = Recorder(selections, metadata)
-    foxglove = config.get("foxglove", {})
-    if foxglove.get("channels_in_recordings", True):
+    if config.get("foxglove", {}).get("channels_in_recordings", True):
         recorder.translate_factory = foxglove_recording(recorder, jpeg_quality(config))
-    # Without a beat to keep (lockstep at --speed max) recording waits for the writer rather than drop.
-    recorder.blocking = args.speed is None and not args.concurrent
-    if args.record is not None:
-        recorder.start(args.record)
+    recorder.blocking = blocking
     return recorder
 
 
@@ -777,8 +789,24 @@ def command_match(args: argparse.Namespace, extra: Sequence[str]) -> int:
     return run_match(args, extra)
 
 
+def command_scenarios(args: argparse.Namespace, extra: Sequence[str]) -> int:
+    from tafel.tools.scenarios import command_scenarios as run_scenarios
+
+    if extra:
+        fail(f"unrecognized arguments: {' '.join(extra)}")
+    return run_scenarios(args)
+
+
+def command_replay_batch(args: argparse.Namespace, extra: Sequence[str]) -> int:
+    from tafel.tools.replay_batch import command_replay_batch as replay
+
+    if extra:
+        fail(f"unrecognized arguments: {' '.join(extra)}")
+    return replay(args)
+
+
 COMMANDS = {"run": command_run, "view": command_view, "platforms": command_platforms, "modules": command_modules, "log": command_log,
-            "console": command_console, "match": command_match}
+            "console": command_console, "match": command_match, "scenarios": command_scenarios, "replay-batch": command_replay_batch}
 
 
 class PipeSafeStream:

@@ -140,7 +140,7 @@ class Referee:
         self.note_touch()
         bx, by = self.world.ball_position()
         over_goal_line = abs(bx) > HALF_LINE_X + pitch.BALL_RADIUS
-        if over_goal_line and abs(by) < pitch.GOAL_INNER_WIDTH / 2:
+        if pitch.goal_of(bx, by):
             scorer = 0 if bx > 0 else 1  # the first team attacks +x
             self.game.teams[scorer].score += 1
             self.events.append(Event(now, f"GOAL {self.team_numbers[scorer]}"))
