@@ -2,7 +2,7 @@
 
 Everything is generated from ``representations.field`` as engine-neutral ``FieldPart`` pieces (m), so
 MuJoCo and PyBullet show the same world. The SPL ball (white with black pentagons, used since 2016) is
-a textured sphere: ``ball_texture`` paints the pattern of a truncated icosahedron procedurally and
+a textured sphere: ``paint_ball_texture`` paints the pattern of a truncated icosahedron procedurally and
 ``ball_mesh`` gives the UV sphere both engines wrap it on. Nothing is downloaded.
 """
 
@@ -11,7 +11,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cache
+from pathlib import Path
 
+import cv2
 import numpy as np
 
 from tafel.representations import field
@@ -141,9 +143,13 @@ def _sphere_direction(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     return np.stack([np.cos(latitude) * np.cos(longitude), np.cos(latitude) * np.sin(longitude), np.sin(latitude)], axis=-1)
 
 
-@cache
-def ball_texture(width: int = 512, height: int = 256) -> np.ndarray:
-    """The SPL ball's pattern as an equirectangular RGB image (row 0 at v = 0), 4x4 supersampled."""
+def paint_ball_texture(width: int = 512, height: int = 256) -> np.ndarray:
+    """The SPL ball's pattern as an equirectangular RGB image (row 0 at v = 0), 4x4 supersampled.
+
+    Painting takes about a second, so the simulators load the copy shipped in ``assets/`` instead
+    (``ball_texture``); a test checks that the copy is what this paints. After a change here, write
+    it anew with ``python -m tafel.platforms.field_world``.
+    """
     samples = 4
     u = (np.arange(width * samples) + 0.5) / (width * samples)
     v = (np.arange(height * samples) + 0.5) / (height * samples)
@@ -151,6 +157,23 @@ def ball_texture(width: int = 512, height: int = 256) -> np.ndarray:
     share = black.reshape(height, samples, width, samples).mean(axis=(1, 3))
     grey = np.round(BALL_WHITE + (BALL_BLACK - BALL_WHITE) * share).astype(np.uint8)
     return np.repeat(grey[:, :, None], 3, axis=2)
+
+
+#: the painted ball texture as shipped (a PNG, RGB)
+BALL_TEXTURE_PATH = Path(__file__).resolve().parent / "assets" / "ball_texture.png"
+
+
+@cache
+def ball_texture_png() -> bytes:
+    """The shipped ball texture's PNG file, as the engines load it."""
+    return BALL_TEXTURE_PATH.read_bytes()
+
+
+@cache
+def ball_texture() -> np.ndarray:
+    """The shipped ball texture as an RGB image (what ``paint_ball_texture`` paints)."""
+    image = cv2.imdecode(np.frombuffer(ball_texture_png(), np.uint8), cv2.IMREAD_COLOR)
+    return cv2.cvtColor(image, cv2.COLOR_BGR2RGB)
 
 
 @cache
@@ -191,3 +214,11 @@ def cylinder_mesh(radius: float, half_height: float, segments: int = 24) -> tupl
         base, bottom, top = 2 * segments, 4 * segments, 4 * segments + 1
         triangles += [(bottom, base + j, base + i), (top, base + segments + i, base + segments + j)]
     return vertices, normals, np.array(triangles, dtype=np.int64)
+
+
+if __name__ == "__main__":  # python -m tafel.platforms.field_world: paint the ball texture anew into assets/
+    BALL_TEXTURE_PATH.parent.mkdir(exist_ok=True)
+    ok, png = cv2.imencode(".png", cv2.cvtColor(paint_ball_texture(), cv2.COLOR_RGB2BGR), [cv2.IMWRITE_PNG_COMPRESSION, 9])
+    assert ok, "OpenCV could not encode the ball texture"
+    BALL_TEXTURE_PATH.write_bytes(png.tobytes())
+    print(f"wrote {BALL_TEXTURE_PATH} ({len(png)} bytes)")

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tafel.platforms.mujoco_sim import MujocoBall, MujocoRobot, mujoco
+from tafel.platforms.mujoco_sim import MujocoBall, MujocoRobot, TorqueLimits, mujoco
 from tafel.platforms.robot_model import STANDING_HEIGHT, mjcf, mjcf_assets, robot_prefix
 from tafel.platforms.simulated import TIMESTEP
 from tafel.representations.motion import JOINT_COUNT
@@ -66,6 +66,7 @@ class MatchWorld:
         self.model = mujoco.MjModel.from_xml_string(self.xml, mjcf_assets(ball_color))
         self.data = mujoco.MjData(self.model)
         self.robots = [MujocoRobot(self.model, robot_prefix(k, len(places))) for k in range(len(places))]
+        self.torque_limits = TorqueLimits(self.model, self.robots)
         self.ball = MujocoBall(self.model)
         self.time_ns = 0
         mujoco.mj_forward(self.model, self.data)
@@ -80,8 +81,7 @@ class MatchWorld:
     def step_to(self, time_ns: int) -> None:
         steps = int(round((time_ns - self.time_ns) * 1e-9 / TIMESTEP))
         for _ in range(max(0, steps)):
-            for robot in self.robots:
-                robot.limit_torques(self.data)
+            self.torque_limits.apply(self.data)
             mujoco.mj_step(self.model, self.data)
         self.time_ns = time_ns
 

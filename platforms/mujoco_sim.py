@@ -82,11 +82,6 @@ class MujocoRobot:
         self.model.actuator_biasprm[self.actuator, 1] = -kp
         self.model.actuator_biasprm[self.actuator, 2] = -kp * SERVO_DAMPING_RATIO
 
-    def limit_torques(self, data: Any) -> None:
-        """The motors' torque falls with their speed: set this step's limits (call before every step)."""
-        low, high = torque_range(data.qvel[self.joint_dof], self.stall_torque, self.no_load_speed)
-        self.model.actuator_forcerange[self.actuator, 0] = low
-        self.model.actuator_forcerange[self.actuator, 1] = high
 
     def place(self, data: Any, position_m: np.ndarray, quaternion_wxyz: np.ndarray) -> None:
         """Put the torso at ``position_m`` turned by ``quaternion_wxyz``, at rest (call mj_forward after)."""
@@ -94,6 +89,22 @@ class MujocoRobot:
         data.qpos[q : q + 3] = position_m
         data.qpos[q + 3 : q + 7] = quaternion_wxyz
         data.qvel[v : v + 6] = 0.0
+
+
+class TorqueLimits:
+    """The motors' torque falls with their speed: every robot's limits for the next physics step, set
+    at once (call before every step; one array operation for all robots costs what one robot's does)."""
+
+    def __init__(self, model: Any, robots: list[MujocoRobot]) -> None:
+        self.model = model
+        self.dof = np.concatenate([r.joint_dof for r in robots])
+        self.actuator = np.concatenate([r.actuator for r in robots])
+        self.stall_torque = np.concatenate([r.stall_torque for r in robots])
+        self.no_load_speed = np.concatenate([r.no_load_speed for r in robots])
+
+    def apply(self, data: Any) -> None:
+        low, high = torque_range(data.qvel[self.dof], self.stall_torque, self.no_load_speed)
+        self.model.actuator_forcerange[self.actuator] = np.column_stack((low, high))
 
 
 class MujocoBall:
@@ -150,6 +161,7 @@ class MujocoPlatform(SimulatedRobotPlatform):
         self.model = mujoco.MjModel.from_xml_string(xml, mjcf_assets(self.ball_color))
         self.data = mujoco.MjData(self.model)
         self.robot = MujocoRobot(self.model)
+        self.torque_limits = TorqueLimits(self.model, [self.robot])
         self.ball = MujocoBall(self.model)
         self.move_ball(*self.initial_ball, self.initial_ball_velocity)
         if self.cameras and "cognition" in contexts:
@@ -260,7 +272,7 @@ class MujocoPlatform(SimulatedRobotPlatform):
 
     def step_physics(self, steps: int) -> None:
         for _ in range(steps):
-            self.robot.limit_torques(self.data)
+            self.torque_limits.apply(self.data)
             mujoco.mj_step(self.model, self.data)
         self.data.xfrc_applied[self.robot.torso, :3] = 0.0  # a push lasts the steps it was applied for
         if self.viewer is not None and self.viewer.is_running():

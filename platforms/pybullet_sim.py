@@ -11,12 +11,11 @@ import os
 import tempfile
 from typing import Any
 
-import cv2
 import numpy as np
 import pybullet
 
 from tafel.core.platform import PlatformError
-from tafel.platforms.field_world import FieldPart, ball_mesh, ball_texture, cylinder_mesh, field_parts
+from tafel.platforms.field_world import FieldPart, ball_mesh, ball_texture_png, cylinder_mesh, field_parts
 from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, fsr_sites, joint_motor, urdf
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.field import BALL_RADIUS
@@ -116,7 +115,7 @@ class PybulletPlatform(SimulatedRobotPlatform):
     def _ball_texture(self) -> int:
         """The SPL ball's pattern, through a temporary PNG (PyBullet loads textures only from files)."""
         with tempfile.NamedTemporaryFile(suffix=".png", delete=False) as handle:
-            handle.write(cv2.imencode(".png", cv2.cvtColor(ball_texture(), cv2.COLOR_RGB2BGR))[1].tobytes())
+            handle.write(ball_texture_png())
         try:
             return pybullet.loadTexture(handle.name, physicsClientId=self.client)
         finally:

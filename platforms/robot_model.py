@@ -13,10 +13,9 @@ import re
 from dataclasses import dataclass
 from xml.sax.saxutils import quoteattr
 
-import cv2
 import numpy as np
 
-from tafel.platforms.field_world import ball_mesh, ball_texture, field_parts
+from tafel.platforms.field_world import ball_mesh, ball_texture_png, field_parts
 from tafel.representations import field
 from tafel.representations.nao import (
     ACCELEROMETER_POSITION,
@@ -251,9 +250,7 @@ def mjcf_assets(ball_color: str = "spl") -> dict[str, bytes]:
     """The files ``mjcf`` refers to, for ``MjModel.from_xml_string(xml, assets)``: made here, never read from disk."""
     if ball_color != "spl":
         return {}
-    ok, png = cv2.imencode(".png", cv2.cvtColor(ball_texture(), cv2.COLOR_RGB2BGR))
-    assert ok, "OpenCV could not encode the ball texture"
-    return {BALL_TEXTURE_FILE: png.tobytes()}
+    return {BALL_TEXTURE_FILE: ball_texture_png()}
 
 
 #: sliding, torsional and rolling friction of the ball (MuJoCo's three coefficients)

@@ -22,7 +22,7 @@ from tafel.modules.perception.field_boundary_detector import FieldBoundaryDetect
 from tafel.modules.perception.field_color_provider import FieldColorProvider
 from tafel.modules.perception.image_geometry import ImageProjection
 from tafel.modules.perception.line_detector import longest_arc, white_runs
-from tafel.platforms.field_world import ball_is_black, ball_texture
+from tafel.platforms.field_world import ball_is_black, ball_texture, paint_ball_texture
 from tafel.representations import field
 from tafel.representations.motion import CameraMatrix
 from tafel.representations.perception import (
@@ -247,3 +247,9 @@ def test_the_spl_ball_is_white_with_black_pentagons() -> None:
     assert texture.shape == (256, 512, 3) and texture.dtype == np.uint8
     grey = cv2.cvtColor(texture, cv2.COLOR_RGB2GRAY)
     assert (grey < 60).mean() > 0.15 and (grey > 200).mean() > 0.55
+
+
+def test_the_shipped_ball_texture_is_what_the_code_paints() -> None:
+    """The simulators load platforms/assets/ball_texture.png; after a change to the painting, write it
+    anew with python -m tafel.platforms.field_world."""
+    np.testing.assert_array_equal(ball_texture(), paint_ball_texture())

@@ -320,11 +320,11 @@ def test_the_same_seeds_give_the_same_rows_with_one_worker_two_workers_and_ray(t
         pass
     for name, option in where:
         out = tmp_path / f"{name}.jsonl"
-        done = tafel("scenarios", "run", str(path), "--repeat", "3", "--seed", "11", *option, "--out", str(out), "--no-logs", cwd=tmp_path)
+        done = tafel("scenarios", "run", str(path), "--repeat", "2", "--seed", "11", *option, "--out", str(out), "--no-logs", cwd=tmp_path)
         assert done.returncode == 0, done.stdout + done.stderr
         results[name] = [json.loads(line) for line in out.read_text().splitlines()]
-    assert len(results["one"]) == 3 and len({r["seed"] for r in results["one"]}) == 3
-    assert len({r["sensor_noise"] for r in results["one"]}) == 3  # the runs really differ
+    assert len(results["one"]) == 2 and len({r["seed"] for r in results["one"]}) == 2
+    assert len({r["sensor_noise"] for r in results["one"]}) == 2  # the runs really differ
     for name in results:
         assert comparable(results[name]) == comparable(results["one"]), name
     if "ray" not in results:

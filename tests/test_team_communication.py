@@ -138,6 +138,20 @@ def test_the_interval_is_each_players_share_of_the_budget_over_the_time_left() -
     assert send_interval(budget=20, players=2, remaining_s=100.0, reserve=20, min_interval=1.0) == math.inf
 
 
+def test_a_shorter_game_spends_its_budget_over_its_own_halves() -> None:
+    """A practice game of 60-s halves, 60 s left in the first: with ``half_s`` 60 a robot of five takes its
+    share of the 1200 messages over the 120 s of play left (the 1 s floor), not over the 660 s that the
+    SPL's halves would leave."""
+    sent = {}
+    for half_s in (600.0, 60.0):
+        harness = ModuleHarness(TeamMessageSender, playing_game(1200, 5, 60, True, 2), PlayerRole(), RobotPose(), BallModel(),
+                                parameters={"half_s": half_s})
+        harness.execute(300)  # 10 s; the interval is 5 * (60 + half_s) / 1180 s, at least 1 s
+        sent[half_s] = sum(bool(m.data) for m in harness.history(OutgoingTeamMessage))
+    assert sent[600.0] == 4  # every 2.8 s: at 0, 2.8, 5.6 and 8.4 s
+    assert sent[60.0] == 10  # the 1 s floor: 0.5 s would be the share
+
+
 def test_nothing_is_sent_outside_playing_and_without_a_game_controller_at_the_fallback_rate() -> None:
     game = playing_game(1200, 5, 600, True, 2)
     game.state = State.ready

@@ -129,6 +129,8 @@ class Match:
                        "--resolution", self.args.resolution, "--seed", str(self.args.seed + player.index), "--speed", "max",
                        "--debug-port", "0", "--no-web", "--status-interval", "3600",
                        "--set", "parameters.GameStateProvider.start_state=initial",
+                       # the team message budget is paced over the game's halves, here shorter than the SPL's
+                       "--set", f"parameters.TeamMessageSender.half_s={max(1.0, self.args.seconds / 2):g}",
                        *(a for key, value in settings.items() for a in ("--set", f"game.{key}={json.dumps(value)}")),
                        *(a for override in self.args.overrides for a in ("--set", override)),
                        *(a for override in getattr(self.args, f"team{player.team + 1}_overrides") for a in ("--set", override))]

@@ -161,7 +161,7 @@ def add_replay_batch_command(commands: Any) -> None:
     batch.add_argument("--remove-module", action="append", default=[], metavar="CONTEXT:MODULE", help="leave this module out (repeatable)")
     batch.add_argument("--compare", action="store_true", help="compare every replay with its log, as tafel log compare does")
     batch.add_argument("--metric", action="append", default=[], metavar="REP.FIELD",
-                       help="report the mean of this field, recorded and replayed (repeatable), e.g. BallModel.valid")
+                       help="report the mean of a representation's field, recorded and replayed (repeatable); tafel log info lists them")
     batch.add_argument("--out", type=Path, default=Path("replay-batch.csv"), metavar="FILE.csv", help="one row per log (default: %(default)s)")
     batch.add_argument("--artifacts", type=Path, metavar="DIR", help="keep the replayed logs in this folder (on Ray: one every node shares)")
     batch.add_argument("--workers", type=int, metavar="K", help=f"logs at a time (default: all cores, here {default_workers()})")
@@ -178,7 +178,7 @@ def command_replay_batch(args: argparse.Namespace) -> int:
         return 2
     bad = [m for m in args.metric if "." not in m.strip(".")]
     if bad:
-        print(f"tafel replay-batch: --metric takes REPRESENTATION.FIELD, e.g. BallModel.valid; got {bad[0]!r}", file=sys.stderr)
+        print(f"tafel replay-batch: --metric takes REPRESENTATION.FIELD (a representation the logs hold and one of its fields); got {bad[0]!r}", file=sys.stderr)
         return 2
     try:
         logs = expand(args.logs)

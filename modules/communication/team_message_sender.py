@@ -13,8 +13,6 @@ from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import FallState
 from tafel.representations.team import OutgoingTeamMessage, PlayerRole, TeamMessage, pack_message
 
-HALF_S = 600.0  # s of one half in the SPL
-
 
 def send_interval(budget: int, players: int, remaining_s: float, reserve: int, min_interval: float) -> float:
     """s between one robot's messages so that ``players`` robots sending alike spend at most
@@ -26,10 +24,10 @@ def send_interval(budget: int, players: int, remaining_s: float, reserve: int, m
     return max(min_interval, max(1, players) * max(remaining_s, 0.0) / usable)
 
 
-def remaining_game_s(game: GameState) -> float:
-    """s of playing time left in the game: this half, and the second half while in the first."""
+def remaining_game_s(game: GameState, half_s: float) -> float:
+    """s of playing time left in the game: this half, and a second half of ``half_s`` while in the first."""
     rest = max(0.0, float(game.secs_remaining))
-    return rest + HALF_S if game.first_half and game.game_phase is GamePhase.normal else rest
+    return rest + half_s if game.first_half and game.game_phase is GamePhase.normal else rest
 
 
 @requires(GameState, PlayerRole, FrameInfo)
@@ -48,6 +46,8 @@ class TeamMessageSender(Module):
         min_interval: float = bounded(0.1, 60.0, 1.0)
         """s: never more often than this"""
         interval_without_game_controller: float = bounded(0.1, 60.0, 2.0)
+        half_s: float = bounded(1.0, 3600.0, 600.0)
+        """s of one half: the SPL's 600; practice games with shorter halves set theirs (tafel match does)"""
 
     def __init__(self) -> None:
         self.last_sent_s = -math.inf
@@ -64,7 +64,7 @@ class TeamMessageSender(Module):
         team = game.own_team()
         if game.heard and team is not None:
             players = sum(1 for robot in team.players[: max(1, game.players_per_team)] if robot.penalty is not Penalty.substitute)
-            interval = send_interval(team.message_budget, players, remaining_game_s(game), p.reserve, p.min_interval)
+            interval = send_interval(team.message_budget, players, remaining_game_s(game, p.half_s), p.reserve, p.min_interval)
         else:
             interval = p.interval_without_game_controller
         if now - self.last_sent_s < interval - SEND_SLACK_S:
