@@ -101,10 +101,11 @@ class TorqueLimits:
         self.actuator = np.concatenate([r.actuator for r in robots])
         self.stall_torque = np.concatenate([r.stall_torque for r in robots])
         self.no_load_speed = np.concatenate([r.no_load_speed for r in robots])
+        self._limits = np.empty((len(self.actuator), 2))
 
     def apply(self, data: Any) -> None:
-        low, high = torque_range(data.qvel[self.dof], self.stall_torque, self.no_load_speed)
-        self.model.actuator_forcerange[self.actuator] = np.column_stack((low, high))
+        self._limits[:, 0], self._limits[:, 1] = torque_range(data.qvel[self.dof], self.stall_torque, self.no_load_speed)
+        self.model.actuator_forcerange[self.actuator] = self._limits
 
 
 class MujocoBall:

@@ -67,7 +67,8 @@ def torque_range(velocity: np.ndarray, stall: np.ndarray, no_load_speed: np.ndar
     limits the NAO's joint speeds, so the simulated joints cannot move faster than the real ones.
     """
     share = velocity / no_load_speed
-    return -stall * np.clip(1.0 + share, 0.0, 1.0), stall * np.clip(1.0 - share, 0.0, 1.0)
+    # np.minimum and np.maximum: the same as np.clip, at a fraction of its overhead (this runs 500 times a second per robot)
+    return -stall * np.maximum(np.minimum(1.0 + share, 1.0), 0.0), stall * np.maximum(np.minimum(1.0 - share, 1.0), 0.0)
 
 JOINT_DAMPING = 0.6
 JOINT_ARMATURE = 0.01

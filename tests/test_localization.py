@@ -3,8 +3,8 @@
 - A route of eight waypoints, driven by ``motion:walk_to`` over the debug server of a ``tafel run``
   subprocess, then a kidnapping by ``sim:move_robot``; the pose is read with
   ``representation:print RobotPose`` and compared with ``sim:status`` all along.
-- The striker scores from random starts in its own half (seeded), in-process, in MuJoCo; that it
-  scores on PyBullet too is shown by ``test_walking``'s default scene, which uses the same pipeline.
+- The striker scoring from random starts in its own half is the shipped scenario
+  ``config/scenarios/striker_scores.toml``, run over five seeds by ``tests/test_scenarios.py``.
 """
 
 from __future__ import annotations

@@ -12,8 +12,6 @@ from pathlib import Path
 
 import pytest
 
-from tafel.representations.field import goal_of
-from tests.support.simulation import Simulation
 from tests.test_debug_server import Program
 
 ENGINES = ["mujoco", "pybullet"]
@@ -150,22 +148,3 @@ def test_a_push_that_topples_the_robot_is_detected_as_a_fall_and_it_gets_up(robo
     wait_until_standing(robot, 15.0)
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize(("engine", "seed"), [("mujoco", 0)])  # PyBullet (a third of real time): walk and kick above
-def test_the_striker_scores_in_the_default_scene(engine: str, seed: int) -> None:
-    """The default program and scene: the ball crosses the opponent goal line within 120 s, on both
-    engines (tests/test_scenarios.py scores from five perturbed starts more, with the shipped scenario)."""
-    sim = Simulation(engine, scene="default", seed=str(seed))
-    scored: list[float] = []
-
-    def goal(s: Simulation) -> None:
-        x, y = s.platform.ball_position()
-        if not scored and goal_of(x, y) == 1:
-            scored.append(s.time)
-
-    try:
-        while sim.time < 120 and not scored:
-            sim.run(1.0, goal)
-    finally:
-        sim.close()
-    assert scored, "no goal in 120 s"

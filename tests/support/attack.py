@@ -165,12 +165,13 @@ def status_rates(lines: list[str]) -> dict[str, list[float]]:
     return rates
 
 
-def rates_during(errors: list[str], seconds: float) -> dict[str, float]:
-    """The lowest rate of each context over the status lines printed in the next ``seconds``.
+def rates_during(errors: list[str], seconds: float, forgive: int = 0) -> dict[str, float]:
+    """The lowest rate of each context over the status lines printed in the next ``seconds``, leaving
+    out the ``forgive`` lowest (one slow second of a noisy machine is not a slowdown).
 
     The first line after the start is skipped: its interval began before.
     """
     start = len(errors)
     time.sleep(seconds)
     rates = status_rates(errors[start:])
-    return {name: min(values[1:]) if len(values) > 1 else float("nan") for name, values in rates.items()}
+    return {name: sorted(values[1:])[forgive] if len(values) > 1 + forgive else float("nan") for name, values in rates.items()}
