@@ -98,6 +98,15 @@ def test_a_bad_file_is_an_error_that_names_the_file_the_line_and_what_would_be_r
     assert message in str(error.value)
 
 
+def test_a_push_outside_the_run_or_too_strong_is_refused(tmp_path: Path) -> None:
+    event = '\n[[events]]\nat_s = {at}\npush_n = [{force}, 0.0]\n'
+    with pytest.raises(ScenarioError, match=r"scenario.toml:24: at_s is a time within the run, 0 to 5 s; got 7"):
+        load_scenario(write(tmp_path, GOOD + event.format(at=7.0, force=300.0)))
+    with pytest.raises(ScenarioError, match=r"scenario.toml:25: push_n takes \[fx, fy\] up to 500 N, got \[900.0, 0.0\]"):
+        load_scenario(write(tmp_path, GOOD + event.format(at=1.0, force=900.0)))
+    assert load_scenario(write(tmp_path, GOOD + event.format(at=1.0, force=300.0))).events[0].force_n == (300.0, 0.0)
+
+
 def test_predicates_over_representations_are_checked_against_the_representations(tmp_path: Path) -> None:
     entry = '\n[[success]]\npredicate = "representation"\nname = "{name}"\nfield = "{field}"\nequals = true\n'
     path = write(tmp_path, GOOD + entry.format(name="BallModl", field="valid"))
@@ -176,8 +185,9 @@ def test_an_always_predicate_fails_the_run_when_it_breaks_and_holds_it_otherwise
     entries = '[[success]]\npredicate = "robot_near_ball"\n\n[[success]]\npredicate = "no_fall"\n'
     falls = [(t / 10, 0.0, t < 12) for t in range(50)]
     assert judged(tmp_path, entries, falls) == (False, "no_fall broke at 1.20 s", 1.2)
-    # alone, an always predicate decides at the end of the run
+    # alone, an always predicate decides at the end of the run; after its within_s it is no longer checked
     assert judged(tmp_path, '[[success]]\npredicate = "no_fall"\n', [(t / 10, 0.0, True) for t in range(51)]) == (True, "", 5.0)
+    assert judged(tmp_path, '[[success]]\npredicate = "no_fall"\nwithin_s = 1.0\n', [(t / 10, 0.0, t < 12) for t in range(51)]) == (True, "", 5.0)
 
 
 # -------------------------------------------------------------------------- seeds and intervals
@@ -300,6 +310,19 @@ def test_success_and_failure_are_detected_and_a_failed_run_keeps_a_replayable_lo
     assert "finds the ball beside it                 2    100%" in done.stdout and "BELOW" in done.stdout
     replay = tafel("run", "--platform", "log", "--log", rows[2]["log"], "--speed", "max", "--no-debug", cwd=tmp_path, timeout=120)
     assert replay.returncode == 0, replay.stderr
+
+
+@pytest.mark.slow
+def test_without_a_shared_folder_a_failed_runs_log_travels_back_with_its_row(tmp_path: Path) -> None:
+    """What a Ray cluster's worker does when the caller gave no --artifacts: the log comes back as bytes."""
+    from tafel.tools.scenarios import Job, run_job
+
+    scenario = load_scenario(write(tmp_path, FAILS))
+    row = run_job(Job(scenario, 0, 5, artifacts=None))
+    assert row["success"] is False and row["log"] == "scenario-run0-seed5.mcap"
+    (tmp_path / "back.mcap").write_bytes(row["log_bytes"])
+    with LogReader(tmp_path / "back.mcap") as log:
+        assert "cognition/BallModel" in log.channels
 
 
 def comparable(rows: list[dict[str, Any]]) -> list[tuple]:

@@ -753,20 +753,16 @@ def command_modules(args: argparse.Namespace, extra: Sequence[str]) -> int:
     return 0
 
 
-def command_log(args: argparse.Namespace, extra: Sequence[str]) -> int:
-    from tafel.tools.log_tools import run_log_command
+def tool_command(module: str, function: str) -> Callable[[argparse.Namespace, Sequence[str]], int]:
+    """A command whose code is in ``tafel.tools.<module>`` (loaded when it runs) and that takes no
+    arguments beyond its own."""
 
-    if extra:
-        fail(f"unrecognized arguments: {' '.join(extra)}")
-    return run_log_command(args)
+    def command(args: argparse.Namespace, extra: Sequence[str]) -> int:
+        if extra:
+            fail(f"unrecognized arguments: {' '.join(extra)}")
+        return int(getattr(importlib.import_module(f"tafel.tools.{module}"), function)(args))
 
-
-def command_console(args: argparse.Namespace, extra: Sequence[str]) -> int:
-    from tafel.tools.console import run_console
-
-    if extra:
-        fail(f"unrecognized arguments: {' '.join(extra)}")
-    return run_console(args)
+    return command
 
 
 def command_view(args: argparse.Namespace, extra: Sequence[str]) -> int:
@@ -789,24 +785,10 @@ def command_match(args: argparse.Namespace, extra: Sequence[str]) -> int:
     return run_match(args, extra)
 
 
-def command_scenarios(args: argparse.Namespace, extra: Sequence[str]) -> int:
-    from tafel.tools.scenarios import command_scenarios as run_scenarios
-
-    if extra:
-        fail(f"unrecognized arguments: {' '.join(extra)}")
-    return run_scenarios(args)
-
-
-def command_replay_batch(args: argparse.Namespace, extra: Sequence[str]) -> int:
-    from tafel.tools.replay_batch import command_replay_batch as replay
-
-    if extra:
-        fail(f"unrecognized arguments: {' '.join(extra)}")
-    return replay(args)
-
-
-COMMANDS = {"run": command_run, "view": command_view, "platforms": command_platforms, "modules": command_modules, "log": command_log,
-            "console": command_console, "match": command_match, "scenarios": command_scenarios, "replay-batch": command_replay_batch}
+COMMANDS = {"run": command_run, "view": command_view, "platforms": command_platforms, "modules": command_modules,
+            "log": tool_command("log_tools", "run_log_command"), "console": tool_command("console", "run_console"),
+            "match": command_match, "scenarios": tool_command("scenarios", "command_scenarios"),
+            "replay-batch": tool_command("replay_batch", "command_replay_batch")}
 
 
 class PipeSafeStream:

@@ -258,7 +258,7 @@ def load_scenario(path: str | Path) -> Scenario:
         ball=f.take(("ball",), ball, "position", "pair", (0.0, 0.0)),
         ball_velocity_mm_s=f.take(("ball",), ball, "velocity", "pair", (0.0, 0.0)),
         perturbation=_perturbation(f, top),
-        events=tuple(_push(f, ("events", i), event) for i, event in enumerate(_tables(f, top, "events"))),
+        events=tuple(_push(f, ("events", i), event, duration) for i, event in enumerate(_tables(f, top, "events"))),
         success=tuple(_condition(f, ("success", i), entry, duration) for i, entry in enumerate(success)),
     )
 
@@ -286,12 +286,15 @@ def _perturbation(f: _File, top: dict[str, Any]) -> Perturbation:
     return Perturbation(**taken)
 
 
-def _push(f: _File, table: tuple[Any, ...], values: dict[str, Any]) -> Push:
+def _push(f: _File, table: tuple[Any, ...], values: dict[str, Any], duration: float) -> Push:
     f.only(table, values, ["at_s", "push_n"])
     force = f.take(table, values, "push_n", "pair")
     if math.hypot(*force) > MAX_PUSH_N:
         raise f.error(table, "push_n", f"push_n takes [fx, fy] up to {MAX_PUSH_N:g} N, got {list(force)}")
-    return Push(at_s=f.take(table, values, "at_s", "number"), force_n=force)
+    at = f.take(table, values, "at_s", "number")
+    if not 0 <= at < duration:
+        raise f.error(table, "at_s", f"at_s is a time within the run, 0 to {duration:g} s; got {at:g}")
+    return Push(at_s=at, force_n=force)
 
 
 def _condition(f: _File, table: tuple[Any, ...], values: dict[str, Any], duration: float) -> Condition:

@@ -2,7 +2,8 @@
 
 Each ``[[success]]`` entry of a scenario file names one predicate and its parameters. A predicate of
 kind *eventually* must hold at some moment between ``after_s`` and ``within_s`` (for ``for_s`` without
-a break, if given); one of kind *always* must hold at every tick from ``after_s`` until the run ends.
+a break, if given); one of kind *always* must hold at every tick from ``after_s`` until ``within_s``
+or the run's end.
 A run succeeds, and ends, when every *eventually* predicate has held; it fails, and ends, when an
 *always* predicate breaks or a deadline passes.
 
@@ -137,6 +138,6 @@ PREDICATES: dict[str, PredicateKind] = {
 #: parameters every predicate takes: when it is checked (s of the run)
 TIMING = {
     "after_s": Parameter("number", "checked from this time on", 0.0),
-    "within_s": Parameter("number", "deadline of an 'eventually' predicate (default: the duration)", math.inf),
+    "within_s": Parameter("number", "an 'eventually' predicate's deadline, an 'always' one's end (default: the duration)", math.inf),
     "for_s": Parameter("number", "how long it must hold without a break", 0.0),
 }

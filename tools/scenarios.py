@@ -115,7 +115,7 @@ class _Judge:
                 continue
             holds = PREDICATES[condition.predicate].test(world, condition.parameters)
             if condition.when == "always":
-                if not holds:
+                if not holds and now <= condition.within_s:
                     self.outcome = (False, f"{condition.describe()} broke at {now:.2f} s")
                     return
                 continue
