@@ -245,3 +245,33 @@ def test_debug_commands_reach_the_platform_through_the_server(engine: str) -> No
         assert program.ask("sim:move_ball -x far").startswith("error: sim:move_ball failed")
     finally:
         program.stop()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ["mujoco", "pybullet"])
+def test_a_ball_can_start_rolling_and_the_sensor_noise_can_be_scaled(engine: str) -> None:
+    sim = Simulation(engine, cameras="off", ball="-2000,2000", ball_velocity="1000,-500", sensor_noise="0")
+    try:
+        sim.run(0.5)
+        x, y = sim.platform.ball_position()
+        dx, dy = x + 2000.0, y - 2000.0
+        assert abs(math.degrees(math.atan2(dy, dx) - math.atan2(-500.0, 1000.0))) < 5.0  # the way it was sent
+        assert 0.5 * 1118.0 * 0.5 < math.hypot(dx, dy) < 1118.0 * 0.5  # rolling and slowing down (1118 mm/s at the start)
+        joints = sim.blackboard("motion")[JointSensorData].position
+        np.testing.assert_array_equal(joints, sim.platform.joint_angles())  # no noise at all with factor 0
+    finally:
+        sim.close()
+
+
+@pytest.mark.parametrize(("option", "value", "message"), [
+    ("ball_velocity", "fast", "--ball-velocity takes VX,VY in mm/s, e.g. 500,0; got 'fast'"),
+    ("ball_velocity", "20000,0", "--ball-velocity takes VX,VY in mm/s up to 10000 mm/s; got '20000,0'"),
+    ("sensor_noise", "nan", "--sensor-noise takes a factor from 0 to 100 (1: the NAO's noise, 0: none), got 'nan'"),
+    ("sensor_noise", "-1", "--sensor-noise takes a factor from 0 to 100"),
+])
+def test_bad_ball_velocities_and_noise_factors_say_what_would_be_right(option: str, value: str, message: str) -> None:
+    from tafel.core.platform import PlatformOptionError, load_platform
+
+    with pytest.raises(PlatformOptionError) as error:
+        load_platform("mujoco")({option: value})
+    assert message in str(error.value)

@@ -115,5 +115,9 @@ class FakeLola:
 
     def close(self) -> None:
         self.stop.set()
+        try:  # wakes an accept() still waiting for a program that never came (closing alone does not)
+            self.server.shutdown(socket.SHUT_RDWR)
+        except OSError:
+            pass
         self.server.close()
         self.thread.join(timeout=5)

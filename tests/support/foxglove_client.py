@@ -20,8 +20,10 @@ MESSAGE_DATA, SERVICE_CALL_REQUEST, SERVICE_CALL_RESPONSE = 0x01, 0x02, 0x03
 
 class FoxgloveClient:
     def __init__(self, url: str, timeout: float = 10.0, subprotocol: str = SUBPROTOCOL, headers: dict[str, str] | None = None) -> None:
+        # close_timeout: a client closing under a stream of images waits at most 1 s for the server's close
+        # frame (websockets' default of 10 s made every such teardown take 10 s)
         self.socket = connect(url, subprotocols=[subprotocol], max_size=None, open_timeout=timeout, additional_headers=headers,
-                              proxy=None, legacy=True)
+                              proxy=None, legacy=True, close_timeout=1.0)
         self.timeout = timeout
         self.channels: dict[int, dict[str, Any]] = {}  # channel id -> its advertisement
         self.services: dict[str, dict[str, Any]] = {}
