@@ -249,6 +249,7 @@ def test_the_spl_ball_is_white_with_black_pentagons() -> None:
     assert (grey < 60).mean() > 0.15 and (grey > 200).mean() > 0.55
 
 
+@pytest.mark.slow  # painting takes a second
 def test_the_shipped_ball_texture_is_what_the_code_paints() -> None:
     """The simulators load platforms/assets/ball_texture.png; after a change to the painting, write it
     anew with python -m tafel.platforms.field_world."""

@@ -120,6 +120,7 @@ def test_predicates_over_representations_are_checked_against_the_representations
         load_scenario(path)
 
 
+@pytest.mark.slow  # worker processes / a subprocess: end to end
 def test_the_command_refuses_a_bad_file_with_status_2_before_running_anything(tmp_path: Path) -> None:
     path = write(tmp_path, GOOD.replace('predicate = "no_fall"', 'predicate = "no_falls"'))
     done = tafel("scenarios", "run", str(path), "--out", str(tmp_path / "runs.csv"), cwd=tmp_path, timeout=60)
@@ -239,6 +240,7 @@ def crash_once(marker: str) -> dict[str, Any]:
     return {"success": True, "pid": os.getpid()}
 
 
+@pytest.mark.slow  # worker processes / a subprocess: end to end
 def test_a_job_whose_worker_dies_runs_again_and_is_reported_once(tmp_path: Path) -> None:
     markers = [str(tmp_path / f"job{i}") for i in range(4)]
     reported: list[int] = []

@@ -130,7 +130,7 @@ class Match:
                        "--debug-port", "0", "--no-web", "--status-interval", "3600",
                        "--set", "parameters.GameStateProvider.start_state=initial",
                        # the team message budget is paced over the game's halves, here shorter than the SPL's
-                       "--set", f"parameters.TeamMessageSender.half_s={max(1.0, self.args.seconds / 2):g}",
+                       "--set", f"parameters.TeamMessageSender.half_s={min(3600.0, max(1.0, self.args.seconds / 2)):g}",
                        *(a for key, value in settings.items() for a in ("--set", f"game.{key}={json.dumps(value)}")),
                        *(a for override in self.args.overrides for a in ("--set", override)),
                        *(a for override in getattr(self.args, f"team{player.team + 1}_overrides") for a in ("--set", override))]
