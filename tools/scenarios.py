@@ -331,7 +331,7 @@ def command_scenarios(args: argparse.Namespace) -> int:
     remote = args.ray not in (None, "local") and args.artifacts is None
     jobs = [Job(s, run, run_seed(args.seed, s.name, run), None if remote else str(artifacts.resolve()), not args.no_logs)
             for s in scenarios for run in range(args.repeat)]
-    print(f"{len(jobs)} runs of {len(scenarios)} scenarios", flush=True)
+    print(f"{plural(len(jobs), 'run')} of {plural(len(scenarios), 'scenario')}", flush=True)
     info = BatchInfo()
 
     def progress(index: int, row: dict[str, Any]) -> None:
