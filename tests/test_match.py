@@ -57,13 +57,14 @@ def event_time(result: dict, name: str, after: float = 0.0) -> float:
 
 
 def test_a_lone_robot_walks_to_its_kickoff_position_in_ready_and_scores_after_playing_starts(tmp_path: Path) -> None:
-    result, done = match(tmp_path, "--teams", "1v0", "--seconds", "40", "--cameras", "off", "--seed", "3", "--ready-seconds", "40",
-                         "--record-dir", str(tmp_path / "logs"), *LEAN)
+    result, done = match(tmp_path, "--teams", "1v0", "--seconds", "60", "--goals", "1", "--cameras", "off", "--seed", "3",
+                         "--ready-seconds", "40", "--record-dir", str(tmp_path / "logs"), *LEAN)
     assert done.returncode == 0 and result["ended"] == "the game is over", done.stderr[-3000:]
     assert "team 1 player 1: debug server 127.0.0.1:" in done.stdout
     ready, kickoff = event_time(result, "READY"), event_time(result, "PLAYING")
     goals = [e["time_s"] for e in result["events"] if e["event"] == "GOAL 1"]
     assert goals and goals[0] > kickoff, result["events"]
+    assert [e["event"] for e in result["events"]][-2:] == ["GOAL 1", "FINISHED"]  # --goals 1: the game ends with the goal
     assert result["teams"][0]["score"] >= 1 and result["score"].endswith(":0")
     # in READY it walked from the touchline to where the team kicking off puts its striker, and stood there at SET
     track = poses(tmp_path / "logs" / "team1_player1.mcap")

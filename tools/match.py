@@ -63,6 +63,7 @@ def add_match_command(commands: Any) -> None:
     match.add_argument("--result", type=Path, metavar="FILE.json", help="also write the result's JSON object here")
     match.add_argument("--resolution", default="320x240", help="camera image size WIDTHxHEIGHT")
     match.add_argument("--ready-seconds", type=positive(float), default=30.0, help="longest READY (default 30)")
+    match.add_argument("--goals", type=positive(int), metavar="N", help="end the game when a team has scored N goals (drills, tests)")
     match.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                        help="a configuration override for every robot's program (repeatable)")
     for team in (1, 2):
@@ -112,7 +113,8 @@ class Match:
         self.ports = {"game_controller_port": free_udp_port(), "return_port": free_udp_port()}
         self.team_ports = (free_udp_port(), free_udp_port())
         self.referee = Referee(self.world, TEAM_NUMBERS, self.players, args.seconds / 2, self.ports["game_controller_port"],
-                               self.ports["return_port"], self.team_ports, ready_s=args.ready_seconds)
+                               self.ports["return_port"], self.team_ports, ready_s=args.ready_seconds,
+                               goals_to_end=args.goals)
         self.key = secrets.token_hex(16)
         self.listener = Listener(("127.0.0.1", 0), backlog=2 * MAX_PLAYERS_PER_TEAM, authkey=self.key.encode())  # all join at once
         self.robots: list[Robot] = []

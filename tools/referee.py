@@ -75,6 +75,8 @@ class Referee:
     ready_s: float = 30.0
     set_s: float = 3.0
     penalty_s: float = 30.0
+    #: the game ends when a team has scored this many (drills and tests); None plays both halves
+    goals_to_end: int | None = None
     events: list[Event] = field(default_factory=list)
 
     def __post_init__(self) -> None:
@@ -96,6 +98,7 @@ class Referee:
         self.still_since: float | None = None
         self.last_touch = 0  # the team that touched the ball last
         self.over = False
+        self.ending = False  # the game ends at the next FINISHED, whichever half it is
 
     # ------------------------------------------------------------------------------------ tick
     def tick(self, now: float, dt: float) -> None:
@@ -112,7 +115,7 @@ class Referee:
         elif state is State.playing:
             self.play(now, dt)
         elif state is State.finished and now - self.phase_since >= 2.0:
-            if self.game.first_half:
+            if self.game.first_half and not self.ending:
                 self.game.first_half, self.clock = False, float(self.half_s)
                 self.game.kicking_team = self.team_numbers[1]
                 self.enter(State.initial, now)
@@ -145,7 +148,11 @@ class Referee:
             self.game.teams[scorer].score += 1
             self.events.append(Event(now, f"GOAL {self.team_numbers[scorer]}"))
             self.game.kicking_team = self.team_numbers[1 - scorer]
-            self.enter(State.ready, now)
+            if self.goals_to_end is not None and self.game.teams[scorer].score >= self.goals_to_end:
+                self.ending = True
+                self.enter(State.finished, now)
+            else:
+                self.enter(State.ready, now)
         elif over_goal_line or abs(by) > HALF_LINE_Y + pitch.BALL_RADIUS:
             self.ball_out(bx, by, now)
         for player in self.players:
