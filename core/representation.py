@@ -137,6 +137,19 @@ def registered_representations() -> dict[str, type]:
     return dict(_REGISTRY)
 
 
+def defining_modules() -> list[str]:
+    """The Python modules that define the registered representations, in registration order.
+
+    A process started with ``spawn`` imports only what unpickling its arguments needs; importing these
+    first gives it the same representations by name as the process that started it (a viewer's feed or
+    a log names representations that none of the context's own modules mention)."""
+    names: dict[str, None] = {}
+    for cls in _REGISTRY.values():
+        if cls.__module__ != "__main__":
+            names.setdefault(cls.__module__, None)
+    return list(names)
+
+
 def get_representation(name: str) -> type:
     """The representation class registered under ``name``; ``KeyError`` with suggestions otherwise."""
     try:

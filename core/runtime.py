@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import faulthandler
 import hashlib
+import importlib
 import logging
 import multiprocessing
 import os
@@ -23,7 +24,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any
@@ -34,6 +35,7 @@ from tafel.core.manager import ModuleManager
 from tafel.core.platform import EndOfData, Platform, PlatformError
 from tafel.core.program import ContextPlan
 from tafel.core.recording import QueueSink, Recorder
+from tafel.core.representation import defining_modules
 from tafel.core.serialization import SerializationError, serialize
 from tafel.core.statistics import PeriodStatistics
 from tafel.core.status import CognitionStatus
@@ -425,6 +427,8 @@ class WorkerSpec:
     setup: tuple[Callable[[ContextRunner, Any], None], Any] | None = None
     #: the program's time 0 on the monotonic clock, shared by every process (``core.clock``)
     clock_origin_ns: int = 0
+    #: Python modules imported first, so the process knows every representation the program knows
+    imports: tuple[str, ...] = ()
 
 
 def try_realtime(priority: int) -> str:
@@ -557,6 +561,16 @@ def _die_with_parent() -> None:
         pass  # not Linux: the polling in _watch_parent does the job
 
 
+def import_definitions(names: Sequence[str]) -> None:
+    """Import the modules that define the program's representations; one that fails is named, not fatal
+    (the context then fails later, and clearly, only if it really needs what that module defines)."""
+    for name in names:
+        try:
+            importlib.import_module(name)
+        except Exception as exc:  # noqa: BLE001 - a user's module may raise anything on import
+            log.warning("cannot import %s, which defines representations: %s: %s", name, type(exc).__name__, exc)
+
+
 def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
     """Entry point of a context process."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the supervisor decides when to stop
@@ -566,6 +580,7 @@ def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
                      daemon=True).start()
     clock.set_origin(spec.clock_origin_ns)
     logging.basicConfig(level=logging.WARNING, format=f"[{spec.plan.name}] %(levelname)s %(message)s")
+    import_definitions(spec.imports)
     realtime = try_realtime(spec.realtime_priority) if spec.plan.name == "motion" else ""
     inbox = SharedChannel.attach(spec.inbox_name) if spec.inbox_name else None
     outbox = SharedChannel.attach(spec.outbox_name) if spec.outbox_name else None
@@ -686,6 +701,7 @@ class ConcurrentRuntime:
                     outbox_name=channels[name].name, stall_timeout_s=self.stall_timeout_s,
                     record=self.recorder.by_context.get(name, []) if self.recorder else [], record_queue=record_queue,
                     record_switch=self.record_switch, setup=self.worker_setup, clock_origin_ns=clock.origin_ns(),
+                    imports=tuple(defining_modules()),
                 )
                 receiver, sender = self._mp.Pipe(duplex=False)
                 process = self._mp.Process(target=_worker_main, args=(spec, self.stop, sender), name=f"tafel-{name}", daemon=True)

@@ -20,7 +20,7 @@ import math
 import os
 import socket
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
 import cv2
@@ -71,6 +71,17 @@ def crouch_pose() -> np.ndarray:
     for name, angle in CROUCH.items():
         pose[JOINT_INDEX[name]] = angle
     return pose
+
+
+#: the bit of LoLA's battery status that is set while the robot charges (B-Human's NaoProvider)
+BATTERY_CHARGING_BIT = 0x80
+
+
+def battery_data(battery: Sequence[float]) -> BatteryData:
+    """LoLA's ``Battery`` array (charge, status, current, temperature) as ``BatteryData``."""
+    status = int(battery[1])
+    return BatteryData(charge=float(battery[0]), status=status, charging=bool(status & BATTERY_CHARGING_BIT),
+                       current=float(battery[2]), temperature=float(battery[3]))
 
 
 def convert_inertial(accelerometer: np.ndarray, gyroscope: np.ndarray, angles: np.ndarray) -> InertialSensorData:
@@ -265,9 +276,7 @@ class NaoPlatform(NetworkedPlatform, Platform):
             blackboard.set(inertial)
             blackboard.set(FsrData(pressure=values["FSR"]))
             blackboard.set(TouchSensorData(pressed=values["Touch"]))
-            battery = values["Battery"]
-            blackboard.set(BatteryData(charge=float(battery[0]), status=float(battery[1]), current=float(battery[2]),
-                                       temperature=float(battery[3])))
+            blackboard.set(battery_data(values["Battery"]))
         elif context == "cognition":
             self.time_ns = clock.now_ns()
             blackboard.set(FrameInfo(frame_number=frame_number, time_ns=self.time_ns))

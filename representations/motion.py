@@ -220,11 +220,17 @@ class ChestButton:
 
 @representation
 class BatteryData:
-    """``charge`` 0..1, ``current`` (A, negative while discharging), ``temperature`` (deg C), and the
-    raw ``status`` flags of the battery board."""
+    """The battery as LoLA reports it (its ``Battery`` array: charge, status, current, temperature, the
+    order B-Human, HULKs and NaoTH read; Softbank's documentation lists another, which is wrong).
+
+    ``charge`` 0..1; ``status`` the battery board's raw flags (a 16-bit signed value, for example
+    -32552 = 0x80D8 while charging); ``charging`` its bit 0x80, as B-Human reads it; ``current`` (A,
+    negative while discharging); ``temperature`` LoLA's raw battery temperature reading: about 3 on real
+    robots whatever the battery does (NaoTH notes the same), so it is no temperature in deg C."""
 
     charge: float = 1.0
-    status: float = 0.0
+    status: int = 0
+    charging: bool = False
     current: float = 0.0
     temperature: float = 0.0
 

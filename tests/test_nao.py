@@ -14,7 +14,7 @@ import pytest
 
 from tafel.core.logfile import read_log
 from tafel.core.serialization import deserialize
-from tafel.platforms.nao import CROUCH, LolaProtocolError, convert_inertial, crouch_pose, parse_sensors
+from tafel.platforms.nao import CROUCH, LolaProtocolError, battery_data, convert_inertial, crouch_pose, parse_sensors
 from tafel.representations.motion import JOINT_INDEX, BatteryData, FsrData, InertialSensorData, TouchSensorData
 from tests.support.fake_lola import KEY_ORDER, PACKET_SIZE, FakeLola, sensor_packet
 from tests.test_cli_runtime import REPO
@@ -23,9 +23,12 @@ LOOK_LEFT = "tests.support.nao_support:LookLeft"
 STAND = "tests.support.motion_requests:ConstantMotionRequest"
 
 
-def run_nao(socket_path: Path, *args: str, modules: str = f'["{LOOK_LEFT}", "{STAND}"]') -> subprocess.CompletedProcess:
+def run_nao(socket_path: Path, *args: str, modules: str | None = f'["{LOOK_LEFT}", "{STAND}"]') -> subprocess.CompletedProcess:
+    """``tafel run --platform nao`` with what a user gets by default: the debug server and the web view
+    (on free ports, so that tests may run side by side); ``modules=None`` keeps the default cognition."""
+    chosen = ["--set", f"cognition.modules={modules}"] if modules is not None else []
     command = [sys.executable, "-m", "tafel.tools.cli", "run", "--platform", "nao", "--lola", str(socket_path), "--cameras", "off",
-               "--no-debug", "--set", f"cognition.modules={modules}", *args]
+               "--debug-port", "0", "--web-port", "0", *chosen, *args]
     return subprocess.run(command, capture_output=True, text=True, timeout=120, cwd=REPO, env={**os.environ, "PYTHONPATH": str(REPO)})
 
 
@@ -39,6 +42,21 @@ def lola(tmp_path: Path):
 def finished(fake: FakeLola) -> None:
     time.sleep(0.2)
     fake.close()
+
+
+@pytest.mark.slow
+def test_the_default_program_runs_both_contexts_with_web_view_debug_server_and_recording(lola: FakeLola, tmp_path: Path) -> None:
+    """A user's first command on a robot: the default cognition, web view and debug server on, recording.
+    The motion process must not die at start (it once did: the web view's feed named a representation
+    that motion's process had never imported)."""
+    log = tmp_path / "robot.mcap"
+    result = run_nao(lola.path, "--seconds", "3", "--record", str(log), modules=None)
+    finished(lola)
+    assert result.returncode == 0, result.stderr
+    assert "FAILED" not in result.stdout and "failed to start" not in result.stderr, result.stdout + result.stderr
+    motion = next(line for line in result.stdout.splitlines() if line.strip().startswith("motion:") and "frames" in line)
+    assert int(motion.split("frames")[0].split()[-1]) > 100, motion
+    assert {"JointSensorData", "BallModel"} <= {channel.schema_name.split(".")[-1] for channel in read_log(log).channels.values()}
 
 
 @pytest.mark.slow
@@ -183,3 +201,15 @@ def test_answers_carry_sonar_on_and_every_led(lola: FakeLola) -> None:
     assert result.returncode == 0, result.stderr
     normal = [a for a in lola.answers if "LEye" in a]
     assert normal and all(a["Sonar"] == [True, True] for a in normal)
+
+
+def test_the_battery_reads_a_real_packet_in_the_order_the_teams_read_it() -> None:
+    """NaoTH's LolaData.h quotes a real robot's packet: ``"Battery":[0.99,-32552,0.016,3.6]``. B-Human,
+    HULKs and NaoTH read it as charge, status, current, temperature; the status is the board's flags
+    (0x80D8 as a 16-bit value: bit 0x80, charging, is set) and the temperature stays near 3 on robots."""
+    battery = battery_data([0.99, -32552.0, 0.016, 3.6])
+    assert battery.charge == pytest.approx(0.99)
+    assert battery.status == -32552 and battery.charging
+    assert battery.current == pytest.approx(0.016)
+    assert battery.temperature == pytest.approx(3.6)
+    assert not battery_data([0.5, 0.0, -1.2, 3.0]).charging

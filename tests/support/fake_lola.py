@@ -31,7 +31,7 @@ def sensor_packet(positions: list[float], stiffness: list[float], index: int, *,
     """
     values: dict[str, Any] = {
         "RobotConfig": [BODY_ID, "6.0.0", HEAD_ID, "6.0.0"],
-        "Accelerometer": list(accelerometer), "Angles": list(angles), "Battery": [0.9, 0.0, -1.2, 30.0],
+        "Accelerometer": list(accelerometer), "Angles": list(angles), "Battery": [0.99, -32552.0, 0.016, 3.6],  # NaoTH's real packet (charging)
         "Current": [0.1] * 25, "FSR": [0.6] * 8, "Gyroscope": list(gyroscope), "Position": list(positions),
         "Sonar": [2.0, 2.0], "Stiffness": list(stiffness), "Temperature": [35.0] * 25, "Touch": [0.0] * 14,
         "Status": [index % 2] * 25,

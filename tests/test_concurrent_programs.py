@@ -1,0 +1,52 @@
+"""The concurrent runtime's processes know what the program knows: representations defined by a
+user's own module files, and every representation a viewer or a recorder names."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from tafel.core.logfile import read_log
+from tests.test_cli_runtime import REPO, TAFEL, frames
+
+USER_MODULE = textwrap.dedent('''
+    """A team's own module with a representation of its own, outside the tafel package."""
+    from tafel.core import Module, provides, representation, requires
+    from tafel.representations.infrastructure import FrameInfo
+
+
+    @representation
+    class HeartbeatCount:
+        """Frames counted by the team's own module."""
+        count: int = 0
+
+
+    @requires(FrameInfo)
+    @provides(HeartbeatCount)
+    class HeartbeatCounter(Module):
+        def execute(self) -> None:
+            self.heartbeat_count.count = self.frame_info.frame_number
+''')
+
+
+@pytest.mark.slow
+def test_a_users_representation_reaches_every_process_with_the_web_view_on(tmp_path: Path) -> None:
+    (tmp_path / "team_modules.py").write_text(USER_MODULE)
+    log = tmp_path / "run.mcap"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), str(tmp_path)])}
+    result = subprocess.run(
+        [*TAFEL, "run", "--platform", "dummy", "--concurrent", "--frames", "150", "--speed", "max", "--debug-port", "0",
+         "--web-port", "0", "--set", 'cognition.modules=["team_modules:HeartbeatCounter", "tests.support.nao_support:LookLeft", '
+         '"tests.support.motion_requests:ConstantMotionRequest"]', "--record", str(log),
+         "--record-reps", "HeartbeatCount"],
+        capture_output=True, text=True, timeout=120, cwd=tmp_path, env=env)
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert "FAILED" not in result.stdout and "failed to start" not in result.stderr, result.stdout + result.stderr
+    assert frames(result.stdout)["motion"] == 150
+    counts = [m for m in read_log(log).messages if m.topic.endswith("HeartbeatCount")]
+    assert len(counts) > 10
