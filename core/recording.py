@@ -20,6 +20,7 @@ from tafel.core.logfile import LogWriter, Translate
 from tafel.core.manager import Blackboard
 from tafel.core.naming import did_you_mean
 from tafel.core.program import ContextPlan
+from tafel.core.representation import is_state
 from tafel.core.serialization import SerializationError, serialize
 
 #: the name that selects every representation of the program
@@ -46,7 +47,8 @@ class Selection:
 
     @property
     def metadata(self) -> dict[str, str]:
-        return {"source": self.source, **({"provider": self.provider} if self.provider else {})}
+        return {"source": self.source, **({"provider": self.provider} if self.provider else {}),
+                **({} if is_state(self.rep) else {"state": "false"})}
 
 
 def select(plans: Mapping[str, ContextPlan], names: Iterable[str] | None, *, include_sensors: bool = True,

@@ -14,8 +14,9 @@ import dataclasses
 import enum
 import sys
 import typing
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, TypeVar
+from typing import Any, TypeVar, overload
 
 import numpy as np
 
@@ -91,12 +92,35 @@ def array(shape: tuple[int | None, ...] = (0,), dtype: Any = np.float64) -> Any:
     )
 
 
-def representation(cls: type[T]) -> type[T]:
+@overload
+def representation(cls: type[T], /) -> type[T]: ...
+
+
+@overload
+def representation(*, state: bool = True) -> Callable[[type[T]], type[T]]: ...
+
+
+def representation(cls: type[T] | None = None, /, *, state: bool = True) -> Any:
     """Make ``cls`` a representation: a dataclass with defaults for every field, registered by name.
+
+    ``@representation(state=False)`` marks diagnostics about the run rather than the robot's state (how
+    long modules took): equal runs differ in them, so program fingerprints and ``tafel log compare``
+    leave them out (``is_state``).
 
     Raises ``RepresentationDefinitionError`` for unsupported field types and when another module
     already registered a representation of the same class name.
     """
+    if cls is None:
+        return lambda target: _make_representation(target, state)
+    return _make_representation(cls, state)
+
+
+def is_state(cls: type) -> bool:
+    """False for representations declared ``state=False`` (timing and other facts about the run)."""
+    return bool(getattr(cls, "__tafel_state__", True))
+
+
+def _make_representation(cls: type[T], state: bool) -> type[T]:
     name = cls.__name__
     previous = _REGISTRY.get(name)
     if previous is not None and (previous.__module__, previous.__qualname__) != (
@@ -123,6 +147,7 @@ def representation(cls: type[T]) -> type[T]:
     data_cls.__hash__ = None  # type: ignore[assignment]
     data_cls.__repr__ = _representation_repr  # type: ignore[method-assign]
     data_cls.__tafel_representation__ = True  # type: ignore[attr-defined]
+    data_cls.__tafel_state__ = state  # type: ignore[attr-defined]
     _REGISTRY[name] = data_cls
     return data_cls
 

@@ -35,7 +35,7 @@ from tafel.core.manager import ModuleManager
 from tafel.core.platform import EndOfData, Platform, PlatformError
 from tafel.core.program import ContextPlan
 from tafel.core.recording import QueueSink, Recorder
-from tafel.core.representation import defining_modules
+from tafel.core.representation import defining_modules, is_state
 from tafel.core.serialization import SerializationError, serialize
 from tafel.core.statistics import PeriodStatistics
 from tafel.core.status import CognitionStatus
@@ -91,15 +91,18 @@ def recorder_hook(recorder: Recorder) -> Callable[[ContextRunner], None]:
 
 
 def state_digest(manager: ModuleManager) -> str:
-    """A short fingerprint of every representation on a blackboard (equal states, equal digests).
+    """A short fingerprint of every representation on a blackboard (equal states, equal digests);
+    representations declared ``state=False`` (timing) are left out.
 
     Each is hashed in its serialized form, the form logs hold, so a value read back from a log
     (a Python float where a module wrote a numpy float) counts as the same state.
     """
     digest = hashlib.blake2b(digest_size=8)
     for name in manager.blackboard.names():
-        digest.update(name.encode())
         instance = manager.blackboard.get(name)
+        if not is_state(type(instance)):
+            continue  # timing differs between equal runs; it is no state
+        digest.update(name.encode())
         try:
             digest.update(serialize(instance))
         except SerializationError:

@@ -29,6 +29,7 @@ class DummyPlatform(NetworkedPlatform, Platform):
     name = "dummy"
     description = "deterministic clock, synthetic joints, IMU, ball percepts and pose, no physics"
     clock = "simulated"
+    default_network = "simulated"  # equal runs stay equal: no other program on the machine is heard
     provides: ClassVar[Mapping[str, tuple[type, ...]]] = {
         "motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData, TouchSensorData),
         "cognition": (FrameInfo, BallPercept, RobotPose, *NETWORK_INPUTS),

@@ -49,6 +49,7 @@ class MatchRobotPlatform(SimulatedRobotPlatform):
     name = "match"
     engine = "MuJoCo (a match's world)"
     description = "one robot of a simulated match: its world runs in tafel match, in lockstep with every robot"
+    default_network = "udp"  # the robots and the referee are processes of their own, on loopback ports of their own
 
     def __init__(self, options: Mapping[str, Any] | None = None) -> None:
         super().__init__(options)

@@ -8,6 +8,12 @@ a log replays exactly what was heard.
 Its settings are the ``[game]`` table of the configuration (see ``config/general.toml``). A socket
 that cannot be opened (port taken without SO_REUSEPORT, no network) is a warning, never a crash: the
 robot then plays without it, as the rules' manual mode expects.
+
+``game.network`` says where the bytes go: ``"udp"`` (real sockets: the robot, matches, a
+GameController on this machine), ``"simulated"`` (inside the program: the robot hears its own team
+messages a frame later, as a real broadcast echoes back, and no GameController; nothing from another
+program on the machine gets in, so equal runs stay equal), or ``"auto"``: the platform's choice,
+``simulated`` for the simulators and the dummy, ``udp`` for the NAO and matches.
 """
 
 from __future__ import annotations
@@ -17,7 +23,7 @@ import socket
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 from tafel.core.config import ConfigError
 from tafel.core.manager import Blackboard
@@ -32,6 +38,7 @@ NETWORK_INPUTS = (GameControllerPackets, IncomingTeamMessages)
 NETWORK_OUTPUTS = (GameControllerReturn, OutgoingTeamMessage)
 MIN_RETURN_INTERVAL_S = 0.5  # the rules: at most two return packets a second
 MAX_DATAGRAMS_PER_FRAME = 64  # more in one frame is a flood: the rest waits (or is dropped by the kernel)
+NETWORK_MODES = ("auto", "udp", "simulated")
 
 
 @dataclass(frozen=True)
@@ -47,6 +54,8 @@ class NetworkSettings:
     """0: 10000 + team number"""
     broadcast: str = "255.255.255.255"
     """where team messages go: the robots' subnet's broadcast address (127.255.255.255 on one machine)"""
+    network: str = "auto"
+    """``udp``, ``simulated`` (inside the program), or ``auto``: the platform's choice"""
 
     @classmethod
     def from_config(cls, table: Mapping[str, Any] | None) -> NetworkSettings:
@@ -59,6 +68,8 @@ class NetworkSettings:
         for key in ("team_number", "player_number", "game_controller_port", "return_port", "team_port"):
             if key in values and (not isinstance(values[key], int) or isinstance(values[key], bool)):
                 raise ConfigError(f"game.{key} takes a whole number, got {values[key]!r}")
+        if "network" in values and values["network"] not in NETWORK_MODES:
+            raise ConfigError(f"game.network takes one of {', '.join(repr(m) for m in NETWORK_MODES)}, got {values['network']!r}")
         settings = cls(**values)
         if not 1 <= settings.team_number <= 254:
             raise ConfigError(f"game.team_number takes 1 to 254 (the GameController's team numbers), got {settings.team_number}")
@@ -88,10 +99,13 @@ def listening_socket(port: int) -> socket.socket:
 
 
 class GameNetwork:
-    """The sockets, opened at ``open`` and read and written once per cognition frame."""
+    """The sockets, opened at ``open`` and read and written once per cognition frame; with a simulated
+    network no socket at all: the team message sent comes back in the next frame, as a broadcast would."""
 
-    def __init__(self, settings: NetworkSettings) -> None:
+    def __init__(self, settings: NetworkSettings, default_mode: str = "udp") -> None:
         self.settings = settings
+        self.simulated = (default_mode if settings.network == "auto" else settings.network) == "simulated"
+        self.echo: list[bytes] = []
         self.game_controller: socket.socket | None = None
         self.team: socket.socket | None = None
         self.collected: tuple[list[Datagram], list[Datagram]] | None = None  # with collect(): what receive() hands on
@@ -99,7 +113,7 @@ class GameNetwork:
         self.returns_sent = self.returns_refused = self.messages_sent = self.messages_refused = self.send_errors = 0
 
     def open(self) -> None:
-        if not self.settings.enabled:
+        if not self.settings.enabled or self.simulated:
             return
         for name, port in (("game_controller", self.settings.game_controller_port), ("team", self.settings.team_messages_port)):
             try:
@@ -123,7 +137,12 @@ class GameNetwork:
 
     def receive(self, blackboard: Blackboard, time_ns: int) -> None:
         """Everything that arrived since the last frame (or was collected), into the input representations."""
-        if self.collected is not None:
+        if self.simulated:
+            game_controller = []
+            team = [Datagram(data=data, host="127.0.0.1", port=self.settings.team_messages_port, received_ns=time_ns)
+                    for data in self.echo]
+            self.echo = []
+        elif self.collected is not None:
             game_controller, team = self.collected
             self.collected = ([], [])
         else:
@@ -159,10 +178,13 @@ class GameNetwork:
                 self.last_return = now
                 self.returns_sent += 1
         message = blackboard[OutgoingTeamMessage] if OutgoingTeamMessage in blackboard else None
-        if message is not None and message.data and self.team is not None:
+        if message is not None and message.data and (self.team is not None or self.simulated and self.settings.enabled):
             if len(message.data) > MAX_MESSAGE_BYTES:
                 self.messages_refused += 1
                 log.warning("team message of %d bytes not sent: the rules allow %d", len(message.data), MAX_MESSAGE_BYTES)
+            elif self.simulated:
+                self.echo.append(bytes(message.data))
+                self.messages_sent += 1
             elif self.transmit(self.team, message.data, (self.settings.broadcast, self.settings.team_messages_port)):
                 self.messages_sent += 1
 
@@ -183,6 +205,10 @@ class GameNetwork:
 
     def status(self) -> str:
         s = self.settings
+        if self.simulated:
+            return (f"team {s.team_number} player {s.player_number}, simulated network inside this program (no GameController; "
+                    f"--set game.network=\"udp\" for real sockets); team messages sent {self.messages_sent}, refused "
+                    f"{self.messages_refused}")
         listening = "listening" if self.game_controller or self.team else "not listening"
         return (f"team {s.team_number} player {s.player_number}, {listening} (GameController port {s.game_controller_port}, team port "
                 f"{s.team_messages_port}); returns sent {self.returns_sent}, refused {self.returns_refused}; team messages sent "
@@ -196,11 +222,13 @@ class NetworkedPlatform:
     in cognition's ``sense``, ``network.send`` in cognition's ``act`` and ``network.close()`` in ``stop``."""
 
     options: dict[str, Any]
+    #: what ``game.network = "auto"`` means on this platform: a simulation keeps its game to itself
+    default_network: ClassVar[str] = "udp"
 
     def __init__(self, options: Mapping[str, Any] | None = None) -> None:
         super().__init__(options)  # type: ignore[call-arg]
-        self.network = GameNetwork(NetworkSettings.from_config(self.options.get("game")))
+        self.network = GameNetwork(NetworkSettings.from_config(self.options.get("game")), self.default_network)
 
     def configure(self, config: Mapping[str, Any]) -> None:
         self.options["game"] = dict(config.get("game") or {})
-        self.network = GameNetwork(NetworkSettings.from_config(self.options["game"]))
+        self.network = GameNetwork(NetworkSettings.from_config(self.options["game"]), self.default_network)

@@ -133,6 +133,7 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
 
     clock = "simulated"
     concurrent = False  # images and joints must come from the same simulated world
+    default_network = "simulated"  # parallel simulations must not hear each other (tafel match asks for udp)
     provides: ClassVar[Mapping[str, tuple[type, ...]]] = {
         "motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData, TouchSensorData),
         "cognition": (FrameInfo, CameraImageTop, CameraImageBottom, *NETWORK_INPUTS),

@@ -45,7 +45,8 @@ def ports() -> dict[str, int]:
 
 
 def robot(ports: dict[str, int], team: int, player: int, *extra: str) -> Program:
-    settings = [f"game.{key}={value}" for key, value in ports.items()] + [f"game.team_number={team}", f"game.player_number={player}"]
+    settings = [f"game.{key}={value}" for key, value in ports.items()] + [f"game.team_number={team}", f"game.player_number={player}",
+                                                                         'game.network="udp"']
     return Program(*(a for s in settings for a in ("--set", s)), *extra)
 
 

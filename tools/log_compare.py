@@ -42,9 +42,27 @@ class ChannelDifference:
         return bool(self.differing or self.only_first or self.only_second)
 
 
-def compare_logs(first: LogReader, second: LogReader, reps: list[str] | None = None) -> dict[str, ChannelDifference]:
-    """Topic -> how the two logs differ on it (channels in only one log included), in one streaming pass."""
+def is_timing(reader: LogReader, topic: str) -> bool:
+    """A channel of a representation declared ``state=False`` (its metadata says so; ``ModuleTimes`` and
+    debug output in logs written before it did): timing, which equal runs do not share, or debug output."""
+    channel = reader.channels.get(topic)
+    if channel is None:
+        return False
+    return channel.metadata.get("state") == "false" or channel.schema_name.split(".")[-1] in LEGACY_TIMING
+
+
+#: representations that were not state before channels said so
+LEGACY_TIMING = frozenset({"ModuleTimes", "DebugDrawings", "DebugPlots"})
+
+
+def compare_logs(first: LogReader, second: LogReader, reps: list[str] | None = None, *,
+                 timing: bool = False) -> dict[str, ChannelDifference]:
+    """Topic -> how the two logs differ on it (channels in only one log included), in one streaming pass.
+
+    Timing channels (``is_timing``) are left out unless ``timing`` or ``reps`` names them."""
     topics = sorted(set(first.channels) | set(second.channels))
+    if not timing and not reps:
+        topics = [t for t in topics if not (is_timing(first, t) or is_timing(second, t))]
     if reps:
         known = sorted({t.split("/", 1)[-1] for t in topics})
         unknown = [r for r in reps if r not in known]
@@ -135,7 +153,8 @@ def run_compare(args: argparse.Namespace) -> int:
     reps = [r.strip() for r in args.rep.split(",") if r.strip()] if args.rep else None
     try:
         with LogReader(args.first) as first, LogReader(args.second) as second:
-            result = compare_logs(first, second, reps)
+            result = compare_logs(first, second, reps, timing=args.timing)
+            skipped = sorted(t for t in set(first.channels) | set(second.channels) if t not in result)
             problems = first.problems + second.problems
     except LogError as exc:
         print(f"tafel log compare: error: {exc}", file=sys.stderr)
@@ -151,6 +170,8 @@ def run_compare(args: argparse.Namespace) -> int:
                 print(f"      {path}: {a!r} != {b!r}")
             if len(difference.fields) > 10:
                 print(f"      ... and {len(difference.fields) - 10} more fields")
+        for topic in skipped:
+            print(f"  skipped  {topic}: not compared (not state: timing or debug output; --all compares it)")
         verdict = f"{len(differing)} of {len(result)} channels differ" if differing else f"no difference in {len(result)} channels"
         print(verdict)
     for problem in problems:
