@@ -12,6 +12,12 @@ from pathlib import Path
 
 import pytest
 
+from tafel.core.config import ConfigError
+from tafel.core.manager import Blackboard
+from tafel.platforms.network import GameNetwork, NetworkSettings
+from tafel.representations.game import GameControllerPackets, GameControllerReturn
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.team import IncomingTeamMessages, OutgoingTeamMessage
 from tests.test_cli_runtime import REPO, TAFEL
 
 DEFAULTS = ("--debug-port", "0", "--web-port", "0")  # the debug server and the web view, on free ports
@@ -81,3 +87,26 @@ def test_a_faithful_mujoco_replay_compares_equal_with_timing_and_drawings_record
     assert result.returncode == 0, result.stdout
     assert re.search(r"skipped  \w+/ModuleTimes: not compared", result.stdout), result.stdout
     assert compare(live, replay, "--all").returncode == 1  # timing really differs between the two runs
+
+
+def test_a_simulated_network_echoes_the_own_message_next_frame_and_opens_no_socket() -> None:
+    network = GameNetwork(NetworkSettings(), default_mode="simulated")
+    network.open()
+    assert network.team is None and network.game_controller is None
+    board = Blackboard()
+    for rep in (FrameInfo, OutgoingTeamMessage, IncomingTeamMessages, GameControllerPackets, GameControllerReturn):
+        board.ensure(rep)
+    board.set(FrameInfo(frame_number=1, time_ns=10))
+    board.set(OutgoingTeamMessage(data=b"hello"))
+    network.send(board)
+    network.receive(board, 20)
+    assert [d.data for d in board[IncomingTeamMessages].datagrams] == [b"hello"]
+    network.receive(board, 30)
+    assert board[IncomingTeamMessages].datagrams == []  # heard once
+    assert "simulated network" in network.status()
+    assert not GameNetwork(NetworkSettings(network="udp"), default_mode="simulated").simulated
+
+
+def test_an_unknown_network_mode_is_a_clear_error() -> None:
+    with pytest.raises(ConfigError, match="game.network takes one of 'auto', 'udp', 'simulated', got 'tcp'"):
+        NetworkSettings.from_config({"network": "tcp"})
