@@ -19,6 +19,8 @@ process (the debug server reads it between frames); each entry remembers the con
 
 from __future__ import annotations
 
+import dataclasses
+import math
 import sys
 import time
 from collections import deque
@@ -26,6 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tafel.core import representation
+from tafel.core.representation import RANGE_META
 from tafel.core.testing import RESET_HOOKS
 
 HISTORY = 300  # values kept per plot and per stopwatch
@@ -181,6 +184,22 @@ def modify(name: str, value: Any) -> Any:
         found = STATE.modifies[name] = Modify(name, context=STATE.context)
     found.value = value
     return found.pinned_value if found.pinned else value
+
+
+def modify_fields(prefix: str, values: Any, names: tuple[str, ...]) -> Any:
+    """Publish fields of a dataclass (a module's parameters) as ``modify`` values ``prefix:name``.
+
+    Returns ``values`` itself while nothing is pinned, else a copy with the pinned values, each clamped
+    into the range its field declares (``bounded``), so that a value tried live cannot leave it."""
+    pinned: dict[str, Any] = {}
+    declared = {item.name: item for item in dataclasses.fields(values)}
+    for name in names:
+        current = getattr(values, name)
+        wanted = modify(f"{prefix}:{name}", current)
+        if wanted != current:
+            low, high = declared[name].metadata.get(RANGE_META, (-math.inf, math.inf))
+            pinned[name] = type(current)(min(max(wanted, low), high))
+    return dataclasses.replace(values, **pinned) if pinned else values
 
 
 def stopwatch(name: str) -> Stopwatch:

@@ -6,9 +6,10 @@ Shared by the behaviours that kick (``Striker``, ``SoccerBehavior``); not a modu
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 from tafel.core import bounded
+from tafel.debug.concepts import modify_fields
 from tafel.representations import field
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import Foot, MotionRequest, MotionType, Odometry
@@ -28,6 +29,10 @@ class KickParameters:
     """rad the robot may face away from the kick direction for a kick"""
 
 
+#: the kick's parameters tried live (modify values Kick:NAME)
+KICK_TUNED = tuple(item.name for item in fields(KickParameters))
+
+
 def goal_direction(ball: BallModel, pose: RobotPose, odometry: Odometry) -> float:
     """rad in the robot frame from the ball to the opponent goal's centre; without a valid pose, the way
     the robot faced at the start (by odometry), which in the default scene is that goal as well."""
@@ -40,7 +45,10 @@ def goal_direction(ball: BallModel, pose: RobotPose, odometry: Odometry) -> floa
 def approach_and_kick(ball: BallModel, kick_direction: float, p: KickParameters, out: MotionRequest) -> tuple[float, float, float]:
     """Fill ``out``: kick towards ``kick_direction`` (rad, robot frame) when the ball lies right in front
     of the kicking foot, else walk to the point ``behind`` mm behind the ball on the kick's line, the
-    kicking foot in line with the ball. Returns that point and direction (mm, mm, rad; robot frame)."""
+    kicking foot in line with the ball. Returns that point and direction (mm, mm, rad; robot frame).
+
+    Every field of ``p`` is a modify value ``Kick:NAME``: pinned by a debug client, it is tried live."""
+    p = modify_fields("Kick", p, KICK_TUNED)
     foot = Foot.left if ball.y >= 0 else Foot.right
     side = p.foot_offset if foot is Foot.left else -p.foot_offset
     c, s = math.cos(kick_direction), math.sin(kick_direction)

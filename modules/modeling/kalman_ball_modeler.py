@@ -6,10 +6,14 @@ import math
 from dataclasses import dataclass
 
 from tafel.core import Module, provides, requires, uses
+from tafel.debug.concepts import modify_fields
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel
 from tafel.representations.motion_control import Odometry
 from tafel.representations.perception import BallPercept
+
+#: the filter's parameters tried live (modify values KalmanBallModeler:NAME)
+TUNED = ("acceleration_noise", "measurement_std", "measurement_std_per_m", "friction", "restart_gate", "forget_after")
 
 
 @dataclass
@@ -94,14 +98,15 @@ class KalmanBallModeler(Module):
         self.last_seen_ns: int | None = None
         self.last_odometry: tuple[float, float, float] | None = None
         self.outliers: list[tuple[float, float]] = []  # recent outliers in a row, in this frame's coordinates
+        self.tuned = self.parameters  # this frame's parameters, with the modify values pinned by a debug client
 
     def execute(self) -> None:
+        self.tuned = p = modify_fields("KalmanBallModeler", self.parameters, TUNED)
         now_ns = self.frame_info.time_ns
-        dt = self.parameters.nominal_dt
+        dt = p.nominal_dt
         if self.last_time_ns is not None and now_ns > self.last_time_ns:
             dt = (now_ns - self.last_time_ns) * 1e-9
         self.last_time_ns = now_ns
-        p = self.parameters
         self.follow_robot()
         if self.axes is not None:
             decay, q = math.exp(-p.friction * dt), p.acceleration_noise**2
@@ -136,7 +141,7 @@ class KalmanBallModeler(Module):
         self.outliers = [(c * ox + s * oy - forward, -s * ox + c * oy - left) for ox, oy in self.outliers]
 
     def update(self, x: float, y: float) -> None:
-        p = self.parameters
+        p = self.tuned
         std = p.measurement_std + p.measurement_std_per_m * math.hypot(x, y) / 1000.0
         r = std * std
         if self.axes is not None:
@@ -166,4 +171,4 @@ class KalmanBallModeler(Module):
         model.x, model.y, model.vx, model.vy = ax.p, ay.p, ax.v, ay.v
         model.position_std = math.sqrt(max(0.0, (ax.pp + ay.pp) / 2))
         model.time_since_seen = max(0.0, (now_ns - self.last_seen_ns) * 1e-9)
-        model.valid = model.time_since_seen <= self.parameters.forget_after
+        model.valid = model.time_since_seen <= self.tuned.forget_after

@@ -17,6 +17,7 @@ import numpy as np
 
 from tafel.core import Module, bounded, provides, requires
 from tafel.debug import drawing, plot, request
+from tafel.debug.concepts import modify_fields
 from tafel.modules.motion.inverse_kinematics import apply_leg_angles, leg_angles, pose
 from tafel.modules.motion.stand_motion import stand_pose
 from tafel.representations.infrastructure import FrameInfo
@@ -28,6 +29,8 @@ DRAW_STEPS = request("WalkingEngine:draw_steps", "planned footsteps and the walk
 WALKING = (MotionType.walk, MotionType.walk_to)
 ARMS = [JOINT_INDEX[n] for n in ("LShoulderPitch", "RShoulderPitch")]
 STAND = stand_pose()  # arms and head while walking; apply_leg_angles copies it
+#: the parameters tried live while the robot walks: modify values WalkingEngine:NAME (pin, watch, release)
+TUNED = ("step_duration", "hip_height", "torso_offset_x", "foot_lift", "sway", "gyro_pitch_gain", "gyro_roll_gain", "arm_swing")
 
 
 @requires(MotionRequest, MotionSelection, FrameInfo, InertialSensorData, FsrData)
@@ -90,9 +93,11 @@ class WalkingEngine(Module):
         self.target: np.ndarray | None = None  # walk_to target in odometry coordinates
         self.last_target = np.full(3, np.nan)
         self.last_ns: int | None = None
+        self.tuned = self.parameters  # this frame's parameters, with the modify values pinned by a debug client
 
     def execute(self) -> None:
-        p, out = self.parameters, self.walking_engine_output
+        self.tuned = modify_fields("WalkingEngine", self.parameters, TUNED)
+        p, out = self.tuned, self.walking_engine_output
         now_ns = self.frame_info.time_ns
         dt = (now_ns - self.last_ns) * 1e-9 if self.last_ns is not None and now_ns > self.last_ns else 0.01
         self.last_ns = now_ns
@@ -173,7 +178,7 @@ class WalkingEngine(Module):
 
     def begin_step(self, velocity: np.ndarray) -> None:
         """The swing foot has landed: it supports now, and the next step is planned."""
-        p = self.parameters
+        p = self.tuned
         if self.phase_s > 0.0 or self.started:
             self.support = Foot.right if self.support is Foot.left else Foot.left
         self.started = True
@@ -203,7 +208,7 @@ class WalkingEngine(Module):
         return self.step * sign
 
     def set_joints(self, swing: Foot, lift: float, sway: float, phase: float) -> None:
-        p, out = self.parameters, self.walking_engine_output
+        p, out = self.tuned, self.walking_engine_output
         height = p.hip_height + HIP_OFFSET_Z
         soles = {}
         for foot, side in ((Foot.left, 1.0), (Foot.right, -1.0)):
