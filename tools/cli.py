@@ -8,7 +8,6 @@ import errno
 import importlib
 import ipaddress
 import logging
-import math
 import os
 import pkgutil
 import re
@@ -35,6 +34,16 @@ from tafel.core.runtime import (
     program_fingerprint,
 )
 from tafel.debug.commands import frame_number
+from tafel.tools.arguments import (
+    add_console_command,
+    add_log_commands,
+    add_match_command,
+    add_replay_batch_command,
+    add_scenario_commands,
+    parse_speed,
+    port_number,
+    positive,
+)
 from tafel.tools.debugging import (
     DEBUG_REPRESENTATIONS,
     LocalExecutor,
@@ -68,42 +77,6 @@ def discover_modules() -> None:
     load_all()
     for info in pkgutil.walk_packages(modules.__path__, prefix="tafel.modules."):
         importlib.import_module(info.name)
-
-
-def parse_speed(text: str) -> float | None:
-    """``--speed``: a factor against the wall clock, or ``max`` (None: as fast as possible)."""
-    if text == "max":
-        return None
-    try:
-        return positive(float)(text)
-    except argparse.ArgumentTypeError:
-        raise argparse.ArgumentTypeError(f"--speed takes a positive number or 'max', got {text!r}") from None
-
-
-def positive(kind: type) -> Any:
-    """An argparse type accepting numbers of ``kind`` greater than zero."""
-
-    def parse(text: str) -> Any:
-        try:
-            value = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected a {'whole ' if kind is int else ''}number, got {text!r}") from None
-        if not math.isfinite(value) or value <= 0:
-            raise argparse.ArgumentTypeError(f"expected a number greater than zero, got {text}")
-        return value
-
-    return parse
-
-
-def port_number(text: str) -> int:
-    """A TCP port: 0 (any free one) to 65535."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"a port is a whole number from 0 to 65535, got {text!r}") from None
-    if not 0 <= value <= 65535:
-        raise argparse.ArgumentTypeError(f"a port is a whole number from 0 to 65535 (0: any free one), got {value}")
-    return value
 
 
 def add_program_arguments(parser: argparse.ArgumentParser) -> None:
@@ -160,20 +133,11 @@ def build_parser() -> argparse.ArgumentParser:
                      help=f"serve Foxglove and Lichtblick live over WebSocket (default 127.0.0.1:{DEFAULT_FOXGLOVE_PORT}; "
                           "with --debug-token clients must give it: ws://HOST:PORT/?token=T)")
 
-    from tafel.tools.log_tools import add_log_commands
-
+    # the tools' command lines only: each tool's code (MuJoCo for match, protobuf for logs) loads when it runs
     add_log_commands(commands)
-    from tafel.tools.console import add_console_command
-
     add_console_command(commands)
-    from tafel.tools.match import add_match_command
-
     add_match_command(commands)
-    from tafel.tools.scenarios import add_scenario_commands
-
     add_scenario_commands(commands)
-    from tafel.tools.replay_batch import add_replay_batch_command
-
     add_replay_batch_command(commands)
 
     platforms = commands.add_parser("platforms", help="list the platforms and what they provide and consume")

@@ -6,25 +6,10 @@ import argparse
 import re
 import sys
 from pathlib import Path
-from typing import Any
 
 from tafel.debug.client import DebugClient
 
 HISTORY = Path.home() / ".tafel_history"
-
-
-def port_number(text: str) -> int:
-    from tafel.tools.cli import port_number as parse
-
-    return parse(text)
-
-
-def add_console_command(commands: Any) -> None:
-    console = commands.add_parser("console", help="talk to a running program's debug server")
-    console.add_argument("--host", default="127.0.0.1")
-    console.add_argument("--port", type=port_number, default=5401)
-    console.add_argument("--token", help="send 'auth TOKEN' first")
-    console.add_argument("-c", dest="one_command", metavar="COMMAND", help="run one command, print its answer and exit (status 1 on error:)")
 
 
 def run_console(args: argparse.Namespace) -> int:

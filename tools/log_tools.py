@@ -13,7 +13,6 @@ import json
 import logging
 import sys
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -21,42 +20,6 @@ from google.protobuf import descriptor_pool, message_factory
 
 from tafel.core.logfile import LogError, LogReader, write_slice
 from tafel.core.naming import did_you_mean
-
-
-def add_log_commands(commands: Any) -> None:
-    log = commands.add_parser("log", help="inspect and export recorded logs")
-    actions = log.add_subparsers(dest="log_command", metavar="ACTION")
-    actions.required = True
-    info = actions.add_parser("info", help="duration, frames per context, channels with counts and sizes")
-    info.add_argument("file", type=Path)
-    info.add_argument("--json", action="store_true", help="print the information as JSON")
-    export = actions.add_parser("export", help="representations as CSV or JSON lines, images as PNG files")
-    export.add_argument("file", type=Path)
-    export.add_argument("--rep", required=True, help="representation name (tafel log info lists them)")
-    export.add_argument("--context", choices=["cognition", "motion"], help="only this context's channel")
-    export.add_argument("--format", required=True, choices=["csv", "jsonl", "png"])
-    export.add_argument("--out", required=True, type=Path, help="output file (csv, jsonl) or folder (png)")
-    compare = actions.add_parser("compare", help="where two logs differ: per channel, the first differing frame and field",
-                                 description="Compare two logs frame by frame, per context and representation; "
-                                             "exit status 1 when they differ.")
-    compare.add_argument("first", type=Path, metavar="A.mcap")
-    compare.add_argument("second", type=Path, metavar="B.mcap")
-    compare.add_argument("--rep", metavar="A,B", help="only these representations")
-    compare.add_argument("--json", action="store_true", help="print the report as JSON")
-    piece = actions.add_parser("slice", help="copy a piece of a log (some representations, some seconds) into a new one",
-                               description="A situation from a game as a small log: for module tests (replay_module) "
-                                           "and for sharing.")
-    piece.add_argument("file", type=Path)
-    piece.add_argument("--out", required=True, type=Path, help="the new log")
-    piece.add_argument("--rep", metavar="A,B", help="only these representations (default: all)")
-    piece.add_argument("--start", type=float, default=0.0, metavar="S", help="seconds after the log's start (default 0)")
-    piece.add_argument("--seconds", type=float, metavar="N", help="how long (default: to the end)")
-    convert = actions.add_parser("convert", help="a copy of a log with Foxglove's channels added (images, scene, series)",
-                                 description="For logs recorded before recordings carried Foxglove's channels: the copy "
-                                             "opens in Foxglove and Lichtblick with images, 3D scene and plots.")
-    convert.add_argument("file", type=Path)
-    convert.add_argument("--out", required=True, type=Path, help="the new log")
-    convert.add_argument("--jpeg-quality", type=int, default=80, metavar="Q", help="JPEG quality of the images, 1 to 100 (default 80)")
 
 
 def run_log_command(args: argparse.Namespace) -> int:

@@ -29,46 +29,14 @@ from typing import Any, TextIO
 
 from tafel.platforms.match_robot import AUTHKEY_ENV
 from tafel.platforms.match_world import TICK_NS, MatchWorld, Side
+from tafel.tools.arguments import MAX_PLAYERS_PER_TEAM
 from tafel.tools.referee import Player, Referee
 
-MAX_PLAYERS_PER_TEAM = 5
 TEAM_NUMBERS = (1, 2)
 #: where robots enter (team frame, mm and rad): on the own half's touchline, facing the field
 ENTRY = [(-3600.0 + 700.0 * k, -3000.0, math.pi / 2) for k in range(MAX_PLAYERS_PER_TEAM)]
 CONNECT_TIMEOUT_S = 120.0  # robots import, plan and open their cameras before they join
 STOP_TIMEOUT_S = 20.0
-
-
-def parse_teams(text: str) -> tuple[int, int]:
-    """``--teams``: NvM with N, M from 0 to 5 and at least one robot, e.g. 2v2 or 1v0."""
-    match = re.fullmatch(r"(\d)v(\d)", text.strip().lower())
-    if not match or int(match[1]) > MAX_PLAYERS_PER_TEAM or int(match[2]) > MAX_PLAYERS_PER_TEAM or match[1] == match[2] == "0":
-        raise argparse.ArgumentTypeError(f"--teams takes NvM with 0 to {MAX_PLAYERS_PER_TEAM} robots a team (1v1, 2v2, 5v5, 1v0), got {text!r}")
-    return int(match[1]), int(match[2])
-
-
-def add_match_command(commands: Any) -> None:
-    from tafel.core.platform import seed_number
-    from tafel.tools.cli import parse_speed, positive
-
-    match = commands.add_parser("match", help="play a simulated game: several robots in MuJoCo, refereed by a simulated GameController")
-    match.add_argument("--teams", type=parse_teams, default=(1, 1), metavar="NvM", help="robots per team, 1v1 to 5v5 or e.g. 1v0 (default 1v1)")
-    match.add_argument("--seconds", type=positive(float), default=600.0, help="playing time of the whole game, both halves (default 600)")
-    match.add_argument("--cameras", choices=["on", "off"], default="on",
-                       help="on: every robot renders its cameras and sees through them; off: perception from ground truth")
-    match.add_argument("--speed", type=parse_speed, default=1.0, help="pace against the wall clock: a factor, or 'max'")
-    match.add_argument("--seed", type=seed_number, default=0, help="seed of every robot's sensor noise")
-    match.add_argument("--record-dir", type=Path, metavar="DIR", help="every robot records its log here (TEAM_PLAYER.mcap)")
-    match.add_argument("--record-reps", metavar="A,B", help="record only these representations (as tafel run --record-reps)")
-    match.add_argument("--result", type=Path, metavar="FILE.json", help="also write the result's JSON object here")
-    match.add_argument("--resolution", default="320x240", help="camera image size WIDTHxHEIGHT")
-    match.add_argument("--ready-seconds", type=positive(float), default=30.0, help="longest READY (default 30)")
-    match.add_argument("--goals", type=positive(int), metavar="N", help="end the game when a team has scored N goals (drills, tests)")
-    match.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                       help="a configuration override for every robot's program (repeatable)")
-    for team in (1, 2):
-        match.add_argument(f"--team{team}-set", dest=f"team{team}_overrides", action="append", default=[], metavar="KEY=VALUE",
-                           help=f"a configuration override for team {team}'s robots only, after --set (repeatable)")
 
 
 @dataclass

@@ -26,7 +26,7 @@ from typing import Any
 
 from tafel.core.logfile import LogError, LogReader
 from tafel.core.naming import did_you_mean
-from tafel.tools.batch import BatchError, BatchInfo, default_workers, run_jobs
+from tafel.tools.batch import BatchError, BatchInfo, run_jobs
 from tafel.tools.log_compare import compare_logs
 from tafel.tools.log_tools import decoded_messages
 from tafel.tools.scenarios import plural, warm_up
@@ -147,28 +147,6 @@ def replay_log(job: ReplayJob) -> dict[str, Any]:
 
 
 # ------------------------------------------------------------------------------------ the command
-def add_replay_batch_command(commands: Any) -> None:
-    batch = commands.add_parser("replay-batch", help="replay many logs with a changed configuration or module; what differs",
-                                description="Replay every log (paths or globs) with the changes given, record the replay, and "
-                                            "report per log what differs from the recorded outputs (--compare) and chosen "
-                                            "metrics, as CSV and a summary. Exit status 1 when --compare finds a difference, "
-                                            "2 for a log that cannot be replayed or a bad option.")
-    batch.add_argument("logs", nargs="+", metavar="LOG_OR_GLOB")
-    batch.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                       help="configuration override for every replay (repeatable), as with tafel run")
-    batch.add_argument("--replace", default="", metavar="A,B", help="feed these recorded representations instead of running their providers")
-    batch.add_argument("--add-module", action="append", default=[], metavar="CONTEXT:MODULE", help="run this module too (repeatable)")
-    batch.add_argument("--remove-module", action="append", default=[], metavar="CONTEXT:MODULE", help="leave this module out (repeatable)")
-    batch.add_argument("--compare", action="store_true", help="compare every replay with its log, as tafel log compare does")
-    batch.add_argument("--metric", action="append", default=[], metavar="REP.FIELD",
-                       help="report the mean of a representation's field, recorded and replayed (repeatable); tafel log info lists them")
-    batch.add_argument("--out", type=Path, default=Path("replay-batch.csv"), metavar="FILE.csv", help="one row per log (default: %(default)s)")
-    batch.add_argument("--artifacts", type=Path, metavar="DIR", help="keep the replayed logs in this folder (on Ray: one every node shares)")
-    batch.add_argument("--workers", type=int, metavar="K", help=f"logs at a time (default: all cores, here {default_workers()})")
-    batch.add_argument("--ray", nargs="?", const="local", metavar="ADDRESS",
-                       help="replay each log as a Ray task: alone, on a local Ray instance; with HOST:PORT, on that cluster")
-
-
 COLUMNS = ["log", "status", "ended", "frames", "channels", "channels_differing", "first_difference", "differing", "wall_s", "replay", "error"]
 
 

@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from tafel.tools.batch import BatchError, BatchInfo, default_workers, run_jobs
+from tafel.tools.batch import BatchError, BatchInfo, run_jobs
 from tafel.tools.scenario_file import Scenario, ScenarioError, load_scenario
 from tafel.tools.scenario_predicates import PREDICATES
 
@@ -277,28 +277,6 @@ def write_rows(path: Path, rows: Sequence[dict[str, Any]]) -> None:
 
 
 # ------------------------------------------------------------------------------------ the command
-def add_scenario_commands(commands: Any) -> None:
-    scenarios = commands.add_parser("scenarios", help="run scenario files many times with perturbations; success rates",
-                                    description="Scenario tests: each file N times with seeded perturbations, headless at full "
-                                                "speed, on all cores or on Ray. Exit status 1 when a success rate is below its "
-                                                "scenario's requirement, 2 for a bad file or option.")
-    actions = scenarios.add_subparsers(dest="scenarios_command", metavar="ACTION")
-    actions.required = True
-    run = actions.add_parser("run", help="run scenarios and report success rates")
-    run.add_argument("files", nargs="+", type=Path, metavar="FILE.toml")
-    run.add_argument("--repeat", type=int, default=10, metavar="N", help="runs of every scenario (default 10)")
-    run.add_argument("--seed", type=int, default=0, metavar="S", help="base seed: the same seed gives the same runs (default 0)")
-    run.add_argument("--workers", type=int, metavar="K", help=f"runs at a time (default: all cores, here {default_workers()})")
-    run.add_argument("--out", type=Path, default=Path("scenario-runs.csv"), metavar="FILE",
-                     help="one row per run: .csv or .jsonl (default: %(default)s)")
-    run.add_argument("--artifacts", type=Path, metavar="DIR",
-                     help="where logs of failed runs go; on a Ray cluster a folder every node shares (default: scenario-logs)")
-    run.add_argument("--no-logs", action="store_true", help="do not record failed runs again")
-    run.add_argument("--ray", nargs="?", const="local", metavar="ADDRESS",
-                     help="run each run as a Ray task: alone, on a local Ray instance; with HOST:PORT, on that cluster")
-    actions.add_parser("predicates", help="the predicates success conditions are built from, with their parameters")
-
-
 def print_predicates() -> int:
     from tafel.tools.scenario_predicates import REQUIRED, TIMING
 

@@ -1,0 +1,179 @@
+"""The command lines of ``tafel``'s subcommands: argparse only, so that building the parser is cheap.
+
+``tafel --help``, ``tafel console`` and ``tafel log info`` build the whole parser; the code that runs a
+command (MuJoCo for ``match``, the scenario runner, protobuf for logs) is imported by that command alone
+(``tafel.tools.<module>``, loaded when it runs). Keep the imports here to the standard library.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import re
+from pathlib import Path
+from typing import Any
+
+
+def parse_speed(text: str) -> float | None:
+    """``--speed``: a factor against the wall clock, or ``max`` (None: as fast as possible)."""
+    if text == "max":
+        return None
+    try:
+        return positive(float)(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"--speed takes a positive number or 'max', got {text!r}") from None
+
+
+def positive(kind: type) -> Any:
+    """An argparse type accepting numbers of ``kind`` greater than zero."""
+
+    def parse(text: str) -> Any:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a {'whole ' if kind is int else ''}number, got {text!r}") from None
+        if not math.isfinite(value) or value <= 0:
+            raise argparse.ArgumentTypeError(f"expected a number greater than zero, got {text}")
+        return value
+
+    return parse
+
+
+def port_number(text: str) -> int:
+    """A TCP port: 0 (any free one) to 65535."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a port is a whole number from 0 to 65535, got {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"a port is a whole number from 0 to 65535 (0: any free one), got {value}")
+    return value
+
+
+#: robots a team may field in ``tafel match`` (the SPL's five)
+MAX_PLAYERS_PER_TEAM = 5
+
+
+def parse_teams(text: str) -> tuple[int, int]:
+    """``--teams``: NvM with N, M from 0 to 5 and at least one robot, e.g. 2v2 or 1v0."""
+    match = re.fullmatch(r"(\d)v(\d)", text.strip().lower())
+    if not match or int(match[1]) > MAX_PLAYERS_PER_TEAM or int(match[2]) > MAX_PLAYERS_PER_TEAM or match[1] == match[2] == "0":
+        raise argparse.ArgumentTypeError(f"--teams takes NvM with 0 to {MAX_PLAYERS_PER_TEAM} robots a team (1v1, 2v2, 5v5, 1v0), got {text!r}")
+    return int(match[1]), int(match[2])
+
+
+def add_match_command(commands: Any) -> None:
+    from tafel.core.platform import seed_number
+
+    match = commands.add_parser("match", help="play a simulated game: several robots in MuJoCo, refereed by a simulated GameController")
+    match.add_argument("--teams", type=parse_teams, default=(1, 1), metavar="NvM", help="robots per team, 1v1 to 5v5 or e.g. 1v0 (default 1v1)")
+    match.add_argument("--seconds", type=positive(float), default=600.0, help="playing time of the whole game, both halves (default 600)")
+    match.add_argument("--cameras", choices=["on", "off"], default="on",
+                       help="on: every robot renders its cameras and sees through them; off: perception from ground truth")
+    match.add_argument("--speed", type=parse_speed, default=1.0, help="pace against the wall clock: a factor, or 'max'")
+    match.add_argument("--seed", type=seed_number, default=0, help="seed of every robot's sensor noise")
+    match.add_argument("--record-dir", type=Path, metavar="DIR", help="every robot records its log here (TEAM_PLAYER.mcap)")
+    match.add_argument("--record-reps", metavar="A,B", help="record only these representations (as tafel run --record-reps)")
+    match.add_argument("--result", type=Path, metavar="FILE.json", help="also write the result's JSON object here")
+    match.add_argument("--resolution", default="320x240", help="camera image size WIDTHxHEIGHT")
+    match.add_argument("--ready-seconds", type=positive(float), default=30.0, help="longest READY (default 30)")
+    match.add_argument("--goals", type=positive(int), metavar="N", help="end the game when a team has scored N goals (drills, tests)")
+    match.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                       help="a configuration override for every robot's program (repeatable)")
+    for team in (1, 2):
+        match.add_argument(f"--team{team}-set", dest=f"team{team}_overrides", action="append", default=[], metavar="KEY=VALUE",
+                           help=f"a configuration override for team {team}'s robots only, after --set (repeatable)")
+
+
+def add_scenario_commands(commands: Any) -> None:
+    from tafel.tools.batch import default_workers
+
+    scenarios = commands.add_parser("scenarios", help="run scenario files many times with perturbations; success rates",
+                                    description="Scenario tests: each file N times with seeded perturbations, headless at full "
+                                                "speed, on all cores or on Ray. Exit status 1 when a success rate is below its "
+                                                "scenario's requirement, 2 for a bad file or option.")
+    actions = scenarios.add_subparsers(dest="scenarios_command", metavar="ACTION")
+    actions.required = True
+    run = actions.add_parser("run", help="run scenarios and report success rates")
+    run.add_argument("files", nargs="+", type=Path, metavar="FILE.toml")
+    run.add_argument("--repeat", type=int, default=10, metavar="N", help="runs of every scenario (default 10)")
+    run.add_argument("--seed", type=int, default=0, metavar="S", help="base seed: the same seed gives the same runs (default 0)")
+    run.add_argument("--workers", type=int, metavar="K", help=f"runs at a time (default: all cores, here {default_workers()})")
+    run.add_argument("--out", type=Path, default=Path("scenario-runs.csv"), metavar="FILE",
+                     help="one row per run: .csv or .jsonl (default: %(default)s)")
+    run.add_argument("--artifacts", type=Path, metavar="DIR",
+                     help="where logs of failed runs go; on a Ray cluster a folder every node shares (default: scenario-logs)")
+    run.add_argument("--no-logs", action="store_true", help="do not record failed runs again")
+    run.add_argument("--ray", nargs="?", const="local", metavar="ADDRESS",
+                     help="run each run as a Ray task: alone, on a local Ray instance; with HOST:PORT, on that cluster")
+    actions.add_parser("predicates", help="the predicates success conditions are built from, with their parameters")
+
+
+def add_replay_batch_command(commands: Any) -> None:
+    from tafel.tools.batch import default_workers
+
+    batch = commands.add_parser("replay-batch", help="replay many logs with a changed configuration or module; what differs",
+                                description="Replay every log (paths or globs) with the changes given, record the replay, and "
+                                            "report per log what differs from the recorded outputs (--compare) and chosen "
+                                            "metrics, as CSV and a summary. Exit status 1 when --compare finds a difference, "
+                                            "2 for a log that cannot be replayed or a bad option.")
+    batch.add_argument("logs", nargs="+", metavar="LOG_OR_GLOB")
+    batch.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                       help="configuration override for every replay (repeatable), as with tafel run")
+    batch.add_argument("--replace", default="", metavar="A,B", help="feed these recorded representations instead of running their providers")
+    batch.add_argument("--add-module", action="append", default=[], metavar="CONTEXT:MODULE", help="run this module too (repeatable)")
+    batch.add_argument("--remove-module", action="append", default=[], metavar="CONTEXT:MODULE", help="leave this module out (repeatable)")
+    batch.add_argument("--compare", action="store_true", help="compare every replay with its log, as tafel log compare does")
+    batch.add_argument("--metric", action="append", default=[], metavar="REP.FIELD",
+                       help="report the mean of a representation's field, recorded and replayed (repeatable); tafel log info lists them")
+    batch.add_argument("--out", type=Path, default=Path("replay-batch.csv"), metavar="FILE.csv", help="one row per log (default: %(default)s)")
+    batch.add_argument("--artifacts", type=Path, metavar="DIR", help="keep the replayed logs in this folder (on Ray: one every node shares)")
+    batch.add_argument("--workers", type=int, metavar="K", help=f"logs at a time (default: all cores, here {default_workers()})")
+    batch.add_argument("--ray", nargs="?", const="local", metavar="ADDRESS",
+                       help="replay each log as a Ray task: alone, on a local Ray instance; with HOST:PORT, on that cluster")
+
+
+def add_log_commands(commands: Any) -> None:
+    log = commands.add_parser("log", help="inspect and export recorded logs")
+    actions = log.add_subparsers(dest="log_command", metavar="ACTION")
+    actions.required = True
+    info = actions.add_parser("info", help="duration, frames per context, channels with counts and sizes")
+    info.add_argument("file", type=Path)
+    info.add_argument("--json", action="store_true", help="print the information as JSON")
+    export = actions.add_parser("export", help="representations as CSV or JSON lines, images as PNG files")
+    export.add_argument("file", type=Path)
+    export.add_argument("--rep", required=True, help="representation name (tafel log info lists them)")
+    export.add_argument("--context", choices=["cognition", "motion"], help="only this context's channel")
+    export.add_argument("--format", required=True, choices=["csv", "jsonl", "png"])
+    export.add_argument("--out", required=True, type=Path, help="output file (csv, jsonl) or folder (png)")
+    compare = actions.add_parser("compare", help="where two logs differ: per channel, the first differing frame and field",
+                                 description="Compare two logs frame by frame, per context and representation; "
+                                             "exit status 1 when they differ.")
+    compare.add_argument("first", type=Path, metavar="A.mcap")
+    compare.add_argument("second", type=Path, metavar="B.mcap")
+    compare.add_argument("--rep", metavar="A,B", help="only these representations")
+    compare.add_argument("--json", action="store_true", help="print the report as JSON")
+    compare.add_argument("--all", action="store_true", dest="timing",
+                         help="also compare what is not state: timing (ModuleTimes) and debug output (drawings, plots)")
+    piece = actions.add_parser("slice", help="copy a piece of a log (some representations, some seconds) into a new one",
+                               description="A situation from a game as a small log: for module tests (replay_module) "
+                                           "and for sharing.")
+    piece.add_argument("file", type=Path)
+    piece.add_argument("--out", required=True, type=Path, help="the new log")
+    piece.add_argument("--rep", metavar="A,B", help="only these representations (default: all)")
+    piece.add_argument("--start", type=float, default=0.0, metavar="S", help="seconds after the log's start (default 0)")
+    piece.add_argument("--seconds", type=float, metavar="N", help="how long (default: to the end)")
+    convert = actions.add_parser("convert", help="a copy of a log with Foxglove's channels added (images, scene, series)",
+                                 description="For logs recorded before recordings carried Foxglove's channels: the copy "
+                                             "opens in Foxglove and Lichtblick with images, 3D scene and plots.")
+    convert.add_argument("file", type=Path)
+    convert.add_argument("--out", required=True, type=Path, help="the new log")
+    convert.add_argument("--jpeg-quality", type=int, default=80, metavar="Q", help="JPEG quality of the images, 1 to 100 (default 80)")
+
+
+def add_console_command(commands: Any) -> None:
+    console = commands.add_parser("console", help="talk to a running program's debug server")
+    console.add_argument("--host", default="127.0.0.1")
+    console.add_argument("--port", type=port_number, default=5401)
+    console.add_argument("--token", help="send 'auth TOKEN' first")
+    console.add_argument("-c", dest="one_command", metavar="COMMAND", help="run one command, print its answer and exit (status 1 on error:)")
