@@ -148,6 +148,8 @@ class ModuleManager:
         self.name = name
         self.strict = strict
         self.frame = 0
+        #: the module running now, "" between modules (read by the watchdog from another thread)
+        self.running = ""
         self.blackboard = Blackboard()
         self.log = logging.getLogger(f"tafel.{name}")
         #: called before and after each frame (for example debug commands between frames)
@@ -185,6 +187,7 @@ class ModuleManager:
         index = self.frame % TIMING_WINDOW
         last = clock()
         for slot in self._slots:
+            self.running = slot.name
             try:
                 slot.run()
             except Exception as exc:
@@ -195,6 +198,7 @@ class ModuleManager:
             now = clock()
             slot.times[index] = now - last
             last = now
+        self.running = ""
         for hook in self.after_frame:
             hook()
 

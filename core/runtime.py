@@ -30,6 +30,8 @@ from fractions import Fraction
 from typing import Any
 
 from tafel.core import clock
+from tafel.core.errors import TafelError
+from tafel.core.extensions import load_modules, loaded_folders
 from tafel.core.handover import Bundle, LocalChannel, SharedChannel, apply_bundle, make_bundle
 from tafel.core.manager import ModuleManager
 from tafel.core.platform import EndOfData, Platform, PlatformError
@@ -39,6 +41,7 @@ from tafel.core.representation import defining_modules, is_state
 from tafel.core.serialization import SerializationError, serialize
 from tafel.core.statistics import PeriodStatistics
 from tafel.core.status import CognitionStatus
+from tafel.core.watchdog import STUCK_TIMEOUT_S, ContextStuck, Watchdog
 
 log = logging.getLogger("tafel.runtime")
 
@@ -223,8 +226,12 @@ class LockstepRuntime:
     """Deterministic single-threaded runtime for platforms with a simulated clock."""
 
     def __init__(self, plans: Mapping[str, ContextPlan], platform: Platform, *, strict: bool = False,
-                 recorder: Recorder | None = None) -> None:
+                 recorder: Recorder | None = None, stuck_timeout_s: float = STUCK_TIMEOUT_S) -> None:
         self.platform = platform
+        #: s a module may run without returning before ``run`` ends the program (0: no watchdog)
+        self.stuck_timeout_s = stuck_timeout_s
+        #: context -> why it failed (a stuck module)
+        self.failures: dict[str, str] = {}
         self.recorder = recorder
         self.plans = {name: plan for name, plan in plans.items() if plan.runs}
         if not self.plans:
@@ -302,6 +309,8 @@ class LockstepRuntime:
     def run(self, limits: Limits) -> dict[str, ContextStats]:
         self.open()
         start = time.monotonic()
+        watchdog = Watchdog(self.managers, self.stuck_timeout_s, on_stuck=self.failures.__setitem__).start() \
+            if self.stuck_timeout_s else None
         try:
             if self.platform.drives_schedule:
                 self._run_platform_schedule(limits)
@@ -309,7 +318,11 @@ class LockstepRuntime:
                 self._run_rate_schedule(limits)
         except EndOfData as exc:
             self.end_reason = str(exc) or "end of data"
+        except ContextStuck:
+            self.end_reason = next(iter(self.failures.values()), "a module got stuck")
         finally:
+            if watchdog is not None:
+                watchdog.stop()
             self.wall_s = time.monotonic() - start
             self.close()
         if self.stop.is_set() and not self.end_reason:
@@ -404,6 +417,7 @@ class LockstepRuntime:
             stats = runner.stats(self.wall_s)
             stats.digest = state_digest(runner.manager)
             stats.finished = True
+            stats.failure = self.failures.get(name, "")
             result[name] = stats
         return result
 
@@ -432,6 +446,10 @@ class WorkerSpec:
     clock_origin_ns: int = 0
     #: Python modules imported first, so the process knows every representation the program knows
     imports: tuple[str, ...] = ()
+    #: folders of the program's own module files (``--module-path``), imported as the supervisor did
+    module_paths: tuple[str, ...] = ()
+    #: s a module may run without returning before the context ends (0: no watchdog)
+    stuck_timeout_s: float = STUCK_TIMEOUT_S
 
 
 def try_realtime(priority: int) -> str:
@@ -469,12 +487,15 @@ def run_context_loop(
     report: Callable[[ContextStats], None],
     cognition_watch: Callable[[], tuple[bool, int, float]] | None = None,
     realtime: str = "",
+    stuck_timeout_s: float = 0.0,
 ) -> ContextStats:
-    """Run one context at its own pace until ``stop``, the limits, or the end of the data.
+    """Run one context at its own pace until ``stop``, the limits, the end of the data, or a module that
+    does not return within ``stuck_timeout_s`` (the watchdog; 0: none).
 
     With a simulated or wall clock the loop sleeps to absolute deadlines (``deadline += period``), and
     a late frame never shifts the beat; with a platform clock ``sense`` blocks and sets the pace.
     """
+    watchdog = Watchdog({runner.name: runner.manager}, stuck_timeout_s).start() if stuck_timeout_s else None
     plan = runner.plan
     own_clock = runner.platform.clock == "own"
     period_ns = int(1e9 / plan.rate_hz)
@@ -510,12 +531,17 @@ def run_context_loop(
                 report(_snapshot_stats(runner, stats, start_ns))
     except EndOfData:
         pass
+    except ContextStuck:  # the watchdog has said which module and why
+        stats.failure = watchdog.stuck if watchdog is not None else "stuck"
     except PlatformError as exc:  # a known failure (lost device, bad data): say it plainly
         stats.failure = str(exc)
         log.error("%s stopped: %s", plan.name, exc)
     except Exception as exc:  # noqa: BLE001 - anything else ends this context with a report
         stats.failure = f"{type(exc).__name__}: {exc}"
         log.exception("%s loop failed", plan.name)
+    finally:
+        if watchdog is not None:
+            watchdog.stop()
     final = _snapshot_stats(runner, stats, start_ns)
     final.finished = True
     report(final)
@@ -583,6 +609,10 @@ def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
                      daemon=True).start()
     clock.set_origin(spec.clock_origin_ns)
     logging.basicConfig(level=logging.WARNING, format=f"[{spec.plan.name}] %(levelname)s %(message)s")
+    try:
+        load_modules(spec.module_paths)
+    except TafelError as exc:  # the supervisor imported them: this is unlikely, and reported when it matters
+        log.warning("%s", exc)
     import_definitions(spec.imports)
     realtime = try_realtime(spec.realtime_priority) if spec.plan.name == "motion" else ""
     inbox = SharedChannel.attach(spec.inbox_name) if spec.inbox_name else None
@@ -613,7 +643,7 @@ def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
         if spec.plan.name == "motion" and watch is None:
             watch = lambda: (False, 0, 0.0)  # noqa: E731 - no cognition context at all
         final = run_context_loop(runner, spec.limits, stop, is_main=spec.is_main, report=send,
-                                 cognition_watch=watch, realtime=realtime)
+                                 cognition_watch=watch, realtime=realtime, stuck_timeout_s=spec.stuck_timeout_s)
         final.digest = state_digest(manager)
         final.record_dropped = sink.dropped if sink else 0
         send(final)
@@ -652,8 +682,9 @@ class ConcurrentRuntime:
                  platform_options: Mapping[str, Any], *, strict: bool = False, stall_timeout_s: float = 1.0,
                  recorder: Recorder | None = None,
                  worker_setup: tuple[Callable[[ContextRunner, Any], None], Any] | None = None,
-                 grace_s: float = SHUTDOWN_GRACE_S) -> None:
+                 grace_s: float = SHUTDOWN_GRACE_S, stuck_timeout_s: float = STUCK_TIMEOUT_S) -> None:
         self.recorder = recorder
+        self.stuck_timeout_s = stuck_timeout_s
         #: s the context processes get to stop once asked; then their stacks are dumped and they are ended
         self.grace_s = grace_s
         self.worker_setup = worker_setup
@@ -704,7 +735,7 @@ class ConcurrentRuntime:
                     outbox_name=channels[name].name, stall_timeout_s=self.stall_timeout_s,
                     record=self.recorder.by_context.get(name, []) if self.recorder else [], record_queue=record_queue,
                     record_switch=self.record_switch, setup=self.worker_setup, clock_origin_ns=clock.origin_ns(),
-                    imports=tuple(defining_modules()),
+                    imports=tuple(defining_modules()), module_paths=tuple(loaded_folders()), stuck_timeout_s=self.stuck_timeout_s,
                 )
                 receiver, sender = self._mp.Pipe(duplex=False)
                 process = self._mp.Process(target=_worker_main, args=(spec, self.stop, sender), name=f"tafel-{name}", daemon=True)
@@ -751,6 +782,8 @@ class ConcurrentRuntime:
                     except (EOFError, OSError):
                         del open_connections[name]
                         continue
+                    if self.stats[name].finished and self.stats[name].failure and name not in self.dead:
+                        self._ended(name, self.stats[name].failure)
                     for hook in self.on_report:
                         hook(self)
             for name, process in self.processes.items():
@@ -758,13 +791,7 @@ class ConcurrentRuntime:
                     reported_dead.add(name)
                     self.exit_codes[name] = process.exitcode
                     if not self.stats[name].finished:
-                        self.dead[name] = f"process died (exit code {process.exitcode})"
-                        if name == self.main:  # nothing drives the robot any more: the program ends, and fails
-                            self.stats[name].failure = self.dead[name]
-                            self.notices.append(f"{name} process died (exit code {process.exitcode}); the program ends")
-                        else:
-                            self.notices.append(f"{name} process died (exit code {process.exitcode}); the other context keeps running")
-                        log.error(self.notices[-1])
+                        self._ended(name, f"process died (exit code {process.exitcode})")
                         open_connections.pop(name, None)
                         for hook in self.on_report:
                             hook(self)
@@ -776,6 +803,18 @@ class ConcurrentRuntime:
                 self._stopping_since = self._stopping_since or time.monotonic()
                 if time.monotonic() - self._stopping_since > self.grace_s:
                     break  # a context that does not stop in time: run() ends it
+
+    def _ended(self, name: str, why: str) -> None:
+        """A context died or failed (a stuck module): a failure of the program, whichever context it was.
+        Without the main context nothing drives the robot, so the program ends; without cognition motion
+        goes on with its safe motions."""
+        self.dead[name] = why
+        self.stats[name].failure = self.stats[name].failure or why
+        consequence = "the program ends" if name == self.main else "the other context keeps running"
+        self.notices.append(f"{name} {why}; {consequence}")
+        log.error(self.notices[-1])
+        if name == self.main:
+            self.stop.set()
 
     def alive(self, name: str) -> bool:
         """Whether the context's process runs (or has not started yet)."""

@@ -64,3 +64,31 @@ class StuckForever(Module):
 @requires(FrameInfo)
 class CrashMotionProcess(CrashCognitionProcess):
     """The same abrupt end, placed in motion: the program must end and say why."""
+
+
+@requires(FrameInfo)
+class SlowEveryFrame(Module):
+    """Takes ``seconds`` every frame: a program too slow for real time (the pacing notice's case)."""
+
+    @dataclass
+    class Parameters:
+        seconds: float = 0.06
+
+    def execute(self) -> None:
+        time.sleep(self.parameters.seconds)
+
+
+@requires(FrameInfo)
+class StuckAfter(Module):
+    """Busy forever in pure Python after ``after_frames`` frames (an endless loop in a module's code),
+    in whichever context configuration puts it: the watchdog's case."""
+
+    @dataclass
+    class Parameters:
+        after_frames: int = 20
+
+    def execute(self) -> None:
+        if self.frame_info.frame_number >= self.parameters.after_frames:
+            spins = 0
+            while True:
+                spins += 1
