@@ -590,6 +590,21 @@ def _die_with_parent() -> None:
         pass  # not Linux: the polling in _watch_parent does the job
 
 
+def end_with_parent(parent: int) -> None:
+    """For a worker process (a batch's pool): end when ``parent`` is gone, whatever killed it.
+
+    Linux sends SIGTERM at the parent's death (PR_SET_PDEATHSIG); a thread also polls for the parent,
+    which covers other systems and a parent that died before this call."""
+    _die_with_parent()
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(0.5)
+        os._exit(3)
+
+    threading.Thread(target=watch, name="tafel-parent-watch", daemon=True).start()
+
+
 def import_definitions(names: Sequence[str]) -> None:
     """Import the modules that define the program's representations; one that fails is named, not fatal
     (the context then fails later, and clearly, only if it really needs what that module defines)."""

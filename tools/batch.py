@@ -22,6 +22,8 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
+from tafel.core.runtime import end_with_parent
+
 #: times a job whose worker died runs again before it is reported as lost
 RETRIES = 2
 #: each run is single-threaded: numerical libraries must not start threads of their own in every worker
@@ -78,9 +80,10 @@ def run_jobs(function: Callable[[Any], dict[str, Any]], jobs: Sequence[Any], wor
 _started: Any = None
 
 
-def _set_up_worker(started: Any) -> None:
+def _set_up_worker(started: Any, parent: int) -> None:
     global _started
     _started = started
+    end_with_parent(parent)  # a SIGTERM or SIGKILL of the batch must not leave its workers running
 
 
 @contextmanager
@@ -123,7 +126,7 @@ def _run_locally(function: Callable[[Any], dict[str, Any]], jobs: Sequence[Any],
     while len(rows) < len(jobs):
         pending = [i for i in range(len(jobs)) if i not in rows]
         with _environment(worker_environment()), ProcessPoolExecutor(
-                max_workers=min(workers, len(pending)), mp_context=context, initializer=_set_up_worker, initargs=(started,)) as pool:
+                max_workers=min(workers, len(pending)), mp_context=context, initializer=_set_up_worker, initargs=(started, os.getpid())) as pool:
             if warm_up is not None and not info.startup_s:
                 for done in [pool.submit(warm_up) for _ in range(min(workers, len(pending)))]:
                     done.result()
