@@ -4,6 +4,13 @@ The layers are read from one or more configuration folders in order: the default
 package first, then each folder given with ``--config DIR``, each folder with all four layers.
 
 Each layer is optional and overrides what came before, table by table; lists are replaced whole.
+A layer edits the module lists it inherits with ``add`` and ``remove`` (applied where the layer is
+read, after its own ``modules`` if it has one; ``--set cognition.add=[...]`` too)::
+
+    [cognition]
+    add = ["MyBallModeler"]          # appended (once) to the list of the layers before
+    remove = ["SimpleBallModeler"]   # must be in that list: a misspelt name is an error
+
 A configuration file looks like::
 
     [runtime]
@@ -136,9 +143,9 @@ def load_config(
     sources = []
     for path in layer_paths(folders, platform, robot):
         if path.is_file():
-            config = merge(config, read_toml(path))
+            config = apply_module_edits(merge(config, read_toml(path)), str(path))
             sources.append(str(path))
-    config = apply_overrides(config, overrides)
+    config = apply_module_edits(apply_overrides(config, overrides), "--set")
     check_runtime(config)
     config["_sources"] = sources
     return config
@@ -171,6 +178,44 @@ def check_runtime(config: Mapping[str, Any]) -> None:
             raise ConfigError(f"runtime.{key} takes a positive number of {'Hz' if kind == 'rate' else 'seconds'}, got {value!r}")
         if kind == "rate" and value > MAX_RATE_HZ:
             raise ConfigError(f"runtime.{key} = {value:g} Hz is above what the runtime supports ({MAX_RATE_HZ:g} Hz at the most)")
+
+
+#: the settings of a ``[cognition]`` or ``[motion]`` table
+CONTEXT_KEYS = ("modules", "disabled", "providers", "add", "remove")
+
+
+def apply_module_edits(config: dict[str, Any], where: str) -> dict[str, Any]:
+    """Each context's ``add`` and ``remove`` applied to its module list, and dropped: the layer ``where``
+    (a file, or ``--set``) edits the list it inherits, and the next layer sees the edited list."""
+    for context in CONTEXTS:
+        section = config.get(context)
+        if not isinstance(section, dict):
+            continue  # context_section says what is wrong with it
+        for key in section:
+            if key not in CONTEXT_KEYS:
+                raise ConfigError(f"{where}: [{context}] {key} is not a setting; {did_you_mean(key, CONTEXT_KEYS)}; "
+                                  f"the settings are {', '.join(CONTEXT_KEYS)}")
+        edits = {key: section.pop(key) for key in ("remove", "add") if key in section}
+        if not edits:
+            continue
+        modules = section.get("modules", [])
+        if not isinstance(modules, list):
+            raise ConfigError(f"{where}: [{context}] modules must be a list of module names to {' and '.join(edits)} modules")
+        modules = list(modules)
+        for key, names in edits.items():
+            if not (isinstance(names, list) and all(isinstance(n, str) for n in names)):
+                raise ConfigError(f"{where}: [{context}] {key} takes a list of module names, e.g. {key} = [\"SimpleBallModeler\"]; "
+                                  f"got {names!r}")
+            for name in names:
+                if key == "add" and name not in modules:
+                    modules.append(name)
+                elif key == "remove":
+                    if name not in modules:
+                        raise ConfigError(f"{where}: [{context}] remove: {name} is not in the module list of the layers "
+                                          f"before; {did_you_mean(name, modules)} (where a layer before dropped it already, leave it out here)")
+                    modules.remove(name)
+        section["modules"] = modules
+    return config
 
 
 def edit_modules(config: dict[str, Any], add: Iterable[str] = (), remove: Iterable[str] = ()) -> dict[str, Any]:

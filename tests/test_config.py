@@ -112,3 +112,57 @@ toml_tables = st.recursive(
 @given(toml_tables)
 def test_dump_toml_round_trips(data: dict) -> None:
     assert tomllib.loads(dump_toml(data)) == data
+
+
+# ------------------------------------------------------------------- adding and removing modules in TOML
+@pytest.fixture
+def layered(tmp_path: Path) -> Path:
+    """Four layers, each editing the module list it inherits."""
+    write(tmp_path / "general.toml", '[cognition]\nmodules = ["A", "B", "C"]\n[motion]\nmodules = ["M"]\n')
+    write(tmp_path / "platform" / "sim.toml", '[cognition]\nadd = ["D"]\nremove = ["A"]\n')
+    write(tmp_path / "robot" / "nao1.toml", '[cognition]\nadd = ["E"]\n[motion]\nadd = ["N"]\n')
+    write(tmp_path / "private" / "private.toml", '[cognition]\nremove = ["B"]\n')
+    return tmp_path
+
+
+def test_layers_add_and_remove_modules_without_restating_the_list(layered: Path) -> None:
+    config = load_config(layered, "sim", "nao1")
+    assert config["cognition"]["modules"] == ["C", "D", "E"]
+    assert config["motion"]["modules"] == ["M", "N"]
+    assert "add" not in config["cognition"] and "remove" not in config["cognition"]  # applied, not left for later layers
+
+
+def test_a_layer_that_restates_the_list_starts_over_and_its_own_edits_apply_to_it(layered: Path) -> None:
+    write(layered / "robot" / "nao1.toml", '[cognition]\nmodules = ["X", "Y"]\nadd = ["Z"]\nremove = ["X"]\n')
+    write(layered / "private" / "private.toml", "")
+    assert load_config(layered, "sim", "nao1")["cognition"]["modules"] == ["Y", "Z"]
+
+
+def test_adding_a_listed_module_keeps_one_entry(layered: Path) -> None:
+    write(layered / "robot" / "nao1.toml", '[cognition]\nadd = ["C", "F"]\n')
+    assert load_config(layered, "sim", "nao1")["cognition"]["modules"] == ["C", "D", "F"]
+
+
+def test_edits_in_several_config_folders_and_in_set_overrides_apply_in_order(layered: Path, tmp_path: Path) -> None:
+    user = tmp_path / "user"
+    write(user / "general.toml", '[cognition]\nadd = ["U"]\n')
+    config = load_config([layered, user], "sim", overrides=['cognition.remove=["D"]', 'motion.add=["O"]'])
+    assert config["cognition"]["modules"] == ["C", "U"]  # the private layer of the first folder removed B
+    assert config["motion"]["modules"] == ["M", "O"]
+
+
+def test_removing_a_module_that_is_not_listed_names_the_file_and_the_closest_name(layered: Path) -> None:
+    write(layered / "robot" / "nao1.toml", '[cognition]\nremove = ["C", "Dd"]\n')
+    with pytest.raises(ConfigError, match=r"nao1.toml: \[cognition\] remove: Dd is not in the module list.*did you mean 'D'"):
+        load_config(layered, "sim", "nao1")
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ('[cognition]\nad = ["D"]\n', r"\[cognition\] ad is not a setting; did you mean 'add'"),
+    ('[cognition]\nadd = "D"\n', r"\[cognition\] add takes a list of module names"),
+    ('[motion]\nremove = [1]\n', r"\[motion\] remove takes a list of module names"),
+])
+def test_wrong_module_edits_are_errors_that_say_what_would_be_right(layered: Path, text: str, message: str) -> None:
+    write(layered / "robot" / "nao1.toml", text)
+    with pytest.raises(ConfigError, match=message):
+        load_config(layered, "sim", "nao1")

@@ -50,6 +50,13 @@ def port_number(text: str) -> int:
     return value
 
 
+def add_module_path_argument(parser: argparse.ArgumentParser) -> None:
+    """``--module-path DIR``: folders of module files of one's own, imported at start (repeatable)."""
+    parser.add_argument("--module-path", dest="module_path", action="append", default=[], type=Path, metavar="DIR",
+                        help="import the module files (*.py) in DIR, so that configuration can name their modules "
+                             "(repeatable; installed packages announce theirs in the entry point group tafel.modules)")
+
+
 #: robots a team may field in ``tafel match`` (the SPL's five)
 MAX_PLAYERS_PER_TEAM = 5
 
@@ -78,6 +85,7 @@ def add_match_command(commands: Any) -> None:
     match.add_argument("--resolution", default="320x240", help="camera image size WIDTHxHEIGHT")
     match.add_argument("--ready-seconds", type=positive(float), default=30.0, help="longest READY (default 30)")
     match.add_argument("--goals", type=positive(int), metavar="N", help="end the game when a team has scored N goals (drills, tests)")
+    add_module_path_argument(match)
     match.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                        help="a configuration override for every robot's program (repeatable)")
     for team in (1, 2):

@@ -22,6 +22,7 @@ from typing import Any, NoReturn
 from tafel.core.config import edit_modules, load_config
 from tafel.core.dot import contexts_dot
 from tafel.core.errors import TafelError
+from tafel.core.extensions import load_modules
 from tafel.core.platform import Platform, PlatformError, PlatformOptionError, available_platforms, load_platform
 from tafel.core.program import ContextPlan, plan_program
 from tafel.core.recording import Recorder, select
@@ -39,6 +40,7 @@ from tafel.tools.arguments import (
     add_log_commands,
     add_match_command,
     add_replay_batch_command,
+    add_module_path_argument,
     add_scenario_commands,
     parse_speed,
     port_number,
@@ -69,8 +71,10 @@ class UsageError(Exception):
     """Wrong names or arguments: exit status 2 with a message saying what would have been right."""
 
 
-def discover_modules() -> None:
-    """Import every file under ``representations/`` and ``modules/`` so configuration and logs can name them."""
+def discover_modules(module_paths: Sequence[str | Path] = ()) -> None:
+    """Import every file under ``representations/`` and ``modules/`` so configuration and logs can name
+    them, then the installed packages of modules (entry point group ``tafel.modules``) and the module
+    files in each of ``module_paths`` (``--module-path DIR``)."""
     import tafel.modules as modules
     from tafel.representations import load_all
 
@@ -78,6 +82,7 @@ def discover_modules() -> None:
     for info in pkgutil.walk_packages(modules.__path__, prefix="tafel.modules."):
         importlib.import_module(info.name)
 
+    load_modules(module_paths)
 
 def add_program_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--platform", help="where to run (see 'tafel platforms'); default from configuration")
@@ -94,6 +99,7 @@ def add_program_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--remove-module", action="append", default=[], metavar="CONTEXT:MODULE",
                         help="remove a module from a context's list (repeatable)")
 
+    add_module_path_argument(parser)
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="tafel", description="Run and inspect Tafel robot control programs.")
@@ -157,6 +163,7 @@ def build_parser() -> argparse.ArgumentParser:
     modules = commands.add_parser("modules", help="show the module graph of both contexts")
     add_program_arguments(modules)
     modules.add_argument("--dot", action="store_true", help="print Graphviz DOT of both contexts and their hand-overs")
+    add_module_path_argument(view)
     return parser
 
 
@@ -193,7 +200,7 @@ def prepare(args: argparse.Namespace, extra: Sequence[str]) -> tuple[Platform, d
         known = [a for action in platform_parser._actions for a in action.option_strings]
         hint = f"; options of platform {platform_class.name}: {', '.join(known)}" if known else ""
         fail(f"unrecognized arguments: {' '.join(unknown)}{hint}")
-    discover_modules()
+    discover_modules(args.module_path)
     platform = platform_class(vars(options))
     overrides = [f"runtime.{context}_hz={hz}" for context, hz in (platform.rates() or {}).items()]
     config = load_config(config_dirs(args), platform.config_layers(), args.robot, [*overrides, *args.overrides])
@@ -789,6 +796,7 @@ class PipeSafeStream:
 
 
 #: a value made of numbers and commas that starts with a minus sign: -1500,0,0
+    argv += [a for folder in args.module_path for a in ("--module-path", str(folder))]
 NEGATIVE_LIST = re.compile(r"^-\d[\d.]*(,-?[\d.]+)+$")
 
 

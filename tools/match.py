@@ -102,6 +102,7 @@ class Match:
                        # the team message budget is paced over the game's halves, here shorter than the SPL's
                        "--set", f"parameters.TeamMessageSender.half_s={min(3600.0, max(1.0, self.args.seconds / 2)):g}",
                        *(a for key, value in settings.items() for a in ("--set", f"game.{key}={json.dumps(value)}")),
+                       *(a for folder in self.args.module_path for a in ("--module-path", str(folder))),
                        *(a for override in self.args.overrides for a in ("--set", override)),
                        *(a for override in getattr(self.args, f"team{player.team + 1}_overrides") for a in ("--set", override))]
             log = None
