@@ -1,5 +1,5 @@
 """LookAtBallBehavior: look at the ball while it is seen, glancing round now and then for the
-localization; sweep the head to find it when it is not."""
+localization; sweep the head to find it when it is not; hold the head still while penalized."""
 
 from __future__ import annotations
 
@@ -7,7 +7,8 @@ import math
 from dataclasses import dataclass
 
 from tafel.core import Module, provides, requires, uses
-from tafel.representations.behavior import HeadMotionRequest
+from tafel.representations.behavior import HOLD_SPEED, HeadMotionRequest
+from tafel.representations.game import GameState
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
 
@@ -23,7 +24,7 @@ def sweep(start: float, direction: float, distance: float, amplitude: float) -> 
 
 
 @requires(BallModel, FrameInfo)
-@uses(RobotPose)
+@uses(RobotPose, GameState)
 @provides(HeadMotionRequest)
 class LookAtBallBehavior(Module):
     """Points the head at the ball model's position while the ball is being seen. Once it has not been
@@ -32,7 +33,10 @@ class LookAtBallBehavior(Module):
 
     A ball alone shows little of the field, so every ``glance_interval`` s (more often while the pose is
     not valid) the head glances left and right for lines and goals, unless the ball is close: then the
-    striker needs it in view, and the ball model follows the robot's steps meanwhile anyway."""
+    striker needs it in view, and the ball model follows the robot's steps meanwhile anyway.
+
+    While penalized the head holds still where it is (``max_speed`` 0): the rules allow a penalized
+    robot no motion at all until the GameController unpenalizes it. Then it looks for the ball anew."""
 
     @dataclass
     class Parameters:
@@ -69,6 +73,9 @@ class LookAtBallBehavior(Module):
     def execute(self) -> None:
         p, ball, request = self.parameters, self.ball_model, self.head_motion_request
         now = self.frame_info.time_s
+        if self.game_state.penalized:
+            request.max_speed, self.search_start = HOLD_SPEED, None
+            return
         if ball.valid and ball.time_since_seen <= p.lost_after:
             self.search_start = None
             if self.glance(now, math.hypot(ball.x, ball.y)):

@@ -1,0 +1,74 @@
+"""The SPL rules a referee checks, each through the modules that must keep it (``ModuleHarness``, with the
+GameController's packets built from its published layout) and, where the issue asks, with physics."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tafel.core.testing import ModuleHarness
+from tafel.modules.behavior.look_at_ball_behavior import LookAtBallBehavior
+from tafel.modules.motion.head_motion import HeadMotion
+from tafel.representations.behavior import HeadMotionRequest
+from tafel.representations.game import GameState, Penalty, RobotInfo, State, TeamInfo
+from tafel.representations.modeling import BallModel, RobotPose
+from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, HeadJointTargets, JointSensorData
+from tests.support.simulation import Simulation
+
+
+def game(state: State = State.playing, *, penalty: Penalty = Penalty.none) -> GameState:
+    """This robot (team 1, player 2) in ``state``, with ``penalty``."""
+    team = TeamInfo(team_number=1, players=[RobotInfo() for _ in range(20)])
+    team.players[1].penalty = penalty
+    return GameState(state=state, teams=[team, TeamInfo(team_number=2, players=[RobotInfo() for _ in range(20)])],
+                     team_number=1, player_number=2, heard=True)
+
+
+# ------------------------------------------------------------------------------ penalized means still
+def test_a_penalized_robot_asks_for_no_head_motion_whatever_the_ball_does_until_unpenalized() -> None:
+    harness = ModuleHarness(LookAtBallBehavior, game(), BallModel(valid=True, seen=True, x=2000.0, y=0.0), RobotPose(valid=True))
+    harness.execute(10)
+    harness.set(game(penalty=Penalty.player_pushing))
+    held = []
+    for k in range(300):  # 10 s: the ball rolls round the robot, then is lost (the head would search)
+        angle = 0.01 * k
+        ball = BallModel(valid=k < 150, seen=k < 150, x=2000.0 * math.cos(angle), y=2000.0 * math.sin(angle))
+        request = harness.set(ball).execute()[HeadMotionRequest]
+        held.append((request.yaw, request.pitch, request.max_speed))
+    assert all(speed == 0.0 for _, _, speed in held)
+    assert len({(yaw, pitch) for yaw, pitch, _ in held}) == 1
+    harness.set(game(), BallModel(valid=True, seen=True, x=0.0, y=2000.0))
+    assert harness.execute(3)[HeadMotionRequest].max_speed > 0.0  # unpenalized: it looks again
+
+
+def test_head_motion_holds_the_head_where_it_is_at_a_request_of_speed_zero() -> None:
+    sensors = JointSensorData()
+    sensors.position[HEAD_YAW], sensors.position[HEAD_PITCH] = 0.4, 0.1
+    harness = ModuleHarness(HeadMotion, sensors, HeadMotionRequest(yaw=-1.5, pitch=0.3, max_speed=0.0))
+    targets = [(t.yaw, t.pitch) for t in (harness.execute()[HeadJointTargets] for _ in range(100))]
+    assert targets == [(0.4, 0.1)] * 100
+
+
+@pytest.mark.slow
+def test_with_physics_a_penalized_robot_holds_every_joint_still_until_the_chest_button_unpenalizes_it() -> None:
+    sim = Simulation("mujoco", scene="default", cameras="off", sensor_noise="0")
+    button = sim.platform.commands()["sim:button"][1]
+    move_ball = sim.platform.commands()["sim:move_ball"][1]
+    try:
+        sim.run(3.0)  # playing: walking to the ball
+        button({})  # manual mode: penalized
+        sim.run(2.0)  # the walk stops and the robot stands
+        assert sim.blackboard("cognition")[GameState].penalized
+        move_ball({"x": "-2500", "y": "-1500", "vx": "0", "vy": "1200"})  # the ball rolls across in front of it
+        joints: list[np.ndarray] = []
+        sim.run(5.0, lambda s: joints.append(s.platform.joint_angles()))
+        spread = np.ptp(np.array(joints), axis=0)
+        assert spread[HEAD_YAW] < 0.01 and spread.max() < 0.03, spread.round(3)
+        button({})  # unpenalized: it looks for the ball again
+        head: list[float] = []
+        sim.run(3.0, lambda s: head.append(float(s.platform.joint_angles()[HEAD_YAW])))
+        assert np.ptp(head) > 0.1
+    finally:
+        sim.close()
