@@ -194,31 +194,34 @@ SHUTDOWN_GRACE_S = 15.0
 MAX_IDLE_S = 0.1
 
 
-def install_signal_handlers(stop: Any, on_force: Callable[[], None] | None = None, grace_s: float = SHUTDOWN_GRACE_S) -> None:
+def install_signal_handlers(stop: Any, on_force: Callable[[], None] | None = None,
+                            grace_s: float = SHUTDOWN_GRACE_S) -> list[str]:
     """First Ctrl-C or SIGTERM asks for a clean stop; a second one forces (KeyboardInterrupt).
 
     A stop that has not finished after ``grace_s`` dumps all threads' stacks to stderr and exits (a
     module stuck in an endless loop, say): a robot program must go away when it is told to, and the
-    dump says what held it.
+    dump says what held it. Returns the names of the signals received, in order (filled as they come),
+    so that the summary can say what stopped the run.
     """
 
-    received: list[int] = []  # signals, counted on their own: a stop the program began itself is not one
+    received: list[str] = []  # signals, counted on their own: a stop the program began itself is not one
 
     def handle(signum: int, _frame: Any) -> None:
-        received.append(signum)
+        received.append(signal.Signals(signum).name)
         if len(received) > 1:
             if on_force is not None:
                 on_force()
             raise KeyboardInterrupt
         stop.set()
-        print(f"stopping; if that takes more than {grace_s:g} s, every thread's stack is dumped and the program exits",
+        again = "Ctrl-C again to force; " if signum == signal.SIGINT else ""
+        # one line, on a line of its own (the terminal shows ^C after the status line)
+        print(f"\nstopping ({again}if that takes over {grace_s:g} s, every thread's stack is dumped and the program exits)",
               file=sys.stderr, flush=True)
         faulthandler.dump_traceback_later(grace_s, exit=True)
-        if signum == signal.SIGINT:
-            print("\nstopping (Ctrl-C again to force)", file=sys.stderr, flush=True)
 
     signal.signal(signal.SIGINT, handle)
     signal.signal(signal.SIGTERM, handle)
+    return received
 
 
 # ---------------------------------------------------------------------------------------- lockstep

@@ -72,6 +72,10 @@ class MotionSelection:
     active: MotionType = MotionType.stand
     #: share (0..1) of each motion in this frame's joint command, by MotionType value; they add up to 1
     weights: np.ndarray = bounded(0.0, 1.0, array_shape=(len(MotionType),))
+    #: the motion the request asks for
+    requested: MotionType = MotionType.stand
+    #: why another motion runs than the one asked for ("" when the request runs), e.g. "getting up first"
+    waiting_for: str = ""
 
 
 @representation
@@ -86,9 +90,16 @@ class MotionInfo:
     step_phase: float = bounded(0.0, 1.0)
     #: a kick or get-up in progress (behaviour waits for it)
     busy: bool = False
+    #: the motion the request asks for
+    requested: MotionType = MotionType.stand
+    #: why the request does not run yet ("" when it runs), from ``MotionSelection``
+    waiting_for: str = ""
 
     def status_text(self) -> str:
-        return f"motion {self.motion.name}{'' if self.executing_request else ' (not the request)'}"
+        """``motion stand``, or what was asked and why it waits: ``motion stand (asked walk: getting up first)``."""
+        if self.executing_request:
+            return f"motion {self.motion.name}"
+        return f"motion {self.motion.name} (asked {self.requested.name}: {self.waiting_for or 'blending into it'})"
 
 
 @representation

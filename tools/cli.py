@@ -39,8 +39,8 @@ from tafel.tools.arguments import (
     add_console_command,
     add_log_commands,
     add_match_command,
-    add_replay_batch_command,
     add_module_path_argument,
+    add_replay_batch_command,
     add_scenario_commands,
     parse_speed,
     port_number,
@@ -81,8 +81,8 @@ def discover_modules(module_paths: Sequence[str | Path] = ()) -> None:
     load_all()
     for info in pkgutil.walk_packages(modules.__path__, prefix="tafel.modules."):
         importlib.import_module(info.name)
-
     load_modules(module_paths)
+
 
 def add_program_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--platform", help="where to run (see 'tafel platforms'); default from configuration")
@@ -98,8 +98,8 @@ def add_program_arguments(parser: argparse.ArgumentParser) -> None:
                         help="add a module to a context's list, e.g. cognition:SimpleBallModeler (repeatable)")
     parser.add_argument("--remove-module", action="append", default=[], metavar="CONTEXT:MODULE",
                         help="remove a module from a context's list (repeatable)")
-
     add_module_path_argument(parser)
+
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="tafel", description="Run and inspect Tafel robot control programs.")
@@ -159,11 +159,11 @@ def build_parser() -> argparse.ArgumentParser:
     view.add_argument("--debug-host", default="127.0.0.1", metavar="H", help="the address of both (default: %(default)s)")
     view.add_argument("--debug-token", metavar="T", help="clients and the page must send 'auth T' first")
     view.add_argument("--speed", type=parse_speed, default=1.0, help="playing speed: a factor, or 'max'")
+    add_module_path_argument(view)
 
     modules = commands.add_parser("modules", help="show the module graph of both contexts")
     add_program_arguments(modules)
     modules.add_argument("--dot", action="store_true", help="print Graphviz DOT of both contexts and their hand-overs")
-    add_module_path_argument(view)
     return parser
 
 
@@ -268,13 +268,24 @@ def describe(value: Any) -> str:
     return f"{type(value).__name__} " + " ".join(scalars[:6])
 
 
+def stop_reason(signals: Sequence[str], end_reason: str) -> str:
+    """The summary's words for why a run ended: the signal that stopped it (``stopped by SIGINT``), else
+    what the runtime says (``stopped after 500 motion frames``); "" when nothing is known."""
+    if signals:
+        return f"stopped by {signals[0]}"
+    if end_reason in ("", "stopped"):  # "stopped": a stop asked for by other means (a debug client)
+        return end_reason
+    return f"stopped after {end_reason}"
+
+
 def print_summary(platform: str, mode: str, stats: dict[str, ContextStats], wall_s: float, ran_s: float, reason: str,
                   *, simulated: bool, notes: Sequence[str] = ()) -> None:
     """The summary of a run, all on standard output: ``ran`` is the run's length (platform time covered
-    with a simulated clock, the loops' running time otherwise), never the clock's end value."""
+    with a simulated clock, the loops' running time otherwise), never the clock's end value; ``reason`` is
+    the whole phrase (``stop_reason``)."""
     out = sys.stdout
     time_text = f"{ran_s:.3f} s of platform time" if simulated else f"{ran_s:.3f} s"
-    print(f"platform {platform} ({mode}): ran {time_text}" + (f", stopped after {reason}" if reason else ""), file=out)
+    print(f"platform {platform} ({mode}): ran {time_text}" + (f", {reason}" if reason else ""), file=out)
     for note in notes:
         print(f"  {note}", file=out)
     for name, s in stats.items():
@@ -467,7 +478,7 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
         recorded = debug_recorded(recorder)
         for name, runner in runtime.runners.items():
             context_debug(name, runner.manager, recorded.get(name, ()))
-    install_signal_handlers(runtime.stop, grace_s=shutdown_grace(config))
+    signals = install_signal_handlers(runtime.stop, grace_s=shutdown_grace(config))
     listen(args, debug)
     web = start_web(args, debug, plans, config)
     live = start_foxglove(args, debug, config)
@@ -495,7 +506,8 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
                 viewer.stop()
         if debug is not None:
             debug.server.stop()
-    print_summary(type(platform).name, "lockstep", stats, runtime.wall_s, runtime.time_ns * 1e-9, runtime.end_reason, simulated=True)
+    print_summary(type(platform).name, "lockstep", stats, runtime.wall_s, runtime.time_ns * 1e-9, stop_reason(signals, runtime.end_reason),
+                  simulated=True)
     report_recording(recorder)
     return 0
 
@@ -538,8 +550,8 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
             status_print(line.format(now - started, rt.stats, now, None, [*rt.notices, *recording_notices(recorder)], rt.dead))
 
     runtime.on_report.append(on_report)
-    install_signal_handlers(runtime.stop, on_force=lambda: [p.kill() for p in runtime.processes.values()],
-                            grace_s=shutdown_grace(config))
+    signals = install_signal_handlers(runtime.stop, on_force=lambda: [p.kill() for p in runtime.processes.values()],
+                                      grace_s=shutdown_grace(config))
     if debug is not None:
         listen(args, debug)
         threading.Thread(target=debug.server.dispatch_forever, args=(runtime.stop,), name="tafel-debug-dispatch", daemon=True).start()
@@ -559,7 +571,8 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
     realtime = stats.get("motion", ContextStats("motion")).realtime
     notes = ([f"motion: {realtime}"] if realtime else []) + [f"notice: {notice}" for notice in runtime.notices]
     ran = max((s.wall_s for s in stats.values()), default=0.0)
-    print_summary(platform_class.name, "concurrent", stats, time.monotonic() - started, ran, "", simulated=False, notes=notes)
+    print_summary(platform_class.name, "concurrent", stats, time.monotonic() - started, ran, stop_reason(signals, ""), simulated=False,
+                  notes=notes)
     report_recording(recorder)
     return 1 if any(s.failure for s in stats.values()) else 0
 
@@ -746,6 +759,7 @@ def command_view(args: argparse.Namespace, extra: Sequence[str]) -> int:
             "--speed", "max" if args.speed is None else repr(args.speed), "--status-interval", "3600", *extra]
     if args.debug_token is not None:
         argv += ["--debug-token", args.debug_token]
+    argv += [a for folder in args.module_path for a in ("--module-path", str(folder))]
     run_args, run_extra = build_parser().parse_known_args(argv)
     return command_run(run_args, run_extra)
 
@@ -796,7 +810,6 @@ class PipeSafeStream:
 
 
 #: a value made of numbers and commas that starts with a minus sign: -1500,0,0
-    argv += [a for folder in args.module_path for a in ("--module-path", str(folder))]
 NEGATIVE_LIST = re.compile(r"^-\d[\d.]*(,-?[\d.]+)+$")
 
 

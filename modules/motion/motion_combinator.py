@@ -61,5 +61,7 @@ class MotionCombinator(Module):
         info.motion = active
         info.executing_request = active is self.motion_request.motion or (
             active is MotionType.stand and self.motion_request.motion is MotionType.kick)
+        info.requested = self.motion_request.motion
+        info.waiting_for = "" if info.executing_request else self.motion_selection.waiting_for
         info.support_foot, info.step_phase = walk.support_foot, walk.step_phase if active in (MotionType.walk, MotionType.walk_to) else 0.0
         info.busy = active in (MotionType.kick, MotionType.getup) and not keyframe.done

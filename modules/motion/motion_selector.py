@@ -43,6 +43,8 @@ class MotionSelector(Module):
 
     def __init__(self) -> None:
         self.kicked = False
+        #: why the motion chosen in this frame is not the one requested
+        self.waiting_for = ""
         self.last_ns: int | None = None
         self.first_ns: int | None = None
 
@@ -52,6 +54,7 @@ class MotionSelector(Module):
         now = self.frame_info.time_ns
         self.first_ns = now if self.first_ns is None else self.first_ns
         starting = (now - self.first_ns) * 1e-9 < self.parameters.startup
+        self.waiting_for = "start-up standing" if starting else ""
         active = MotionType.stand if starting else self.choose(previous)
         dt = (now - self.last_ns) * 1e-9 if self.last_ns is not None and now > self.last_ns else 0.01
         self.last_ns = now
@@ -66,21 +69,30 @@ class MotionSelector(Module):
                 weights *= (1.0 - share) / others
             weights[active.value] = share
         selection.active, selection.weights = active, weights
+        selection.requested = self.motion_request.motion
+        selection.waiting_for = self.waiting_for if active is not selection.requested else ""
 
     def choose(self, current: MotionType) -> MotionType:
+        """The motion to run now; ``self.waiting_for`` says why, where that is not the one requested."""
         fall, keyframe, walk, request = self.fall_state, self.keyframe_output, self.walking_engine_output, self.motion_request
         if current is MotionType.getup and (not keyframe.done or fall.lying or (keyframe.aborted and not fall.upright)):
+            self.waiting_for = "getting up first"
             return MotionType.getup  # an aborted get-up holds still until the robot lies, then starts again
         if fall.phase is FallPhase.falling and current is not MotionType.getup:
+            self.waiting_for = "falling"
             return MotionType.fall
         if fall.lying:
+            self.waiting_for = "getting up first"
             return MotionType.getup
         if current is MotionType.kick and not keyframe.done:
+            self.waiting_for = "the kick plays to its end"
             return MotionType.kick
         if current in WALKING and not walk.standing and request.motion not in WALKING:
-            return current  # the walk stops first, with its feet together
+            self.waiting_for = "the walk stops with its feet together first"
+            return current
         wanted = request.motion
         if wanted is MotionType.kick:
+            self.waiting_for = "kicked once; the next kick needs a new request"
             if self.kicked:
                 return MotionType.stand
             if current is MotionType.kick:  # the one frame in which the kick is done
@@ -88,4 +100,7 @@ class MotionSelector(Module):
                 return MotionType.stand
             return MotionType.kick
         self.kicked = False
-        return wanted if wanted in (MotionType.stand, MotionType.walk, MotionType.walk_to, MotionType.sit) else MotionType.stand
+        if wanted in (MotionType.stand, MotionType.walk, MotionType.walk_to, MotionType.sit):
+            return wanted
+        self.waiting_for = f"{wanted.name} is not a motion to request (stand, walk, walk_to, kick, sit)"
+        return MotionType.stand
