@@ -21,7 +21,7 @@ from tafel.modules.motion.head_motion import HeadMotion
 from tafel.modules.motion.inertial_filter import InertialFilter
 from tafel.modules.motion.motion_combinator import MotionCombinator
 from tafel.modules.motion.stand_motion import StandMotion, stand_pose
-from tafel.modules.motion.status_leds import GREEN, RED, StatusLeds
+from tafel.modules.motion.status_leds import BLUE_EYE, RED_EYE, StatusLeds
 from tafel.modules.perception.ball_detector import BallDetector
 from tafel.modules.perception.ball_locator import BallLocator
 from tafel.platforms.actuators import JOINT_LIMITS
@@ -296,13 +296,14 @@ def test_the_command_keeps_every_body_joint_and_stiffness_within_0_and_1(body: B
     assert np.all((command.stiffness >= 0.0) & (command.stiffness <= 1.0))
 
 
-def test_the_chest_turns_red_in_the_frame_cognition_is_lost_and_green_when_it_is_back() -> None:
+def test_the_eyes_turn_red_and_the_ears_dark_in_the_frame_cognition_is_lost_and_back_when_it_returns() -> None:
     alive = [True] * 5 + [False] * 5 + [True] * 3
     harness = ModuleHarness(StatusLeds)
     harness.feed({CognitionStatus: [CognitionStatus(alive=a) for a in alive]})
     harness.execute()
-    chests = [led.chest for led in harness.history(LedRequest)]
-    assert all(np.array_equal(c, GREEN if a else RED) for c, a in zip(chests, alive))
+    leds = harness.history(LedRequest)
+    assert all(np.array_equal(led.left_eye, BLUE_EYE if a else RED_EYE) and led.right_ear.all() == a for led, a in zip(leds, alive))
+    assert all(np.array_equal(led.chest, leds[0].chest) for led in leds)  # the chest is the game state's, not cognition's
 
 
 @given(strategy_for(CognitionStatus))

@@ -10,12 +10,16 @@ import pytest
 
 from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.look_at_ball_behavior import LookAtBallBehavior
+from tafel.modules.communication.game_state_provider import GameStateProvider
 from tafel.modules.motion.head_motion import HeadMotion
+from tafel.modules.motion.status_leds import StatusLeds
 from tafel.representations.behavior import HeadMotionRequest
-from tafel.representations.game import GameState, Penalty, RobotInfo, State, TeamInfo
+from tafel.representations.game import Datagram, GameControllerPackets, GameState, Penalty, RobotInfo, State, TeamInfo
+from tafel.representations.infrastructure import CognitionStatus
 from tafel.representations.modeling import BallModel, RobotPose
-from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, HeadJointTargets, JointSensorData
+from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, HeadJointTargets, JointSensorData, LedRequest
 from tests.support.simulation import Simulation
+from tests.test_game_controller import packet  # built from the published layout, never from the code under test
 
 
 def game(state: State = State.playing, *, penalty: Penalty = Penalty.none) -> GameState:
@@ -70,5 +74,46 @@ def test_with_physics_a_penalized_robot_holds_every_joint_still_until_the_chest_
         head: list[float] = []
         sim.run(3.0, lambda s: head.append(float(s.platform.joint_angles()[HEAD_YAW])))
         assert np.ptp(head) > 0.1
+    finally:
+        sim.close()
+
+
+# ------------------------------------------------------------------------------- the chest LED
+#: the rules' colours (R, G, B) of the chest in each state (the GameController's numbers)
+RULES_CHEST = {0: (0, 0, 0), 5: (0, 1, 1), 1: (0, 0, 1), 2: (1, 1, 0), 3: (0, 1, 0), 4: (0, 0, 0)}
+
+
+def heard(data: bytes) -> GameState:
+    """What GameStateProvider makes of one packet for team 12, player 3."""
+    received = GameControllerPackets(datagrams=[Datagram(data=data, host="10.0.0.1", received_ns=0)], team_number=12, player_number=3)
+    return ModuleHarness(GameStateProvider, received).execute()[GameState]
+
+
+@pytest.mark.parametrize("state", sorted(RULES_CHEST))
+@pytest.mark.parametrize("alive", [True, False])
+def test_the_chest_shows_the_game_state_in_the_rules_colours_whether_or_not_cognition_runs(state: int, alive: bool) -> None:
+    game = heard(packet(state=state))
+    chest = ModuleHarness(StatusLeds, game, CognitionStatus(alive=alive)).execute()[LedRequest].chest
+    assert tuple(chest) == RULES_CHEST[state]
+
+
+@pytest.mark.parametrize("state", sorted(RULES_CHEST))
+def test_the_chest_is_red_while_penalized_in_any_state(state: int) -> None:
+    game = heard(packet(state=state, penalties={(0, 2): (2, 40)}))  # team 12's player 3: pushing, 40 s
+    assert game.penalized
+    assert tuple(ModuleHarness(StatusLeds, game, CognitionStatus(alive=True)).execute()[LedRequest].chest) == (1, 0, 0)
+
+
+@pytest.mark.slow
+def test_in_the_program_the_chest_follows_the_manual_mode_initial_penalized_playing() -> None:
+    sim = Simulation("mujoco", scene="default", cameras="off", overrides=["parameters.GameStateProvider.start_state=\"initial\""])
+    button = sim.platform.commands()["sim:button"][1]
+    try:
+        chests = []
+        for _ in range(3):
+            sim.run(0.5)
+            chests.append(tuple(sim.blackboard("motion")[LedRequest].chest))
+            button({})
+        assert chests == [(0, 0, 0), (1, 0, 0), (0, 1, 0)]  # INITIAL off, PLAYING penalized red, PLAYING green
     finally:
         sim.close()
