@@ -1,7 +1,7 @@
 """Loop rates of the default simulation (MuJoCo, both cameras, speed 1) without and during the attack.
 
-The attack is the security issue's: 20 clients pipelining commands, one streaming 50 MB without
-newlines, 40 connections over the limit of 32, and an HTTP POST. Rates are the program's own, from its
+The attack is the security issues': 20 clients pipelining commands, one streaming 50 MB without
+newlines, 40 connections over the limit of 32, an HTTP POST, and one with a request line over 64 KiB. Rates are the program's own, from its
 status line (one a second); the baseline is measured in the same run, just before the attack.
 
     python benchmarks/debug_attack.py [--seconds 10]
@@ -71,6 +71,7 @@ def main() -> None:
         "attack": {"pipelined_answers": report.answers, "answers_per_s": round(report.answers / attack_s),
                    "streamed_mb": round(report.streamed_bytes / 2**20, 1), "refused_over_limit": report.refused,
                    "over_limit_left_open": report.over_limit_open, "http_post_answered": report.http_answered,
+                   "long_http_post_answered": report.long_http_answered,
                    "client_errors": report.errors[:3]},
         "victim_unchanged": victim.read_text() == "precious\n",
         "files_in_working_folder": sorted(p.name for p in folder.iterdir()),

@@ -3,6 +3,16 @@
 A module declares ``class Parameters`` (a dataclass) in its body and reads ``self.parameters``.
 Values from configuration are checked against the field types, so a typo or a string where a number
 belongs fails at start-up with the field's name instead of misbehaving later.
+
+Every number has a range: the one its field declares (``bounded``), else its type's natural one
+(``tafel.core.validation.natural_range``). A string parameter may declare what it names:
+
+- ``choice_of(options)``: one of a few words (``GameStateProvider.start_state``), checked like an enum
+  wherever a value comes from, so a stored value always loads again;
+- ``folder_within(base)``: a folder the module reads. Configuration (what the user typed) may name any
+  folder; a debug client (``parameter:set``, ``set_parameter(..., client=True)``) only one inside
+  ``base`` or inside the folder configuration named at start, so a client cannot make the program read
+  (and list) a folder of its choosing.
 """
 
 from __future__ import annotations
@@ -10,7 +20,8 @@ from __future__ import annotations
 import dataclasses
 import enum
 import typing
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 from tafel.core.errors import TafelError
@@ -20,6 +31,27 @@ from tafel.core.validation import ValueCheckError, check_number, declared_range
 
 class ParameterError(TafelError, ValueError):
     """A parameter value or name that does not fit the module's Parameters dataclass."""
+
+
+CHOICES_META = "choices"
+FOLDER_META = "folder_within"
+#: the attribute of a Parameters instance that keeps what configuration gave its folder parameters
+_CONFIGURED = "_tafel_configured_folders"
+
+
+def choice_of(options: Sequence[str], default: str | None = None) -> Any:
+    """A string parameter that takes one of ``options`` (in any case; kept as listed): checked at start,
+    at ``parameter:set`` and at ``parameter:store``. The default is ``default`` or the first option."""
+    options = tuple(str(option) for option in options)
+    if not options or (default is not None and default not in options):
+        raise ValueError(f"choice_of({options!r}, default={default!r}): the default must be one of the options")
+    return dataclasses.field(default=options[0] if default is None else default, metadata={CHOICES_META: options})
+
+
+def folder_within(base: str | Path, default: str = "") -> Any:
+    """A string parameter naming a folder the module reads ("" means ``base``). Configuration may name
+    any folder; a debug client only ``base``, the folder configuration named, or a folder inside them."""
+    return dataclasses.field(default=default, metadata={FOLDER_META: str(base)})
 
 
 def parameters_class(module: type) -> type | None:
@@ -48,7 +80,7 @@ def coerce(module_name: str, field: dataclasses.Field, hint: Any, value: Any) ->
                 raise ValueError
             return _within(where, field, float(value), "float")
         if hint is str:
-            return str(value)
+            return _choice(where, field, str(value)) if CHOICES_META in field.metadata else str(value)
         if isinstance(hint, type) and issubclass(hint, enum.Enum):
             if isinstance(value, hint):
                 return value
@@ -66,6 +98,33 @@ def coerce(module_name: str, field: dataclasses.Field, hint: Any, value: Any) ->
             expected += " (" + ", ".join(m.name for m in hint) + ")"
         raise ParameterError(f"parameter {where} takes {expected}, got {value!r}") from None
     return value
+
+
+def _choice(where: str, field: dataclasses.Field, value: str) -> str:
+    """``value`` as one of the field's options (case does not matter), or ``ParameterError`` listing them."""
+    options = field.metadata[CHOICES_META]
+    for option in options:
+        if value.lower() == option.lower():
+            return option
+    raise ParameterError(f"parameter {where} takes one of {', '.join(options)}, got {value!r:.60}")
+
+
+def _client_folder(where: str, field: dataclasses.Field, value: str, configured: str | None) -> str:
+    """A folder a client named, resolved, if it lies inside the declared base or the configured folder."""
+    if value == "":
+        return value
+    base = field.metadata[FOLDER_META]
+    roots = [Path(base)] + ([Path(configured)] if configured else [])
+    try:
+        path = Path(value).resolve()  # symbolic links followed: a link inside that points out is outside
+        inside = any(path == root.resolve() or path.is_relative_to(root.resolve()) for root in roots)
+    except (OSError, ValueError):  # a NUL byte, a loop of links
+        inside = False
+    if not inside:
+        allowed = " or ".join(str(root.resolve()) for root in roots)
+        raise ParameterError(f"parameter {where} takes a folder inside {allowed} (configuration may name another one), "
+                             f"got {value!r:.80}")
+    return str(path)
 
 
 def _within(where: str, field: dataclasses.Field, number: Any, kind: str) -> Any:
@@ -86,16 +145,26 @@ def make_parameters(module: type, values: Mapping[str, Any] | None = None) -> An
     instance = cls()
     for name, value in (values or {}).items():
         set_parameter(module.__name__, instance, name, value)
+    configured = {f.name: getattr(instance, f.name) for f in dataclasses.fields(instance) if FOLDER_META in f.metadata}
+    if configured:
+        object.__setattr__(instance, _CONFIGURED, configured)  # the folders clients may stay within
     return instance
 
 
-def set_parameter(module_name: str, instance: Any, name: str, value: Any) -> Any:
-    """Set one parameter on a Parameters instance after checking name and type; returns the value."""
+def set_parameter(module_name: str, instance: Any, name: str, value: Any, *, client: bool = False) -> Any:
+    """Set one parameter on a Parameters instance after checking name and type; returns the value.
+
+    ``client``: the value comes from a debug client, not from configuration; a folder parameter then
+    only takes a folder within its base or the configured folder (``folder_within``).
+    """
     fields = {f.name: f for f in dataclasses.fields(instance)}
     if name not in fields:
         raise ParameterError(f"{module_name} has no parameter {name!r}; {did_you_mean(name, fields)}")
     hints = typing.get_type_hints(type(instance))
     converted = coerce(module_name, fields[name], hints[name], value)
+    if client and FOLDER_META in fields[name].metadata:
+        configured = getattr(instance, _CONFIGURED, {}).get(name)
+        converted = _client_folder(f"{module_name}.{name}", fields[name], converted, configured)
     setattr(instance, name, converted)
     return converted
 

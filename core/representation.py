@@ -80,6 +80,16 @@ def bounded(low: float, high: float, default: Any = dataclasses.MISSING, *, arra
     return dataclasses.field(default=default, metadata={RANGE_META: (low, high)})
 
 
+#: the most a counter may hold: exact in JSON and in a float, and far from where a module's ``+= 1`` leaves 64 bits
+MAX_COUNT = 2**53
+
+
+def counter(default: int = 0) -> Any:
+    """A whole number that counts up from 0 (packets, presses, messages): ``bounded(0, MAX_COUNT)``, so that a
+    client cannot set it where the next increment would no longer fit a log's 64 bits."""
+    return bounded(0, MAX_COUNT, default)
+
+
 def array(shape: tuple[int | None, ...] = (0,), dtype: Any = np.float64) -> Any:
     """Field default for a numpy array: zeros of ``shape`` (``None`` axes start empty).
 

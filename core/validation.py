@@ -3,8 +3,12 @@
 Debug clients (``representation:set``, ``modify:set``, ``parameter:set``), configuration and tests
 hand the program values it did not compute. Before such a value reaches a blackboard, a module or an
 actuator it is checked here against the field's declared type, array shape and dtype, finiteness and,
-where the field declares one, its range (``bounded``). A value that does not fit is refused with a
-``ValueCheckError`` that names the field and says what would be right; nothing is changed.
+where the field declares one, its range (``bounded``). A number whose field declares no range still
+has one, its type's natural range: a whole number fits in 64 bits (``INT_RANGE``) and any other number
+is finite and at most ``MAX_MAGNITUDE`` (1e12) in size: no length in mm, time in s or gain a robot uses
+comes near it, and a 309-digit integer or a 1e308 that a module squares or loops over would stop the
+program. A value that does not fit is refused with a ``ValueCheckError`` that names the field and says
+what would be right; nothing is changed.
 
 Modules' own writes are not checked here (that would cost every frame): only array shapes are, by
 the writer views.
@@ -22,7 +26,13 @@ from tafel.core.access import ArrayFieldError, check_array
 from tafel.core.errors import TafelError
 from tafel.core.representation import RANGE_META, FieldInfo, fields_of
 
-__all__ = ["ValueCheckError", "check_field", "check_instance", "check_number", "declared_range"]
+__all__ = ["INT_RANGE", "MAX_MAGNITUDE", "ValueCheckError", "check_field", "check_instance", "check_number", "declared_range",
+           "natural_range"]
+
+#: the range of a whole number without a declared one: what a 64-bit signed integer holds (logs store int64)
+INT_RANGE = (-(2**63), 2**63 - 1)
+#: the largest size of any other number without a declared range
+MAX_MAGNITUDE = 1e12
 
 
 class ValueCheckError(TafelError, ValueError):
@@ -37,20 +47,43 @@ def declared_range(field: dataclasses.Field | None) -> tuple[float, float] | Non
     return None if bounds is None else (float(bounds[0]), float(bounds[1]))
 
 
+def natural_range(kind: str) -> tuple[float, float]:
+    """The range of a number whose field declares none: 64 bits for whole numbers, ``MAX_MAGNITUDE`` otherwise."""
+    return INT_RANGE if kind == "int" else (-MAX_MAGNITUDE, MAX_MAGNITUDE)
+
+
+def _text(number: Any) -> str:
+    """A number for a message: short, whatever its size (a 309-digit integer is not printed whole)."""
+    if isinstance(number, int) and abs(number) >= 10**20:
+        digits = int(abs(number).bit_length() * math.log10(2)) + 1  # str() of a huge int is slow, or refused
+        return f"{'-' if number < 0 else ''}a number of about {digits} digits"
+    return str(number) if isinstance(number, int) else f"{number:g}"
+
+
 def check_number(value: Any, where: str, *, kind: str = "float", bounds: tuple[float, float] | None = None) -> Any:
-    """``value`` as a finite ``float`` (or ``int``) within ``bounds``, or ``ValueCheckError``."""
+    """``value`` as a finite ``float`` (or ``int``) within ``bounds``, or without them within the type's
+    natural range (``natural_range``); otherwise ``ValueCheckError``."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ValueCheckError(f"{where} takes {'a whole number' if kind == 'int' else 'a number'}, got {value!r}")
+        raise ValueCheckError(f"{where} takes {'a whole number' if kind == 'int' else 'a number'}, got {value!r:.60}")
     if kind == "int":
         if isinstance(value, (float, np.floating)) and not float(value).is_integer():
             raise ValueCheckError(f"{where} takes a whole number, got {value!r}")
         number: Any = int(value)
     else:
-        number = float(value)
+        try:
+            number = float(value)
+        except OverflowError:  # a whole number beyond any float
+            raise ValueCheckError(f"{where} takes a finite number, got {_text(int(value))}") from None
         if not math.isfinite(number):
             raise ValueCheckError(f"{where} takes a finite number, got {number}")
-    if bounds is not None and not bounds[0] <= number <= bounds[1]:
-        raise ValueCheckError(f"{where} takes {bounds[0]:g} to {bounds[1]:g}, got {number:g}")
+    if bounds is not None:
+        if not bounds[0] <= number <= bounds[1]:
+            raise ValueCheckError(f"{where} takes {bounds[0]:g} to {bounds[1]:g}, got {_text(number)}")
+        return number
+    low, high = natural_range(kind)
+    if not low <= number <= high:
+        what = "a whole number that fits in 64 bits" if kind == "int" else f"a number of at most {MAX_MAGNITUDE:g} in size"
+        raise ValueCheckError(f"{where} takes {what} (it declares no narrower range), got {_text(number)}")
     return number
 
 
@@ -120,6 +153,8 @@ def _check_array(info: FieldInfo, value: Any, where: str, bounds: tuple[float, f
     if array.dtype.kind == "f" and not np.isfinite(array).all():
         bad = int(np.flatnonzero(~np.isfinite(array))[0])
         raise ValueCheckError(f"{where} takes finite numbers; element {bad} is {array.flat[bad]}")
+    if bounds is None and array.dtype.kind == "f":  # whole-number dtypes hold their own range
+        bounds = natural_range("float")
     if bounds is not None and array.size and (array.min() < bounds[0] or array.max() > bounds[1]):
         raise ValueCheckError(f"{where} takes values from {bounds[0]:g} to {bounds[1]:g}; got {array.min():g} to {array.max():g}")
     return array

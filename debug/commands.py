@@ -29,7 +29,7 @@ from tafel.core.naming import did_you_mean
 from tafel.core.parameters import ParameterError, make_parameters, parameter_values, set_parameter
 from tafel.core.representation import FieldInfo, fields_of
 from tafel.core.serialization import SerializationError, deserialize, serialize
-from tafel.core.validation import ValueCheckError, check_field, check_instance, check_number
+from tafel.core.validation import MAX_MAGNITUDE, ValueCheckError, check_field, check_instance, check_number
 from tafel.debug.concepts import CANVASES, STATE, DebugState
 from tafel.debug.protocol import Command
 
@@ -240,13 +240,19 @@ def _check_like(current: Any, value: Any, what: str) -> Any:
     """A pinned modify value must be of the published value's kind: finite numbers, the same array shape."""
     if isinstance(current, float):
         return check_number(value, what)
+    if isinstance(current, int) and not isinstance(current, bool):
+        return check_number(value, what, kind="int")  # 64 bits: a module may loop over it
     if isinstance(current, np.ndarray):
         if value.shape != current.shape:
             raise CommandError(f"{what} is an array of shape {current.shape}; got shape {value.shape}")
         if value.dtype.kind == "f" and not np.isfinite(value).all():
             raise CommandError(f"{what} takes finite numbers; got {value.tolist()}")
-    if isinstance(current, list) and any(isinstance(v, float) and not np.isfinite(v) for v in value):
-        raise CommandError(f"{what} takes finite numbers; got {value}")
+        if value.dtype.kind == "f" and value.size and np.abs(value).max() > MAX_MAGNITUDE:
+            raise CommandError(f"{what} takes numbers of at most {MAX_MAGNITUDE:g} in size; got {np.abs(value).max():g}")
+    if isinstance(current, list):
+        for element in value:
+            if isinstance(element, (int, float)) and not isinstance(element, bool):
+                check_number(element, what, kind="int" if isinstance(element, int) else "float")
     return value
 
 
@@ -568,7 +574,7 @@ class ContextDebug:
     def cmd_parameter_set(self, command: Command) -> str:
         module, parameters = self._parameters(command)
         parameter = argument(command, "name", "parameter", positional=False)
-        value = set_parameter(module, parameters, parameter, argument(command, "value", positional=False))
+        value = set_parameter(module, parameters, parameter, argument(command, "value", positional=False), client=True)
         return f"{module}.{parameter} = {_short(value)}"
 
     def parameter_values(self, module: str) -> dict[str, Any] | None:

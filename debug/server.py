@@ -8,7 +8,10 @@ hands the answers back. A connection writes its answers strictly in the order it
 Nothing a client sends can stop a loop or another client: malformed lines get ``error:`` answers,
 overlong lines are cut off and reported, a client that floods commands is slowed down (it is not read
 while too many of its commands are open), and a client that does not read its answers is dropped once
-its output buffer is full.
+its output buffer is full. A connection that speaks HTTP (a web page's POST) is closed before anything
+runs, however long its first line; one that has not authenticated (without a token: sent no command)
+within ``idle_timeout`` is closed, and the last place under the connection limit is kept for clients
+on this machine, so that held-open connections from elsewhere cannot lock its user out.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ from __future__ import annotations
 import asyncio
 import concurrent.futures
 import hmac
+import ipaddress
 import logging
 import queue
 import threading
@@ -41,6 +45,8 @@ MAX_BYTES_PER_FRAME = 64 * 1024  # bytes read from one client per frame; it wait
 FRAME_WAIT = 0.05  # s a throttled client waits at most when no frame comes (a paused or ended loop)
 AUTH_PER_SECOND = 5  # auth attempts per connection and second; more are answered later
 AUTH_FAILURES = 20  # wrong tokens before the connection is closed
+IDLE_TIMEOUT = 30.0  # s a connection may stay without authenticating (without a token: without a command)
+LOOPBACK_RESERVE = 1  # places under the connection limit only clients on this machine may take
 
 
 class Executor:
@@ -167,11 +173,31 @@ class _Request:
 HTTP_FIRST_WORDS = (b"GET ", b"POST ", b"PUT ", b"HEAD ", b"DELETE ", b"OPTIONS ", b"PATCH ", b"CONNECT ", b"TRACE ")
 
 
+#: bytes at the start of a connection that tell whether it speaks HTTP (the longest method and a space fit)
+HTTP_HEAD = 16
+
+
 def looks_like_http(line: bytes) -> bool:
     """An HTTP request line or header (``POST / HTTP/1.1``, ``Host: ...``): no command ever looks like it."""
     head = line.lstrip()
     return head.startswith(HTTP_FIRST_WORDS) or head.lower().startswith((b"host:", b"user-agent:", b"content-")) \
         or b" HTTP/1." in head
+
+
+def starts_like_http(head: bytes) -> bool:
+    """The first bytes of a connection begin an HTTP request (``POST /...``), however long its line."""
+    return head.lstrip().startswith(HTTP_FIRST_WORDS)
+
+
+def is_loopback(peer: Any) -> bool:
+    """Whether a peer (an address, or ``(address, port, ...)`` as sockets give it) is this machine."""
+    host = peer[0] if isinstance(peer, tuple) and peer else peer
+    try:
+        address = ipaddress.ip_address(str(host).split("%")[0])
+    except ValueError:
+        return False
+    mapped = getattr(address, "ipv4_mapped", None)  # ::ffff:127.0.0.1
+    return address.is_loopback or (mapped is not None and mapped.is_loopback)
 
 
 class Session:
@@ -195,6 +221,8 @@ class Session:
         self.reading_done = False
         self.auth_times: deque[float] = deque(maxlen=AUTH_PER_SECOND)
         self.auth_failures = 0
+        #: authenticated with the token, or (without one) sent a command: only then may it stay idle
+        self.proven = False
 
     # ------------------------------------------------------------------ what a transport supplies
     def _write(self, answers: list[bytes]) -> bool:
@@ -237,6 +265,7 @@ class Session:
         if not self.authenticated:
             self.deliver(sequence, answer_bytes("error: not authenticated (send: auth TOKEN)"))
             return
+        self.proven = True
         local = self.local_command(command)
         if local is not None:
             self.deliver(sequence, answer_bytes(local))
@@ -252,10 +281,26 @@ class Session:
         """A command the transport answers itself (a WebSocket's subscriptions); None: not one."""
         return None
 
+    def watch_idle(self) -> None:
+        """Network thread, at connect: close this connection if it has not proven itself (``proven``)
+        within the server's ``idle_timeout``. A deadline from connecting, not from its last byte: a
+        client trickling bytes keeps no place either."""
+        loop, timeout = self.server._loop, self.server.idle_timeout
+        if loop is not None and timeout is not None:
+            loop.call_later(timeout, self._idle_check)
+
+    def _idle_check(self) -> None:
+        if self.closed or self.proven:
+            return
+        what = "authenticating" if self.server.token is not None else "a command"
+        log.info("debug server: closed %s: %g s without %s", self.peer, self.server.idle_timeout, what)
+        self._write([answer_bytes(f"error: {self.server.idle_timeout:g} s without {what}; closing")])
+        self.close()
+
     def _authenticate(self, sequence: int, command: Command) -> None:
         token = next((k for k, v in command.args.items() if v == ""), "") or command.args.get("token", "")
         if self.server.token is None or hmac.compare_digest(str(token).encode(), self.server.token.encode()):
-            self.authenticated = True
+            self.authenticated = self.proven = True
             self.deliver(sequence, answer_bytes("authenticated"))
             return
         self.auth_failures += 1
@@ -326,14 +371,19 @@ class _Connection(Session):
         super().__init__(server, writer.get_extra_info("peername"))
         self.reader, self.writer = reader, writer
         self.frame_bytes = 0  # read in the current frame
+        self.head = b""  # the connection's first bytes, until they tell whether it speaks HTTP
+        self.head_checked = False
 
     async def serve(self) -> None:
         decoder = TelnetDecoder(self.server.max_line)
+        self.watch_idle()
         try:
             while not self.closed:
                 data = await self.reader.read(65536)
                 if not data:
                     break
+                if not self.head_checked and self._refuse_http(data):
+                    return
                 for line in decoder.feed(data):
                     await self.pace_auth(line)
                     self.handle_line(line)
@@ -349,12 +399,24 @@ class _Connection(Session):
         self.reading_done = True
         self._finish_if_done()
 
+    def _refuse_http(self, data: bytes) -> bool:
+        """Look at the connection's first bytes before any line of them runs: a request line of any length
+        (one over ``max_line`` would otherwise arrive as "too long" and the body's lines would run)."""
+        self.head += data[: HTTP_HEAD - len(self.head)]
+        if starts_like_http(self.head):
+            self._refuse_as_http(self.head)
+            return True
+        self.head_checked = len(self.head) >= HTTP_HEAD or b"\n" in self.head
+        return False
+
+    def _refuse_as_http(self, line: bytes) -> None:
+        # A web page can make a browser send a POST here; its body would run as commands. Never.
+        log.warning("debug server: closed a connection from %s that speaks HTTP (%r); nothing was run", self.peer, line[:60])
+        self.drop()
+
     def handle_line(self, raw: bytes | None) -> None:
         if self.next_sequence == 0 and raw is not None and looks_like_http(raw) and not self.closed:
-            # A web page can make a browser send a POST here; its body would run as commands. Never.
-            log.warning("debug server: closed a connection from %s that speaks HTTP (%r); nothing was run",
-                        self.peer, raw[:60])
-            self.drop()
+            self._refuse_as_http(raw)
             return
         super().handle_line(raw)
 
@@ -400,7 +462,7 @@ class DebugServer:
 
     def __init__(self, router: DebugRouter, host: str = "127.0.0.1", port: int = 5401, *, token: str | None = None,
                  max_line: int = 64 * 1024, max_output: int = MAX_OUTPUT, max_connections: int = MAX_CONNECTIONS,
-                 max_bytes_per_frame: int = MAX_BYTES_PER_FRAME) -> None:
+                 max_bytes_per_frame: int = MAX_BYTES_PER_FRAME, idle_timeout: float | None = IDLE_TIMEOUT) -> None:
         if token is not None and not token:
             raise ValueError("an empty debug token would let anybody in; give a token or none")
         self.router = router
@@ -410,6 +472,8 @@ class DebugServer:
         self.max_output = max_output
         self.max_connections = max_connections
         self.max_bytes_per_frame = max_bytes_per_frame
+        #: s a connection may stay without authenticating (without a token: without a command); None: forever
+        self.idle_timeout = idle_timeout
         self.refused = 0  # connections refused over the limit
         self._frame: asyncio.Event | None = None  # set (and replaced) when a frame starts, for throttled clients
         self._throttled = 0
@@ -472,7 +536,7 @@ class DebugServer:
         asyncio.set_event_loop(loop)
 
         async def accept(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
-            refusal = self.refusal()
+            refusal = self.refusal(writer.get_extra_info("peername"))
             if refusal is not None:
                 writer.write(answer_bytes(refusal))
                 writer.close()
@@ -498,14 +562,20 @@ class DebugServer:
             loop.run_until_complete(loop.shutdown_asyncgens())
             loop.close()
 
-    def refusal(self) -> str | None:
-        """Network thread: why a new client cannot be served (every transport counts), or None."""
-        if len(self.connections) < self.max_connections:
+    def refusal(self, peer: Any = None) -> str | None:
+        """Network thread: why a new client from ``peer`` cannot be served (every transport counts), or None.
+
+        The last ``LOOPBACK_RESERVE`` places are for clients on this machine (a peer not known counts as
+        from elsewhere): connections held open from elsewhere never lock the robot's own user out."""
+        reserve = LOOPBACK_RESERVE if self.max_connections > LOOPBACK_RESERVE else 0
+        local = is_loopback(peer)
+        if len(self.connections) < self.max_connections - (0 if local else reserve):
             return None
         self.refused += 1
         if self.refused == 1 or self.refused % 100 == 0:
             log.warning("debug server: refused %d connection(s) over the limit of %d", self.refused, self.max_connections)
-        return f"error: too many debug connections ({self.max_connections} at most); close another one and connect again"
+        kept = "" if local or not reserve else f", the last {reserve} kept for clients on the robot itself"
+        return f"error: too many debug connections ({self.max_connections} at most{kept}); close another one and connect again"
 
     def run_in_loop(self, coroutine: Any, timeout: float = 10.0) -> Any:
         """Run a coroutine in the network thread's event loop and return its result (another transport

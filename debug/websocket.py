@@ -283,7 +283,7 @@ class WebServer:
 
     # ------------------------------------------------------------------ connections
     async def _session(self, connection: ServerConnection) -> None:
-        refusal = self.debug.refusal()
+        refusal = self.debug.refusal(connection.remote_address)
         if refusal is not None:
             await connection.send(json.dumps({"answer": refusal}))
             await connection.close(1013)

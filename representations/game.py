@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 from tafel.core import representation
 from tafel.core.errors import TafelError
+from tafel.core.representation import counter
 
 NO_TEAM = 255  # ``kicking_team`` when no team kicks
 
@@ -102,7 +103,7 @@ class GameState:
     seconds_since_packet: float = 0.0
     manual: bool = False
     """the state comes from the chest button (the rules' manual mode), not from a GameController"""
-    ignored_packets: int = 0
+    ignored_packets: int = counter()
     """packets ignored so far: not the protocol, or for other teams"""
     source: str = ""
     """the address of the GameController last heard"""

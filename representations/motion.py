@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tafel.core import array, bounded, representation
+from tafel.core.representation import counter
 
 JOINT_NAMES: tuple[str, ...] = (
     "HeadYaw", "HeadPitch",
@@ -84,8 +85,8 @@ class InertialModel:
     """The filtered torso orientation: ``roll`` and ``pitch`` (rad) of the torso relative to the
     ground, ``gyroscope`` (rad/s) and ``accelerometer`` (m/s^2) low-pass filtered."""
 
-    roll: float = 0.0
-    pitch: float = 0.0
+    roll: float = bounded(-math.pi, math.pi)
+    pitch: float = bounded(-math.pi, math.pi)
     gyroscope: np.ndarray = array((3,))
     accelerometer: np.ndarray = array((3,))
 
@@ -96,7 +97,7 @@ class CameraMatrix:
     frame, whose x axis is the optical axis, y points left and z up in the image. ``valid`` once
     computed from measured joints."""
 
-    rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    rotation: np.ndarray = field(default_factory=lambda: np.eye(3), metadata={"range": (-1.0, 1.0)})  # a rotation's elements
     translation: np.ndarray = array((3,))
     valid: bool = False
 
@@ -122,11 +123,11 @@ class CameraMatrixBuffer:
     the NAO). ``count`` entries are filled; ``time_ns`` is on the program's clock, like ``FrameInfo``.
     """
 
-    count: int = 0
+    count: int = bounded(0, CAMERA_MATRIX_HISTORY, 0)
     time_ns: np.ndarray = array((CAMERA_MATRIX_HISTORY,), np.int64)
-    top_rotation: np.ndarray = array((CAMERA_MATRIX_HISTORY, 3, 3))
+    top_rotation: np.ndarray = bounded(-1.0, 1.0, array_shape=(CAMERA_MATRIX_HISTORY, 3, 3))
     top_translation: np.ndarray = array((CAMERA_MATRIX_HISTORY, 3))
-    bottom_rotation: np.ndarray = array((CAMERA_MATRIX_HISTORY, 3, 3))
+    bottom_rotation: np.ndarray = bounded(-1.0, 1.0, array_shape=(CAMERA_MATRIX_HISTORY, 3, 3))
     bottom_translation: np.ndarray = array((CAMERA_MATRIX_HISTORY, 3))
 
     @classmethod
@@ -194,7 +195,7 @@ class TorsoPose:
     """The torso's pose in the robot frame: ``rotation`` (3x3) and ``translation`` (mm); the
     translation's z is the torso's height above the ground."""
 
-    rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    rotation: np.ndarray = field(default_factory=lambda: np.eye(3), metadata={"range": (-1.0, 1.0)})  # a rotation's elements
     translation: np.ndarray = array((3,))
 
 
@@ -215,7 +216,7 @@ class ChestButton:
     ends when the button is let go), so that a reader at any rate misses none."""
 
     pressed: bool = False
-    presses: int = 0
+    presses: int = counter()
 
 
 @representation

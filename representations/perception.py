@@ -9,6 +9,9 @@ import numpy as np
 
 from tafel.core import array, bounded, representation
 
+#: rad: the widest field of view a pinhole camera can have, short of 180 degrees; 0 means not known (no image)
+MAX_FOV = 3.0
+
 
 @representation
 class BallPercept:
@@ -30,11 +33,12 @@ class BallPercept:
 @dataclass
 class CameraImage:
     """An RGB image (height x width x 3, uint8; top-left origin) of one camera, with its field of
-    view (rad). Both cameras have their own representation, so modules declare which they read."""
+    view (rad; 0: not known, and the image is not projected onto the ground). Both cameras have their
+    own representation, so modules declare which they read."""
 
     image: np.ndarray = array((240, 320, 3), np.uint8)
-    horizontal_fov: float = 0.0
-    vertical_fov: float = 0.0
+    horizontal_fov: float = bounded(0.0, MAX_FOV)
+    vertical_fov: float = bounded(0.0, MAX_FOV)
     #: when the image was taken, on the program's clock (ns); later than that it reaches cognition
     time_ns: int = 0
 
@@ -61,8 +65,8 @@ class BallCandidate:
     fill: float = 0.0
     image_width: int = 0
     image_height: int = 0
-    horizontal_fov: float = 0.0
-    vertical_fov: float = 0.0
+    horizontal_fov: float = bounded(0.0, MAX_FOV)
+    vertical_fov: float = bounded(0.0, MAX_FOV)
     #: when the image was taken (ns, program clock): the camera matrix of that instant places it
     time_ns: int = 0
 

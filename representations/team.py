@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 
 from tafel.core import representation
 from tafel.core.errors import TafelError
+from tafel.core.representation import counter
 from tafel.representations.game import Datagram
 
 MAX_MESSAGE_BYTES = 128  # the rules' limit
@@ -142,7 +143,7 @@ class OutgoingTeamMessage:
     """A message to broadcast this frame (``data`` empty: none); ``sent`` counts this robot's messages."""
 
     data: bytes = b""
-    sent: int = 0
+    sent: int = counter()
 
 
 @dataclass
@@ -156,18 +157,21 @@ class TeamMate:
 @representation
 class TeamMates:
     """Every teammate heard, by player number order; ``malformed`` counts messages ignored as not ours
-    or broken, ``received`` the good ones."""
+    or broken, ``received`` the good ones, and ``spoofed`` those that claim this robot's own player
+    number without being a message it sent (spoofed, or a teammate configured with the same number)."""
 
     mates: list[TeamMate]
-    received: int = 0
-    malformed: int = 0
+    received: int = counter()
+    malformed: int = counter()
+    spoofed: int = counter()
 
     def fresh(self, max_age: float) -> list[TeamMate]:
         """The teammates heard within ``max_age`` s."""
         return [mate for mate in self.mates if mate.age <= max_age]
 
     def status_text(self) -> str:
-        return f"{len(self.mates)} teammates heard" + (f", {self.malformed} bad messages" if self.malformed else "")
+        return (f"{len(self.mates)} teammates heard" + (f", {self.malformed} bad messages" if self.malformed else "")
+                + (f", {self.spoofed} claiming this robot's number" if self.spoofed else ""))
 
 
 @representation

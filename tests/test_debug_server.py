@@ -22,6 +22,7 @@ import pytest
 from tafel.core.logfile import read_log
 from tafel.core.serialization import deserialize
 from tafel.debug.client import DebugClient
+from tafel.debug.server import DebugRouter, DebugServer
 from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler
 from tafel.representations.modeling import BallModel
 from tests.support.processes import stop_program
@@ -376,3 +377,97 @@ def test_unknown_canvas_and_bytes_without_plus_say_what_would_be_right(program: 
     assert "did you mean 'image:top'" in close
     raw = program.ask("representation:get -name BallModel")
     assert raw.startswith("error:") and "+representation:get" in raw
+
+
+# ------------------------------------------------------------------ web pages, idle places (second security round)
+def read_until_closed(connection: socket.socket, timeout: float = 10.0) -> bytes:
+    """Everything the server sends until it closes the connection (a reset counts as closed)."""
+    connection.settimeout(timeout)
+    received = b""
+    try:
+        while chunk := connection.recv(4096):
+            received += chunk
+    except ConnectionResetError:
+        pass
+    return received
+
+
+def test_an_http_post_with_a_request_line_over_64_kib_runs_nothing(tmp_path: Path) -> None:
+    """A page on another origin can make a browser POST here with a request line longer than a command
+    line may be: it arrived as "too long", took the first place in the order, and the body ran."""
+    running = Program("--platform", "dummy", cwd=tmp_path)
+    try:
+        body = b"\nlog:start -file posted.mcap\nping\n"
+        request = (b"POST /?" + b"a" * (70 * 1024) + b" HTTP/1.1\r\nHost: 127.0.0.1:5401\r\nOrigin: http://evil.example\r\n"
+                   b"Content-Type: text/plain\r\n" + f"Content-Length: {len(body)}\r\n\r\n".encode() + body)
+        with socket.create_connection((running.host, running.port), timeout=10) as connection:
+            try:
+                connection.sendall(request)
+            except (BrokenPipeError, ConnectionResetError):
+                pass  # closed while the request was still on its way: as it should be
+            received = read_until_closed(connection)
+        assert received == b"", received[:200]  # not one answer, not even "line too long"
+        assert json.loads(running.ask("log:status"))["recording"] is False
+    finally:
+        running.stop()
+    assert not (tmp_path / "logs").exists()
+    assert any("speaks HTTP" in line for line in running.errors), running.errors
+
+
+@pytest.mark.parametrize("token", [None, "right"])
+def test_connections_that_never_authenticate_are_closed_and_free_their_place(tmp_path: Path, token: str | None) -> None:
+    """32 connections held open idle locked every console user out. Now one that has not authenticated
+    (without a token: sent no command) within --debug-idle-timeout is told so and closed; a user who
+    did stays, however long they idle."""
+    running = Program("--platform", "dummy", "--no-web", "--debug-max-connections", "4", "--debug-idle-timeout", "0.5",
+                      *(["--debug-token", token] if token else []), cwd=tmp_path)
+    what = "authenticating" if token else "a command"
+    try:
+        with running.client() as user:
+            assert user.ask(f"auth {token}" if token else "ping") == ("authenticated" if token else "pong")
+            idle = [socket.create_connection((running.host, running.port), timeout=10) for _ in range(3)]  # every other place
+            for connection in idle:
+                assert read_until_closed(connection) == f"error: 0.5 s without {what}; closing\n\0".encode()
+                connection.close()
+            with running.client() as late:  # a place is free again
+                assert late.ask(f"auth {token}" if token else "ping") == ("authenticated" if token else "pong")
+            assert user.ask("ping") == "pong"  # idle longer than the others were, and still served
+    finally:
+        running.stop()
+
+
+def outward_address() -> str | None:
+    """This machine's address on its network (not loopback), or None without one."""
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        try:
+            probe.connect(("192.0.2.1", 9))  # no packet is sent: this only picks the route's source address
+        except OSError:
+            return None
+        address = probe.getsockname()[0]
+    return None if address.startswith("127.") else address
+
+
+def test_the_last_place_is_kept_for_a_client_on_this_machine() -> None:
+    """Connections from elsewhere, held open and even authenticated, never take the last place: the
+    robot's own user (or one logged in on it) can always get in."""
+    address = outward_address()
+    if address is None:
+        pytest.skip("this machine has no network address besides loopback")
+    server = DebugServer(DebugRouter(), "0.0.0.0", 0, max_connections=3)
+    server.start()
+    held: list[socket.socket] = []
+    try:
+        for _ in range(2):
+            connection = socket.create_connection((address, server.port), timeout=10)
+            connection.sendall(b"ping\n")
+            assert connection.recv(64) == b"pong\n\0"
+            held.append(connection)
+        with socket.create_connection((address, server.port), timeout=10) as third:
+            refusal = read_until_closed(third)
+        assert refusal.startswith(b"error: too many debug connections (3 at most, the last 1 kept for clients on the robot itself)")
+        with DebugClient("127.0.0.1", server.port) as local:
+            assert local.ask("ping") == "pong"
+    finally:
+        for connection in held:
+            connection.close()
+        server.stop()

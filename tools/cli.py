@@ -130,6 +130,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="read the token from a file (it then does not show in ps); a trailing newline is dropped")
     run.add_argument("--debug-max-connections", type=positive(int), default=32, metavar="N",
                      help="debug connections served at once; more get an error line (default: %(default)s)")
+    run.add_argument("--debug-idle-timeout", type=positive(float), default=30.0, metavar="S",
+                     help="close a debug connection that has not authenticated (without a token: sent no command) "
+                          "within S seconds (default: %(default)s)")
     run.add_argument("--no-debug", action="store_true", help="run without the debug server (and without the web view)")
     run.add_argument("--web-port", type=port_number, default=DEFAULT_WEB_PORT, metavar="P",
                      help="serve RobotControl in the browser on the debug server's address at this port "
@@ -331,7 +334,8 @@ def start_debug(args: argparse.Namespace, recorder: Recorder | None, plans: dict
               "steer this program and record on it; give one with --debug-token-file F (or --debug-token T)",
               file=sys.stderr, flush=True)
     debug = ProgramDebug(host=args.debug_host, port=port, token=token, config_dir=store_dir(args), recorder=recorder,
-                         record_dir=args.record_dir, max_connections=args.debug_max_connections)
+                         record_dir=args.record_dir, max_connections=args.debug_max_connections,
+                         idle_timeout=args.debug_idle_timeout)
     started = datetime.datetime.now().astimezone().isoformat(timespec="seconds")
     debug.router.identity = f"tafel {version('tafel')}: platform {args.platform}, pid {os.getpid()}, started {started}"
     debug.handovers = handovers_of(plans)

@@ -28,7 +28,7 @@ from tafel.core.runtime import ContextRunner
 from tafel.debug.commands import CommandError, ContextDebug, argument
 from tafel.debug.concepts import STATE, DebugDrawings, DebugPlots, ModuleTimes, frame_debug_data
 from tafel.debug.protocol import Command, parse
-from tafel.debug.server import DebugRouter, DebugServer, Executor
+from tafel.debug.server import IDLE_TIMEOUT, DebugRouter, DebugServer, Executor
 
 DEBUG_REPRESENTATIONS = (DebugDrawings, DebugPlots, ModuleTimes)
 INTERNAL_ERROR = "__error__"  # key of a context's answer to an internal question it could not answer
@@ -251,9 +251,10 @@ class ProgramDebug:
     """The debug server of one program run, with the program-wide commands."""
 
     def __init__(self, *, host: str, port: int, token: str | None, config_dir: Path, recorder: Recorder | None,
-                 record_path_default: Path | None = None, record_dir: Path = Path("logs"), max_connections: int = 32) -> None:
+                 record_path_default: Path | None = None, record_dir: Path = Path("logs"), max_connections: int = 32,
+                 idle_timeout: float | None = IDLE_TIMEOUT) -> None:
         self.router = DebugRouter()
-        self.server = DebugServer(self.router, host, port, token=token, max_connections=max_connections)
+        self.server = DebugServer(self.router, host, port, token=token, max_connections=max_connections, idle_timeout=idle_timeout)
         self.config_dir = config_dir
         self.recorder = recorder
         self.executors: dict[str, Any] = {}

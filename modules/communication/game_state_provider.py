@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from tafel.core import Module, bounded, provides, requires, uses
+from tafel.core.parameters import choice_of
 from tafel.representations.game import (
     MAX_PLAYERS,
     GameControllerPackets,
@@ -20,6 +21,9 @@ from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import ChestButton
 
 STATES = tuple(state.name for state in State)
+#: presses one frame acts on at most: the first may start PLAYING, then each toggles the penalty, so
+#: three (or two, for the same parity) do what any larger number would, however many a client claims
+MAX_PRESSES_PER_FRAME = 3
 
 
 @requires(GameControllerPackets, FrameInfo)
@@ -38,7 +42,7 @@ class GameStateProvider(Module):
 
     @dataclass
     class Parameters:
-        start_state: str = "initial"
+        start_state: str = choice_of(STATES, "initial")
         """the state before any GameController is heard: initial, ready, set, playing, finished or standby"""
         timeout: float = bounded(0.1, 60.0, 2.0)
         """s without a packet for this team after which the GameController counts as not heard"""
@@ -69,13 +73,19 @@ class GameStateProvider(Module):
         game.seconds_since_packet = (now_ns - self.last_heard_ns) * 1e-9 if self.last_heard_ns is not None else float("inf")
         game.heard = game.seconds_since_packet < self.parameters.timeout
         presses = self.chest_button.presses
-        for _ in range(max(0, presses - self.presses_seen)):
-            if not game.heard:
+        if not game.heard:
+            for _ in range(self.presses_to_act_on(presses - self.presses_seen)):
                 self.press(game)
         self.presses_seen = presses
 
+    @staticmethod
+    def presses_to_act_on(new: int) -> int:
+        """How many of ``new`` presses to carry out: all of a few, and for more the fewest with the same
+        effect (the penalty toggles, so parity is what counts): never a loop a client's number bounds."""
+        return max(0, new) if new <= MAX_PRESSES_PER_FRAME else 2 + new % 2  # 2 or 3: the first, and the parity of the rest
+
     def start(self, game: GameState) -> None:
-        state = self.parameters.start_state.lower()
+        state = self.parameters.start_state.lower()  # checked where it was set (choice_of); this guards direct writes
         if state not in STATES:
             raise ValueError(f"GameStateProvider.start_state is {self.parameters.start_state!r}; it takes {', '.join(STATES)}")
         game.state, self.started = State[state], True

@@ -2,20 +2,28 @@
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass
 
-from tafel.core import Module, bounded, provides, requires
+from tafel.core import Module, bounded, provides, requires, uses
 from tafel.representations.game import GameState
 from tafel.representations.infrastructure import FrameInfo
-from tafel.representations.team import IncomingTeamMessages, TeamMate, TeamMates, TeamMessageError, unpack_message
+from tafel.representations.team import IncomingTeamMessages, OutgoingTeamMessage, TeamMate, TeamMates, TeamMessageError, unpack_message
+
+#: this robot's own messages remembered, to know their echoes: far more than are sent while one is on the way
+OWN_MESSAGES_KEPT = 32
 
 
 @requires(IncomingTeamMessages, GameState, FrameInfo)
+@uses(OutgoingTeamMessage)
 @provides(TeamMates)
 class TeamMatesProvider(Module):
     """Unpacks every message on the team port. Messages that are not ours (broken, another format,
     another team) are ignored and counted in ``TeamMates.malformed``; this robot's own broadcasts come
-    back too and are left out. A teammate not heard for ``forget_after`` s is dropped."""
+    back too and are left out. A message with this robot's player number that it did not send (its
+    bytes are none of the last messages it sent) is left out too, and counted in ``TeamMates.spoofed``:
+    someone speaks in its name, or a teammate has the same number. A teammate not heard for
+    ``forget_after`` s is dropped."""
 
     @dataclass
     class Parameters:
@@ -24,9 +32,13 @@ class TeamMatesProvider(Module):
 
     def __init__(self) -> None:
         self.heard: dict[int, tuple[int, TeamMate]] = {}  # player -> (received ns, what it said)
+        self.sent: deque[bytes] = deque(maxlen=OWN_MESSAGES_KEPT)  # this robot's last messages
 
     def execute(self) -> None:
         mates, game, now_ns = self.team_mates, self.game_state, self.frame_info.time_ns
+        own = self.outgoing_team_message.data  # what the last frame sent (its echo may be in this frame's datagrams)
+        if own and (not self.sent or self.sent[-1] != own):
+            self.sent.append(own)
         for datagram in self.incoming_team_messages.datagrams:
             try:
                 message = unpack_message(datagram.data)
@@ -37,6 +49,8 @@ class TeamMatesProvider(Module):
                 mates.malformed += 1
                 continue
             if message.player == game.player_number:
+                if datagram.data not in self.sent:
+                    mates.spoofed += 1
                 continue
             mates.received += 1
             self.heard[message.player] = (datagram.received_ns, TeamMate(message=message))

@@ -8,7 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from tafel.core import Module, provides, requires
-from tafel.modules.motion.keyframes import KeyframeMotion, MotionFileError, load_motion
+from tafel.core.parameters import folder_within
+from tafel.modules.motion.keyframes import SHIPPED_MOTIONS, KeyframeMotion, MotionFileError, load_motion
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import InertialSensorData, JointSensorData
 from tafel.representations.motion_control import (
@@ -39,8 +40,9 @@ class KeyframePlayer(Module):
 
     @dataclass
     class Parameters:
-        motions_dir: str = ""
-        """folder of the motion files (empty: the shipped config/motions)"""
+        motions_dir: str = folder_within(SHIPPED_MOTIONS)
+        """folder of the motion files (empty: the shipped config/motions). Configuration may name any
+        folder; a debug client only the shipped one, the configured one, or a folder inside them"""
 
     def __init__(self) -> None:
         self.motions: dict[str, KeyframeMotion | None] = {}

@@ -14,7 +14,7 @@ import numpy as np
 
 from tafel.core import Module, provides, requires
 from tafel.debug import drawing, plot, request
-from tafel.modules.perception.image_geometry import focal_lengths, ground_point, pixel_ray
+from tafel.modules.perception.image_geometry import focal_lengths, ground_point, pixel_ray, projectable
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import CameraMatrix, CameraMatrixBuffer
 from tafel.representations.perception import BallCandidate, BallImagePercept, BallPercept
@@ -56,7 +56,7 @@ class BallLocator(Module):
 
     def locate(self, candidate: BallCandidate, matrix: CameraMatrix) -> np.ndarray | None:
         """The ball's centre on the ground (mm, robot frame), or None if position and size disagree."""
-        if not matrix.valid or candidate.horizontal_fov <= 0:
+        if not matrix.valid or not projectable(candidate.horizontal_fov, candidate.vertical_fov):
             return None
         ray = pixel_ray(candidate.x, candidate.y, candidate.image_width, candidate.image_height,
                         candidate.horizontal_fov, candidate.vertical_fov)

@@ -18,8 +18,17 @@ from tafel.representations.nao import FOOT_HEIGHT, HIP_OFFSET_Y, SOLE_BACK, SOLE
 from tafel.representations.perception import CameraImage
 
 
+def projectable(horizontal_fov: float, vertical_fov: float) -> bool:
+    """Whether both fields of view (rad) describe a pinhole camera: above 0 (0 means not known) and below
+    180 degrees. Only then do pixels and rays convert (``focal_lengths``)."""
+    return all(math.isfinite(fov) and 0.0 < fov < math.pi for fov in (horizontal_fov, vertical_fov))
+
+
 def focal_lengths(width: int, height: int, horizontal_fov: float, vertical_fov: float) -> tuple[float, float]:
-    """(fx, fy) in px."""
+    """(fx, fy) in px; ``ValueError`` for a field of view that is not ``projectable`` (0 would divide by zero)."""
+    if not projectable(horizontal_fov, vertical_fov):
+        raise ValueError(f"fields of view of {horizontal_fov!r} and {vertical_fov!r} rad describe no camera: "
+                         "each must lie between 0 and pi (check projectable() first)")
     return (width / 2) / math.tan(horizontal_fov / 2), (height / 2) / math.tan(vertical_fov / 2)
 
 
@@ -113,8 +122,8 @@ def camera_views(top: CameraImage, bottom: CameraImage, buffer: CameraMatrixBuff
     time is known: what every detector that works on the ground loops over."""
     for camera, image in (("top", top), ("bottom", bottom)):
         pixels = np.asarray(image.image)
-        if pixels.ndim != 3 or pixels.size == 0 or image.horizontal_fov <= 0:
-            continue
+        if pixels.ndim != 3 or pixels.size == 0 or not projectable(image.horizontal_fov, image.vertical_fov):
+            continue  # no image, or its field of view is not known
         matrix = buffer.at(camera, image.time_ns)
         if matrix.valid and np.isfinite(matrix.rotation).all() and np.isfinite(matrix.translation).all():
             yield camera, image, ImageProjection(matrix, pixels.shape[1], pixels.shape[0], image.horizontal_fov, image.vertical_fov)

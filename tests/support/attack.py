@@ -1,8 +1,9 @@
 """A debug-server attack as the security issue describes it, for the stress test and ``benchmarks/debug_attack.py``.
 
 All at once against one running program on loopback: clients pipelining commands, one client
-streaming bytes without a newline, connections beyond the limit, and an HTTP POST whose body would
-record over a file. Every loop is bounded in count and time, and everything stops by itself.
+streaming bytes without a newline, connections beyond the limit, an HTTP POST whose body would
+record over a file, and one whose request line is longer than a command line may be (it once arrived
+as "too long" and its body ran). Every loop is bounded in count and time, and everything stops by itself.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ class AttackReport:
     refused: int = 0  # connections over the limit that were answered with an error and closed
     over_limit_open: int = 0  # connections over the limit that stayed open (should be none)
     http_answered: bool = False  # the POST got anything back (it should not)
+    long_http_answered: bool = False  # the POST with a request line over 64 KiB got anything back (it should not)
     errors: list[str] = field(default_factory=list)
 
 
@@ -55,6 +57,7 @@ class Attack:
             self._threads.append(thread)
         time.sleep(0.5)  # the attack's own clients are in
         self._http_post()
+        self._long_http_post()
         self._fill_to_limit(self.limit - self.pipelining_clients - 1)
         self._over_limit()
 
@@ -150,6 +153,25 @@ class Attack:
                     pass
         except OSError as exc:
             self.report.errors.append(f"http client: {exc}")
+
+
+    def _long_http_post(self) -> None:
+        """A browser's POST from a page of another origin, its request line over 64 KiB; the body would record."""
+        body = b"\nlog:start -file posted.mcap\n"
+        request = (b"POST /?" + b"a" * (70 * 1024) + b" HTTP/1.1\r\nHost: 127.0.0.1\r\nOrigin: http://evil.example\r\n"
+                   + f"Content-Type: text/plain\r\nContent-Length: {len(body)}\r\n\r\n".encode() + body)
+        try:
+            with self._connect() as connection:
+                connection.settimeout(3)
+                try:
+                    connection.sendall(request)
+                    self.report.long_http_answered = bool(connection.recv(4096))
+                except TimeoutError:
+                    self.report.long_http_answered = True  # kept open: it was not closed at once
+                except OSError:
+                    pass  # reset while sending or reading: closed, as it should be
+        except OSError as exc:
+            self.report.errors.append(f"long http client: {exc}")
 
 
 STATUS_RATE = re.compile(r"(cognition|motion) ([\d.]+) Hz")
