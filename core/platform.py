@@ -120,6 +120,11 @@ class Platform:
     def stop(self) -> None:
         """Release everything (also called after errors); must not raise."""
 
+    def take_events(self) -> list[str]:
+        """What happened in the world since the last call that a user watching the run is told at once,
+        in a few words each (a simulated goal with the score); ``tafel run`` prints each on a status line."""
+        return []
+
     # Debug hooks: name -> (description, handler(args) -> answer text). Filled by platforms with
     # commands such as moving the ball; the debug server exposes them.
     def commands(self) -> Mapping[str, tuple[str, Any]]:

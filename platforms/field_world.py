@@ -27,7 +27,10 @@ BALL_COLORS = ("spl", "orange")
 class FieldPart:
     """One piece of the field world (m). ``kind``: plane, box (size = half extents, turned by ``yaw``),
     cylinder (radius, half height), capsule (radius; from ``start`` to ``end``), or sphere (the ball).
-    ``texture``: the ball's pattern is painted on it (engines use ``ball_mesh`` and ``ball_texture``)."""
+    ``texture``: the ball's pattern is painted on it (engines use ``ball_mesh`` and ``ball_texture``).
+    ``in_cameras`` False: the robot's cameras do not see it, only the viewers do. ``absorbs``: it takes
+    what hits it without a bounce and lets nothing climb it (a net: slippery, overdamped contacts; a
+    ball spinning into a gripping wall would roll up it and fly back out of the goal)."""
 
     name: str
     kind: str
@@ -39,6 +42,8 @@ class FieldPart:
     end: tuple[float, float, float] = (0.0, 0.0, 0.0)
     mass: float = 0.0  # > 0: a free body (the ball)
     texture: bool = False
+    in_cameras: bool = True
+    absorbs: bool = False
 
 
 CARPET_RGBA = (0.18, 0.55, 0.2, 1.0)
@@ -48,6 +53,9 @@ HALL_RGBA = (0.42, 0.4, 0.38, 1.0)  # floor and walls around the carpet: neither
 CEILING_RGBA = (0.75, 0.75, 0.78, 1.0)
 HALL_MARGIN = 3.0  # m from the carpet's edge to the walls
 HALL_HEIGHT = 6.0  # m: above every camera's view from the field
+NET_RGBA = (0.92, 0.92, 0.92, 0.35)  # what the viewers show of the nets: a light, see-through grey
+NET_HALF_THICKNESS = 0.02  # m: thick enough that the fastest ball (10 m/s, 2 cm a physics step) cannot pass
+NET_FRICTION = 0.05  # sliding friction of a net (the ball's own is 0.6)
 
 
 def _flat_box(name: str, x1: float, y1: float, x2: float, y2: float, half_width: float) -> FieldPart:
@@ -86,11 +94,29 @@ def field_parts(ball: tuple[float, float] = (1.0, 0.0), ball_color: str = "spl")
         parts.append(FieldPart(f"goal_{name}", "cylinder", (x * M, y * M, h / 2), (r, h / 2), WHITE))
     for side, (x, y) in (("opponent", posts[0]), ("own", posts[2])):
         parts.append(FieldPart(f"goal_{side}_bar", "capsule", (x * M, -y * M, h), (r,), WHITE, collides=False, end=(x * M, y * M, h)))
+    parts += goal_nets()
     ball_r = field.BALL_RADIUS * M
     rgba = WHITE if ball_color == "spl" else ORANGE_BALL_RGBA
     parts.append(FieldPart("ball", "sphere", (ball[0], ball[1], ball_r), (ball_r,), rgba, mass=field.BALL_MASS,
                            texture=ball_color == "spl"))
     return parts
+
+
+def goal_nets() -> list[FieldPart]:
+    """Back, sides and roof of both goals' nets (m): a scored ball stays in the goal, as on a real field.
+
+    The nets stop the ball and the robots; the robot's cameras do not see them (``in_cameras``), so
+    perception sees the goals as it always did, and only the viewers show them.
+    """
+    t, h = NET_HALF_THICKNESS, field.GOAL_HEIGHT * M
+    post_x, post_y = goal_post_positions()[0][0] * M, goal_post_positions()[0][1] * M  # the posts' centres
+    back_x = (field.LENGTH / 2 + field.GOAL_DEPTH) * M + t  # the back net's inside on the goal's depth
+    outer_y = post_y + field.GOAL_POST_DIAMETER / 2 * M  # the posts' outer edge
+    side_x = (post_x + back_x + t) / 2, (back_x + t - post_x) / 2  # from the posts to the back net: centre, half length
+    panels = [("back", back_x, 0.0, h / 2, (t, outer_y + t, h / 2 + t)), ("left", side_x[0], post_y, h / 2, (side_x[1], t, h / 2)),
+              ("right", side_x[0], -post_y, h / 2, (side_x[1], t, h / 2)), ("roof", side_x[0], 0.0, h + t, (side_x[1], outer_y + t, t))]
+    return [FieldPart(f"goal_{side}_net_{name}", "box", (sign * x, y, z), size, NET_RGBA, in_cameras=False, absorbs=True)
+            for sign, side in ((1.0, "opponent"), (-1.0, "own")) for name, x, y, z, size in panels]
 
 
 # ------------------------------------------------------------------------------------- the SPL ball

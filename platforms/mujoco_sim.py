@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from tafel.core.platform import PlatformError
-from tafel.platforms.robot_model import SERVO_GAIN, fsr_sites, joint_motor, mjcf, mjcf_assets, torque_range
+from tafel.platforms.robot_model import SERVO_GAIN, VIEWER_ONLY_GROUP, fsr_sites, joint_motor, mjcf, mjcf_assets, torque_range
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import JOINT_NAMES
@@ -189,6 +189,8 @@ class MujocoPlatform(SimulatedRobotPlatform):
             import mujoco.viewer
 
             self.viewer = mujoco.viewer.launch_passive(self.model, self.data)
+            with self.viewer.lock():
+                self.viewer.opt.geomgroup[VIEWER_ONLY_GROUP] = 1  # the goal nets: the viewer shows them, the cameras do not
         except Exception as exc:  # noqa: BLE001 - no GLFW, no display server, ...
             print(f"mujoco: cannot open the viewer ({exc}); running headless", file=sys.stderr)
 

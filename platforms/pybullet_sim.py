@@ -6,21 +6,47 @@ is built from the same ``field_parts``. Cameras render with PyBullet's CPU rende
 
 from __future__ import annotations
 
+import ctypes
 import math
 import os
+import sys
 import tempfile
 from typing import Any
 
 import numpy as np
-import pybullet
 
 from tafel.core.platform import PlatformError
-from tafel.platforms.field_world import FieldPart, ball_mesh, ball_texture_png, cylinder_mesh, field_parts
+from tafel.platforms.field_world import NET_FRICTION, FieldPart, ball_mesh, ball_texture_png, cylinder_mesh, field_parts
 from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, fsr_sites, joint_motor, urdf
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import JOINT_NAMES
 from tafel.representations.nao import ACCELEROMETER_POSITION, CAMERAS, COUPLED_JOINTS, SOLE_BACK, SOLE_FRONT, VERTICAL_FOV
+
+
+def _import_quietly() -> Any:
+    """``import pybullet`` without the ``pybullet build time: ...`` line its C code prints at import,
+    which every command that loads the platform would otherwise show (it writes to the file
+    descriptors themselves, so ``sys.stderr`` cannot catch it: both are pointed at /dev/null meanwhile)."""
+    for stream in (sys.stdout, sys.stderr):
+        stream.flush()
+    saved = [os.dup(fd) for fd in (1, 2)]
+    try:
+        with open(os.devnull, "wb") as null:
+            for fd in (1, 2):
+                os.dup2(null.fileno(), fd)
+            import pybullet as module
+
+            ctypes.CDLL(None).fflush(None)  # whatever C buffered goes to /dev/null, not out after the restore
+    finally:
+        for fd, copy in zip((1, 2), saved):
+            os.dup2(copy, fd)
+            os.close(copy)
+    return module
+
+
+pybullet = _import_quietly()
+
 
 POSITION_GAIN = 0.1  # PyBullet's position motors: share of the position error corrected per step
 ROBOT_RGBA = (0.87, 0.87, 0.9, 1.0)
@@ -43,9 +69,11 @@ class PybulletPlatform(SimulatedRobotPlatform):
     def __init__(self, options: dict[str, Any] | None = None) -> None:
         super().__init__(options)
         self.client: int | None = None
+        self.viewer = False
 
     # ------------------------------------------------------------------------------- the world
     def build(self, contexts: frozenset[str], viewer: bool) -> None:
+        self.viewer = viewer
         self.client = pybullet.connect(pybullet.GUI if viewer else pybullet.DIRECT)
         if self.client < 0:
             raise PlatformError("PyBullet could not start its physics server")
@@ -81,7 +109,13 @@ class PybulletPlatform(SimulatedRobotPlatform):
             # PyBullet capsules lie along z: tip z over onto the direction
             orientation = pybullet.getQuaternionFromEuler([0.0, math.atan2(math.hypot(direction[0], direction[1]), direction[2]),
                                                            math.atan2(direction[1], direction[0])])
-        if part.texture:
+        if not part.in_cameras:
+            # the cameras render every body, its collision shape where it has no visual shape; fully
+            # transparent shapes they leave out. The viewer gets lines instead.
+            visual = pybullet.createVisualShape(kind, rgbaColor=(*part.rgba[:3], 0.0), physicsClientId=c, **shape)
+            if self.viewer:
+                self._draw_net(part)
+        elif part.texture:
             vertices, normals, uvs, triangles = ball_mesh(part.size[0])
             visual = pybullet.createVisualShape(pybullet.GEOM_MESH, vertices=vertices.tolist(), normals=normals.tolist(),
                                                 uvs=uvs.tolist(), indices=triangles.ravel().tolist(), rgbaColor=part.rgba,
@@ -110,7 +144,22 @@ class PybulletPlatform(SimulatedRobotPlatform):
                                     physicsClientId=c)
         elif part.kind == "plane":
             pybullet.changeDynamics(body, -1, lateralFriction=1.0, physicsClientId=c)
+        elif part.absorbs:
+            pybullet.changeDynamics(body, -1, lateralFriction=NET_FRICTION, restitution=0.0, physicsClientId=c)
         return body
+
+    def _draw_net(self, part: FieldPart, mesh: float = 0.1) -> None:
+        """A box the cameras must not see (a goal net) as a grid of debug lines, which only the GUI draws."""
+        centre, half = np.array(part.position), np.array(part.size)
+        thin = int(np.argmin(half))  # the net's plane is across its thinnest axis
+        u, v = (axis for axis in range(3) if axis != thin)
+        colour = part.rgba[:3]
+        for along, across in ((u, v), (v, u)):
+            for offset in np.arange(-half[across], half[across] + 1e-9, mesh):
+                start, end = centre.copy(), centre.copy()
+                start[across] = end[across] = centre[across] + offset
+                start[along], end[along] = centre[along] - half[along], centre[along] + half[along]
+                pybullet.addUserDebugLine(start.tolist(), end.tolist(), colour, physicsClientId=self.client)
 
     def _ball_texture(self) -> int:
         """The SPL ball's pattern, through a temporary PNG (PyBullet loads textures only from files)."""

@@ -15,7 +15,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from tafel.platforms.field_world import ball_mesh, ball_texture_png, field_parts
+from tafel.platforms.field_world import NET_FRICTION, ball_mesh, ball_texture_png, field_parts
 from tafel.representations import field
 from tafel.representations.nao import (
     ACCELEROMETER_POSITION,
@@ -205,11 +205,17 @@ def _body_xml(link: str, children: dict[str, list], indent: str) -> list[str]:
     return lines
 
 
+#: geom group the renderers of the cameras leave out (MuJoCo shows groups 0 to 2 by default); the viewer shows it
+VIEWER_ONLY_GROUP = 3
+
+
 def _field_xml(ball_color: str, robot_bits: int = ROBOT_GROUP) -> list[str]:
     lines = []
     for part in field_parts(ball_color=ball_color):
         rgba = _vec(part.rgba)
         groups = f'contype="{WORLD_GROUP}" conaffinity="{WORLD_GROUP | robot_bits}"' if part.collides else 'contype="0" conaffinity="0"'
+        groups += "" if part.in_cameras else f' group="{VIEWER_ONLY_GROUP}"'
+        groups += f' priority="1" friction="{NET_FRICTION} 0.005 0.0001" solref="0.004 2"' if part.absorbs else ""  # its friction wins
         if part.kind == "plane":
             lines.append(f'<geom name="{part.name}" type="plane" size="{_vec(part.size)}" pos="{_vec(part.position)}" rgba="{rgba}" '
                          f'{groups} friction="1.0 0.02 0.002"/>')

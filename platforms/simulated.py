@@ -25,6 +25,7 @@ from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS, NetworkedPl
 from tafel.platforms.robot_model import STANDING_HEIGHT
 from tafel.representations import field
 from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.modeling import KnownPose
 from tafel.representations.motion import (
     CHEST_BUTTON,
     JOINT_NAMES,
@@ -128,6 +129,18 @@ def number(args: Mapping[str, Any], name: str, default: float = 0.0, limit: floa
     return value
 
 
+def switch(args: Mapping[str, Any], name: str) -> bool:
+    """An on/off debug command argument: ``-NAME on`` (or true, yes, 1), or the bare word ``NAME``."""
+    if name not in args:
+        return False
+    text = str(args[name]).lower()
+    if text in ("", "on", "true", "yes", "1"):
+        return True
+    if text in ("off", "false", "no", "0"):
+        return False
+    raise PlatformOptionError(f"-{name} takes on or off, got {args[name]!r}")
+
+
 class SimulatedRobotPlatform(NetworkedPlatform, Platform):
     """Base of the simulator platforms: one world feeds both contexts in lockstep."""
 
@@ -136,7 +149,7 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
     default_network = "simulated"  # parallel simulations must not hear each other (tafel match asks for udp)
     provides: ClassVar[Mapping[str, tuple[type, ...]]] = {
         "motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData, TouchSensorData),
-        "cognition": (FrameInfo, CameraImageTop, CameraImageBottom, *NETWORK_INPUTS),
+        "cognition": (FrameInfo, CameraImageTop, CameraImageBottom, KnownPose, *NETWORK_INPUTS),
     }
     consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {"motion": (JointCommand,), "cognition": NETWORK_OUTPUTS}
     #: the engine's name in help texts
@@ -170,6 +183,12 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         #: (time_ns, engine state) of the recent physics steps, while images arrive late
         self.history: deque[tuple[int, Any]] = deque()
         self.button_until_ns = -1  # the chest button is held down until then (sim:button)
+        #: goals scored by the robot's team (it attacks +x, towards the opponent goal) and against it
+        self.score = [0, 0]
+        self.ball_in_goal = 0  # field.goal_of of the ball after the last step: a goal counts when the ball gets in
+        self.events: list[str] = []
+        self.known_pose = KnownPose()  # told to the localization at the next cognition frame (sim:move_robot -reset on)
+        self.tell_pose = False
 
     @classmethod
     def add_arguments(cls, parser: argparse.ArgumentParser) -> None:
@@ -282,6 +301,7 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
             print(f"{self.name}: --viewer needs a display (DISPLAY is not set); running headless", file=sys.stderr)
         self.build(contexts, viewer)
         self.move_robot(*self.initial_pose)
+        self.ball_in_goal = field.goal_of(*self.initial_ball)  # a ball that starts in a goal scores nothing
         if "cognition" in contexts:
             self.network.open()
 
@@ -289,6 +309,27 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         self.network.close()
 
     def advance(self, time_ns: int) -> None:
+        self.step_world(time_ns)
+        self.judge_goal()
+
+    def take_events(self) -> list[str]:
+        events, self.events = self.events, []
+        return events
+
+    def judge_goal(self) -> None:
+        """A goal when the ball has got wholly over a goal line between the posts (``field.goal_of``, the
+        rule the match's referee judges by); the ball lying in the net afterwards is no new goal."""
+        where = field.goal_of(*self.ball_position())
+        if where and where != self.ball_in_goal:
+            self.score[0 if where > 0 else 1] += 1
+            what = ("GOAL for the robot's team (the ball is in the opponent goal)" if where > 0
+                    else "GOAL against the robot's team (the ball is in its own goal)")
+            self.events.append(f"{what}: score {self.score[0]}:{self.score[1]}")
+        self.ball_in_goal = where
+
+    def step_world(self, time_ns: int) -> None:
+        """The physics from the last ``advance`` to ``time_ns`` (none while paused), keeping each step's
+        world while images arrive late."""
         steps = int(round((time_ns - self.time_ns) * 1e-9 / TIMESTEP))
         start_ns, self.time_ns = self.time_ns, time_ns
         self.last_steps = 0 if self.paused else max(steps, 0)
@@ -331,6 +372,8 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
             blackboard.set(TouchSensorData(pressed=touch))
             return
         self.network.receive(blackboard, time_ns)
+        if context == "cognition":
+            self.tell_known_pose(blackboard)
         if context == "cognition" and self.cameras:
             taken_ns, images = self.images(time_ns)
             for camera, rep in (("top", CameraImageTop), ("bottom", CameraImageBottom)):
@@ -338,6 +381,16 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
                 image.image = images[camera]
                 image.time_ns = taken_ns
                 image.horizontal_fov, image.vertical_fov = self.fov()
+
+    def tell_known_pose(self, blackboard: Blackboard) -> None:
+        """``KnownPose``: the last pose told, and after ``sim:move_robot -reset on`` a new one, where the
+        robot is now (ground truth), so that the localization starts anew there."""
+        if self.tell_pose:
+            self.tell_pose = False
+            x, y, heading = self.robot_pose()
+            self.known_pose = KnownPose(serial=self.known_pose.serial + 1, x=x, y=y, rotation=heading)
+        if self.known_pose.serial:
+            blackboard.set(KnownPose(**vars(self.known_pose)))
 
     def images(self, time_ns: int) -> tuple[int, dict[str, np.ndarray]]:
         """(when taken, images) delivered at ``time_ns``: rendered ``camera_latency_ns`` earlier."""
@@ -406,6 +459,7 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
             x, y = number(args, "x", limit=CARPET_X), number(args, "y", limit=CARPET_Y)
             velocity = number(args, "vx", limit=MAX_BALL_SPEED), number(args, "vy", limit=MAX_BALL_SPEED)
             self.move_ball(x, y, velocity)
+            self.ball_in_goal = field.goal_of(x, y)  # put in a goal by hand: no goal scored
             return f"ball at x={x:.0f} y={y:.0f} mm" + (f", rolling at {velocity[0]:.0f},{velocity[1]:.0f} mm/s" if any(velocity) else "")
 
         def robot(args: Mapping[str, Any]) -> str:
@@ -414,8 +468,16 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
             lying = str(args.get("lying", ""))
             if lying not in ("", "front", "back"):
                 raise PlatformOptionError(f"-lying takes front or back, got {lying!r}")
+            reset = switch(args, "reset")
             self.move_robot(x, y, heading, lying)
-            return f"robot at x={x:.0f} y={y:.0f} mm, rotation {heading:.3f} rad" + (f", lying on its {lying}" if lying else "")
+            where = f"robot at x={x:.0f} y={y:.0f} mm, rotation {heading:.3f} rad" + (f", lying on its {lying}" if lying else "")
+            if reset:
+                self.tell_pose = True
+                return where + "; the localization starts anew at this pose (KnownPose)"
+            twin = f"x={-x:.0f} y={-y:.0f} mm, rotation {math.remainder(heading + math.pi, math.tau):.3f} rad"
+            return (f"{where}. The field looks the same turned by 180 degrees: the localization may take the mirrored pose "
+                    f"({twin}), as it does for a robot carried by a referee, which it puts in its own half; "
+                    "add -reset on to tell it the true pose")
 
         def push(args: Mapping[str, Any]) -> str:
             fx, fy = number(args, "x", limit=MAX_PUSH), number(args, "y", limit=MAX_PUSH)
@@ -435,7 +497,8 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
             bx, by = self.ball_position()
             x, y, heading = self.robot_pose()
             return (f"time {self.time_ns * 1e-9:.3f} s{' (paused)' if self.paused else ''}; robot x={x:.0f} y={y:.0f} mm "
-                    f"rotation {heading:.3f} rad, torso height {self.torso_height():.0f} mm, {self.posture()}; ball x={bx:.0f} y={by:.0f} mm")
+                    f"rotation {heading:.3f} rad, torso height {self.torso_height():.0f} mm, {self.posture()}; ball x={bx:.0f} y={by:.0f} mm"
+                    + (f"; score {self.score[0]}:{self.score[1]} (the robot's team first)" if any(self.score) else ""))
 
         def button(args: Mapping[str, Any]) -> str:
             self.button_until_ns = self.time_ns + int(BUTTON_SECONDS * 1e9)
@@ -445,7 +508,8 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
             **self.network.commands(),
             "sim:button": ("press the chest button once (the rules' manual mode steps the game state without a GameController)", button),
             "sim:move_ball": ("put the ball at -x X -y Y (mm, field), rolling at -vx VX -vy VY (mm/s) if given", ball),
-            "sim:move_robot": ("put the robot at -x X -y Y (mm, field) -rotation R (rad) [-lying front|back]", robot),
+            "sim:move_robot": ("put the robot at -x X -y Y (mm, field) -rotation R (rad) [-lying front|back] [-reset on: "
+                               "the localization starts anew at this pose]", robot),
             "sim:push": ("push the torso for 0.1 s with -x FX -y FY (N, field frame)", push),
             "sim:pause": ("stop the physics (the loops go on)", pause),
             "sim:resume": ("run the physics again", resume),

@@ -66,3 +66,16 @@ class RobotPose:
         if not self.valid:
             return "pose lost" if self.lost else "pose unknown"
         return f"pose x={self.x:.0f} y={self.y:.0f} mm {math.degrees(self.rotation):.0f} deg"
+
+
+@representation
+class KnownPose:
+    """Where the robot is, told from outside its sensors: the simulator's ground truth after
+    ``sim:move_robot ... -reset on``. ``serial`` counts the poses told (0: none yet); the localization
+    starts anew at ``x``, ``y`` (mm) and ``rotation`` (rad) whenever it changes. Only simulated
+    platforms provide it; elsewhere it stays at serial 0 and changes nothing."""
+
+    serial: int = 0
+    x: float = bounded(-15000.0, 15000.0)
+    y: float = bounded(-15000.0, 15000.0)
+    rotation: float = bounded(-math.pi, math.pi)

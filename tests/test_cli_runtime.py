@@ -371,3 +371,38 @@ def test_the_tools_package_knows_no_representation_by_name() -> None:
         text = path.read_text()
         offenders += [f"{path.name}: {name}" for name in names if re.search(rf"\b{name}\b", text)]
     assert not offenders, offenders
+
+
+SLOWER = "slower than real time"
+
+
+@pytest.mark.slow
+def test_a_run_slower_than_real_time_says_so_once_with_its_real_time_factor() -> None:
+    # 30 cognition frames a second of 60 ms each: 1.8 s of work for every second
+    result = dummy("--seconds", "5", "--status-interval", "1", "--add-module", "cognition:tests.support.runtime_faults:SlowEveryFrame")
+    assert result.returncode == 0, result.stderr
+    assert result.stderr.count(SLOWER) == 1, result.stderr
+    factor = float(re.search(rf"{SLOWER}: (\d+\.\d+)x", result.stderr).group(1))
+    assert 0.3 < factor < 0.8, result.stderr  # about 1 / 1.8
+
+
+@pytest.mark.slow
+def test_a_run_that_keeps_up_says_nothing_about_its_pace() -> None:
+    result = dummy("--seconds", "4", "--speed", "1", "--status-interval", "1")
+    assert result.returncode == 0, result.stderr
+    assert SLOWER not in result.stderr and "[tafel] dummy" in result.stderr
+
+
+def test_the_pace_notice_needs_a_growing_lag_not_one_stall_made_up() -> None:
+    from tafel.tools.cli import StatusLine
+
+    line = StatusLine("dummy", {})
+    # (wall s, platform s, s behind): a 1.5 s stall, made up at 1.25x, then on time
+    for now, platform, behind in ((10.0, 8.5, 1.5), (12.0, 11.0, 1.0), (12.5, 12.0, 0.5), (14.0, 13.5, 0.5)):
+        assert line.pace(now, platform, behind, 1.0) is None
+    # then too slow for good: 0.4x real time
+    assert line.pace(20.0, 18.8, 1.2, 1.0) is None
+    said = line.pace(22.5, 19.8, 2.7, 1.0)
+    assert said is not None and "slower than real time: 0.40x real time" in said
+    assert line.pace(30.0, 22.8, 7.2, 1.0) is None  # once
+    assert StatusLine("dummy", {}).pace(22.5, 19.8, 2.7, None) is None  # --speed max asks no pace

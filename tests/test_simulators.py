@@ -15,6 +15,7 @@ import sys
 import numpy as np
 import pytest
 
+from tafel.core.platform import PlatformOptionError
 from tafel.core.testing import ModuleHarness
 from tafel.modules.motion.camera_matrix_provider import CameraMatrixProvider
 from tafel.modules.perception.ball_detector import BallDetector
@@ -275,3 +276,116 @@ def test_bad_ball_velocities_and_noise_factors_say_what_would_be_right(option: s
     with pytest.raises(PlatformOptionError) as error:
         load_platform("mujoco")({option: value})
     assert message in str(error.value)
+
+
+# ------------------------------------------------------------------------- the first minutes (issue 28)
+class World:
+    """A bare simulated world (no program): put the ball, let the physics run, ask where the ball is."""
+
+    def __init__(self, engine: str) -> None:
+        self.match = engine == "match"
+        if self.match:
+            from tafel.platforms.match_world import MatchWorld
+
+            self.world = MatchWorld([(-1500.0, 0.0)])
+        else:
+            from tafel.core.platform import load_platform
+
+            self.world = load_platform(engine)({"cameras": "off", "start": "-1500,0,0"})
+            self.world.start(frozenset({"motion"}))
+
+    def shoot(self, x: float, y: float, velocity: tuple[float, float]) -> None:
+        if self.match:
+            self.world.ball.place(self.world.data, x, y, velocity)
+        else:
+            self.world.move_ball(x, y, velocity)
+
+    def run(self, seconds: float) -> None:
+        if self.match:
+            self.world.step_to(self.world.time_ns + int(seconds * 1e9))
+        else:
+            self.world.step_physics(int(round(seconds / 0.002)))
+
+    def ball(self) -> tuple[float, float]:
+        return self.world.ball_position()
+
+    def close(self) -> None:
+        if not self.match:
+            self.world.stop()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", [*ENGINES, "match"])
+def test_a_ball_shot_into_either_goal_stops_in_its_net(engine: str) -> None:
+    from tafel.representations.field import BALL_RADIUS, GOAL_DEPTH, GOAL_INNER_WIDTH, LENGTH
+
+    world = World(engine)
+    try:
+        # straight at the back net, and slanted into each side net, as fast as a strong kick and faster
+        for sign in (1.0, -1.0):
+            for angle, speed in ((0.0, 8000.0), (40.0, 5000.0), (-40.0, 5000.0), (0.0, 10000.0)):
+                velocity = (sign * speed * math.cos(math.radians(angle)), speed * math.sin(math.radians(angle)))
+                world.shoot(sign * 3800.0, 0.0, velocity)
+                deepest = 0.0
+                for _ in range(60):  # 3 s
+                    world.run(0.05)
+                    deepest = max(deepest, sign * world.ball()[0])
+                end = world.ball()
+                shot = f"{engine}: shot at {velocity} mm/s from ({sign * 3800:.0f}, 0) ended at {end}, deepest {deepest:.0f}"
+                assert deepest < LENGTH / 2 + GOAL_DEPTH, shot  # never through the net
+                assert LENGTH / 2 + BALL_RADIUS < sign * end[0] and abs(end[1]) < GOAL_INNER_WIDTH / 2, shot  # in the goal
+                world.run(0.2)
+                assert math.dist(end, world.ball()) < 5.0, shot + ": still rolling"
+    finally:
+        world.close()
+
+
+def test_importing_pybullet_prints_nothing() -> None:
+    result = subprocess.run([sys.executable, "-c", "import tafel.platforms.pybullet_sim; print('imported')"],
+                            cwd=REPO, capture_output=True, text=True, timeout=120, env={**os.environ, "PYTHONPATH": str(REPO)})
+    assert result.returncode == 0, result.stderr
+    assert result.stdout == "imported\n"
+    assert "build time" not in result.stderr
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("engine", "ball", "velocity", "goal"), [
+    ("mujoco", "3800,200", "3000,0", r"GOAL for the robot's team \(the ball is in the opponent goal\): score 1:0"),
+    ("pybullet", "-3800,-200", "-3000,0", r"GOAL against the robot's team \(the ball is in its own goal\): score 0:1"),
+])
+def test_tafel_run_says_goal_with_the_score(engine: str, ball: str, velocity: str, goal: str) -> None:
+    result = tafel("run", "--platform", engine, "--no-debug", "--cameras", "off", "--seconds", "3", "--speed", "max",
+                   "--ball", ball, "--ball-velocity", velocity)
+    assert result.returncode == 0, result.stderr
+    lines = [line for line in result.stderr.splitlines() if "GOAL" in line]
+    assert len(lines) == 1 and re.search(goal, lines[0]) and lines[0].startswith(f"[tafel] {engine} t="), result.stderr
+
+
+@pytest.mark.slow
+def test_move_robot_explains_the_mirrored_pose_and_resets_the_localization_when_asked() -> None:
+    from tafel.debug.protocol import parse
+    from tafel.representations.modeling import RobotPose
+
+    sim = Simulation("mujoco", start="-1500,0,0")
+    try:
+        sim.run(1.0)
+        move = sim.platform.commands()["sim:move_robot"][1]
+        answer = move(parse("sim:move_robot -x 2000 -y 500 -rotation 0.5").args)
+        assert "mirrored pose (x=-2000 y=-500 mm, rotation -2.642 rad)" in answer and "-reset on" in answer, answer
+        assert "starts anew" in move(parse("sim:move_robot -x 2000 -y 500 -rotation 0.5 -reset on").args)
+
+        def error() -> tuple[float, float]:
+            pose, (x, y, heading) = sim.blackboard("cognition")[RobotPose], sim.platform.robot_pose()
+            return math.hypot(pose.x - x, pose.y - y), abs(math.remainder(pose.rotation - heading, math.tau))
+
+        sim.run(0.1)  # three cognition frames
+        assert sim.blackboard("cognition")[RobotPose].valid
+        distance, angle = error()
+        assert distance < 100.0 and angle < 0.1, (distance, angle)
+        sim.run(3.0)  # and it stays there: continuity, not the own half
+        distance, angle = error()
+        assert distance < 300.0 and angle < 0.2, (distance, angle)
+        with pytest.raises(PlatformOptionError, match="-reset takes on or off, got 'maybe'"):
+            move({"x": "0", "reset": "maybe"})
+    finally:
+        sim.close()

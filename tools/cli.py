@@ -214,6 +214,10 @@ def prepare(args: argparse.Namespace, extra: Sequence[str]) -> tuple[Platform, d
 
 
 # ----------------------------------------------------------------------------------------- run
+#: s behind the wall clock, for s of wall time, before a run is called slower than real time
+LAG_S, LAG_FOR_S = 1.0, 2.0
+
+
 class StatusLine:
     """The status line of a run: rates over the last interval, and what ``[status] show`` names.
 
@@ -226,6 +230,8 @@ class StatusLine:
         show = config.get("status", {}).get("show", []) if isinstance(config.get("status"), dict) else []
         self.show = [str(name) for name in show] if isinstance(show, list) else []
         self._last: dict[str, tuple[int, float]] = {}
+        self._lagging_since: tuple[float, float] | None = None  # (wall s, platform s) since the loop lags
+        self._said_slower = False
 
     def rates(self, stats: dict[str, ContextStats], now: float) -> dict[str, float]:
         """Frames per second of each context since the previous line (since the start for the first)."""
@@ -250,6 +256,34 @@ class StatusLine:
         parts.extend(self.shown(runners or {}))
         parts.extend(notices)
         return " | ".join(parts)
+
+    def event(self, elapsed_s: float, text: str) -> str:
+        """A line of its own for something that happened (a goal): it is printed when it happens."""
+        return f"[tafel] {self.platform} t={elapsed_s:.1f}s {text}"
+
+    def pace(self, now: float, platform_s: float, behind_s: float, speed: float | None) -> str | None:
+        """Once, when the run cannot keep the pace asked for: its real-time factor, which is why the rates
+        are low. Said when the loop has been ``LAG_S`` behind the wall clock for ``LAG_FOR_S`` and went
+        on losing ground meanwhile; a single stall that the loop makes up again is not slowness."""
+        if self._said_slower or speed is None:
+            return None
+        if behind_s < LAG_S:
+            self._lagging_since = None
+            return None
+        if self._lagging_since is None:
+            self._lagging_since = (now, platform_s)
+            return None
+        wall, platform = now - self._lagging_since[0], platform_s - self._lagging_since[1]
+        if wall < LAG_FOR_S:
+            return None
+        factor = platform / wall
+        if factor >= 0.98 * speed:  # keeping the pace again, only late from before
+            self._lagging_since = (now, platform_s)
+            return None
+        self._said_slower = True
+        slower = "slower than real time" if speed == 1.0 else f"slower than --speed {speed:g} asks"
+        return self.event(platform_s, f"{slower}: {factor:.2f}x real time; a frame's work takes longer than its period, "
+                                      "so the rates are below the configured ones (said once)")
 
     def shown(self, runners: dict[str, Any]) -> list[str]:
         texts = []
@@ -496,6 +530,11 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
 
     def status(rt: LockstepRuntime) -> None:
         now = time.monotonic()
+        for event in platform.take_events():
+            status_print(line.event(rt.time_ns * 1e-9, event))
+        slower = line.pace(now, rt.time_ns * 1e-9, rt.behind_s, limits.speed)
+        if slower:
+            status_print(slower)
         if now - last[0] >= args.status_interval:
             last[0] = now
             stats = {name: r.stats(now - started) for name, r in rt.runners.items()}

@@ -13,15 +13,16 @@ from tafel.modules.modeling.field_model import FIELD_MODEL, OWN_HALF, mirror
 from tafel.representations import field
 from tafel.representations.game import GameState
 from tafel.representations.infrastructure import FrameInfo
-from tafel.representations.modeling import RobotPose
+from tafel.representations.modeling import KnownPose, RobotPose
 from tafel.representations.motion_control import FallState, Odometry
 from tafel.representations.perception import GoalPostPercept, LinePercept
 
+KNOWN_POSE_STD, KNOWN_ROTATION_STD = 30.0, 0.03  # mm and rad: the particles' spread round a pose told (KnownPose)
 DRAW_PARTICLES = request("SelfLocator:draw_particles", "every particle and the estimate on the field canvas")
 
 
 @requires(Odometry, LinePercept, GoalPostPercept, FrameInfo)
-@uses(FallState, GameState)
+@uses(FallState, GameState, KnownPose)
 @provides(RobotPose)
 class SelfLocator(Module):
     """Monte Carlo localization.
@@ -42,6 +43,9 @@ class SelfLocator(Module):
       ``RobotPose.lost`` says so.
     - When a penalty ends, the referee has carried the robot to a touchline of its own half: the
       particles start anew there, facing the field.
+    - Told where it is (``KnownPose``, the simulator's ``sim:move_robot ... -reset on``): every particle
+      starts there and the pose is valid at once. That is the only way out of the symmetric field's
+      ambiguity for a robot carried into the other half, which the rules above put in its own half.
     """
 
     @dataclass
@@ -100,6 +104,7 @@ class SelfLocator(Module):
         self.concentrated_since: float | None = None  # s since when the particles agree on one pose
         self.evidence: set[str] = set()  # what was seen since: one line alone fits many places
         self.was_penalized = False
+        self.known_serial = 0  # the last KnownPose taken
 
     def execute(self) -> None:
         if len(self.particles) != self.parameters.particles:
@@ -110,6 +115,9 @@ class SelfLocator(Module):
             self.trusted = self.estimate = self.concentrated_since = None
         self.was_penalized = penalized
         self.predict()
+        if self.known_pose.serial != self.known_serial:
+            self.known_serial = self.known_pose.serial
+            self.start_at(self.known_pose)
         upright = self.fall_state.upright
         if upright and self.was_upright:  # percepts of a lying robot come through a wrong camera matrix
             fits = self.weigh()
@@ -143,6 +151,16 @@ class SelfLocator(Module):
         self.particles[:, 0] += np.cos(heading) * forward - np.sin(heading) * left
         self.particles[:, 1] += np.sin(heading) * forward + np.cos(heading) * left
         self.particles[:, 2] = np.remainder(heading + turn + math.pi, math.tau) - math.pi
+
+    def start_at(self, pose: KnownPose) -> None:
+        """Every particle at a pose the robot was told, a little spread; trusted and valid at once."""
+        n = len(self.particles)
+        told = np.array([pose.x, pose.y, pose.rotation])
+        self.particles = told + self.rng.normal(0.0, [KNOWN_POSE_STD, KNOWN_POSE_STD, KNOWN_ROTATION_STD], (n, 3))
+        self.particles[:, 2] = np.remainder(self.particles[:, 2] + math.pi, math.tau) - math.pi
+        self.trusted, self.estimate, self.best = (pose.x, pose.y, pose.rotation), told, None
+        self.slow = self.fast = 0.0  # the measurements' fit is learnt anew at this place
+        self.concentrated_since, self.evidence = self.frame_info.time_s - self.parameters.confirm_after, {"told"}
 
     # ----------------------------------------------------------------------------------- sensing
     def weigh(self) -> float | None:
@@ -236,7 +254,7 @@ class SelfLocator(Module):
         if self.concentrated_since is not None:
             self.evidence |= self.evidence_seen(pose.rotation)
         pose.valid = (self.concentrated_since is not None and now - self.concentrated_since >= p.confirm_after
-                      and bool(self.evidence & {"circle", "post"} or {"along", "across"} <= self.evidence))
+                      and bool(self.evidence & {"circle", "post", "told"} or {"along", "across"} <= self.evidence))
         pose.lost = lost or (self.trusted is not None and not pose.valid)
         if pose.valid:
             self.trusted = (pose.x, pose.y, pose.rotation)
