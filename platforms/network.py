@@ -21,6 +21,7 @@ from __future__ import annotations
 import logging
 import socket
 import time
+from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
@@ -36,7 +37,7 @@ log = logging.getLogger("tafel.network")
 #: what a platform with a network adds to cognition
 NETWORK_INPUTS = (GameControllerPackets, IncomingTeamMessages)
 NETWORK_OUTPUTS = (GameControllerReturn, OutgoingTeamMessage)
-MIN_RETURN_INTERVAL_S = 0.5  # the rules: at most two return packets a second
+RETURNS_PER_SECOND = 2  # the rules: at most two return packets in any second
 MAX_DATAGRAMS_PER_FRAME = 64  # more in one frame is a flood: the rest waits (or is dropped by the kernel)
 NETWORK_MODES = ("auto", "udp", "simulated")
 
@@ -109,7 +110,7 @@ class GameNetwork:
         self.game_controller: socket.socket | None = None
         self.team: socket.socket | None = None
         self.collected: tuple[list[Datagram], list[Datagram]] | None = None  # with collect(): what receive() hands on
-        self.last_return = -MIN_RETURN_INTERVAL_S
+        self.return_times: deque[int] = deque(maxlen=RETURNS_PER_SECOND)  # ns of the last return packets sent
         self.returns_sent = self.returns_refused = self.messages_sent = self.messages_refused = self.send_errors = 0
 
     def open(self) -> None:
@@ -166,16 +167,16 @@ class GameNetwork:
         return datagrams
 
     def send(self, blackboard: Blackboard) -> None:
-        """Send what cognition handed over: the return packet (at most twice a second) and a team message
+        """Send what cognition handed over: the return packet (at most two in any second) and a team message
         (at most 128 bytes); anything beyond the limits is refused and counted, never sent."""
         answer = blackboard[GameControllerReturn] if GameControllerReturn in blackboard else None
         if answer is not None and answer.data and answer.host and self.game_controller is not None:
             # the platform's time: the wall clock on a robot, simulated time in a simulation at any speed
-            now = blackboard[FrameInfo].time_ns * 1e-9 if FrameInfo in blackboard else time.monotonic()
-            if now - self.last_return < MIN_RETURN_INTERVAL_S * 0.98:
-                self.returns_refused += 1
+            now_ns = blackboard[FrameInfo].time_ns if FrameInfo in blackboard else time.monotonic_ns()
+            if len(self.return_times) == RETURNS_PER_SECOND and now_ns - self.return_times[0] < 1_000_000_000:
+                self.returns_refused += 1  # a third within one second of the one two before
             elif self.transmit(self.game_controller, answer.data, (answer.host, self.settings.return_port)):
-                self.last_return = now
+                self.return_times.append(now_ns)
                 self.returns_sent += 1
         message = blackboard[OutgoingTeamMessage] if OutgoingTeamMessage in blackboard else None
         if message is not None and message.data and (self.team is not None or self.simulated and self.settings.enabled):

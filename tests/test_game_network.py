@@ -143,12 +143,12 @@ def test_the_network_refuses_what_the_rules_forbid_and_survives_a_taken_port(por
         board.set(FrameInfo(time_ns=10**9))  # the platform's clock decides the rate, not the wall clock
         board.set(GameControllerReturn(data=b"x" * 32, host="127.0.0.1"))
         board.set(OutgoingTeamMessage(data=b"y" * 129))
-        for _ in range(10):  # ten frames within a few milliseconds: one answer
+        for _ in range(10):  # ten frames within a few milliseconds: two answers, the most in any second
             network.send(board)
-        assert returns(receiver) == [b"x" * 32]
-        assert (network.returns_sent, network.returns_refused, network.messages_refused, network.messages_sent) == (1, 9, 10, 0)
+        assert returns(receiver) == [b"x" * 32] * 2
+        assert (network.returns_sent, network.returns_refused, network.messages_refused, network.messages_sent) == (2, 8, 10, 0)
         board.set(GameControllerReturn(data=b"z", host="no.such.host.invalid"))
-        board.set(FrameInfo(time_ns=int(1.5e9)))
+        board.set(FrameInfo(time_ns=int(2.5e9)))
         network.send(board)  # cannot be resolved: counted, not raised
         assert network.send_errors == 1
     finally:

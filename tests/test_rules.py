@@ -3,21 +3,36 @@ GameController's packets built from its published layout) and, where the issue a
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
+from tafel.core.manager import Blackboard
 from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.look_at_ball_behavior import LookAtBallBehavior
 from tafel.modules.communication.game_state_provider import GameStateProvider
 from tafel.modules.motion.head_motion import HeadMotion
 from tafel.modules.motion.status_leds import StatusLeds
+from tafel.platforms.network import GameNetwork, NetworkSettings
 from tafel.representations.behavior import HeadMotionRequest
-from tafel.representations.game import Datagram, GameControllerPackets, GameState, Penalty, RobotInfo, State, TeamInfo
-from tafel.representations.infrastructure import CognitionStatus
+from tafel.representations.game import (
+    Datagram,
+    GameControllerPackets,
+    GameControllerReturn,
+    GameState,
+    Penalty,
+    RobotInfo,
+    State,
+    TeamInfo,
+)
+from tafel.representations.infrastructure import CognitionStatus, FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, HeadJointTargets, JointSensorData, LedRequest
+from tafel.representations.team import OutgoingTeamMessage
 from tests.support.simulation import Simulation
 from tests.test_game_controller import packet  # built from the published layout, never from the code under test
 
@@ -117,3 +132,39 @@ def test_in_the_program_the_chest_follows_the_manual_mode_initial_penalized_play
         assert chests == [(0, 0, 0), (1, 0, 0), (0, 1, 0)]  # INITIAL off, PLAYING penalized red, PLAYING green
     finally:
         sim.close()
+
+
+# ------------------------------------------------------------------------------- return packets
+class CountingNetwork(GameNetwork):
+    """The platform's network with the socket left out: what it would send, and when (ns)."""
+
+    def __init__(self) -> None:
+        super().__init__(NetworkSettings(team_number=1, player_number=2))
+        self.game_controller = object()  # type: ignore[assignment]  # anything: transmit below never uses it
+        self.sent_at: list[int] = []
+        self.now_ns = 0
+
+    def transmit(self, sock: object, data: bytes, address: tuple[str, int]) -> bool:
+        self.sent_at.append(self.now_ns)
+        return True
+
+
+@given(st.lists(st.integers(1, 700_000_000), min_size=1, max_size=60))
+def test_the_platform_lets_at_most_two_return_packets_leave_in_any_second_and_refuses_no_more_than_that(gaps: list[int]) -> None:
+    network, board = CountingNetwork(), Blackboard()
+    for rep in (GameControllerReturn, OutgoingTeamMessage, FrameInfo):
+        board.ensure(rep)
+    board.set(GameControllerReturn(data=b"x" * 32, host="127.0.0.1"))
+    refused_at = []
+    for now in itertools.accumulate(gaps):
+        network.now_ns = now
+        board.set(FrameInfo(time_ns=now))
+        before = len(network.sent_at)
+        network.send(board)
+        if len(network.sent_at) == before:
+            refused_at.append(now)
+    sent = network.sent_at
+    assert all(later - earlier >= 1_000_000_000 for earlier, later in zip(sent, sent[2:]))  # never three within a second
+    for now in refused_at:  # and each refusal was needed: two had left within the second before
+        assert sum(now - 1_000_000_000 < t <= now for t in sent) == 2
+    assert (network.returns_sent, network.returns_refused) == (len(sent), len(refused_at))

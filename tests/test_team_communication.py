@@ -12,9 +12,10 @@ from hypothesis import strategies as st
 
 from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.role_provider import RoleProvider
+from tafel.modules.communication.game_state_provider import GameStateProvider
 from tafel.modules.communication.team_mates_provider import TeamMatesProvider
 from tafel.modules.communication.team_message_sender import TeamMessageSender, send_interval
-from tafel.representations.game import Datagram, GameState, RobotInfo, State, TeamInfo
+from tafel.representations.game import Datagram, GameControllerPackets, GameState, RobotInfo, State, TeamInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.team import (
     MAX_MESSAGE_BYTES,
@@ -166,6 +167,35 @@ def test_nothing_is_sent_outside_playing_and_without_a_game_controller_at_the_fa
     harness.execute(181)  # 6 s
     assert sum(bool(m.data) for m in harness.history(OutgoingTeamMessage)) == 4  # at 0, 2, 4, 6 s
     assert unpack_message(harness.history(OutgoingTeamMessage)[-1].data).player == 2
+
+
+@pytest.mark.slow
+def test_the_budget_holds_over_a_game_in_which_one_robot_stops_hearing_the_game_controller() -> None:
+    """Five robots, each GameStateProvider fed the GameController's packets (built from the published
+    layout) every 0.5 s, each TeamMessageSender paced by what its provider makes of them; the
+    GameController counts every message against the team's 1200. Player 3 goes deaf two minutes into
+    the game and stays in PLAYING: it goes on pacing on the last budget it heard, still talking."""
+    from tests.test_game_controller import packet
+
+    step, half_s, budget, deaf_from_s = 0.5, 600.0, 1200, 120.0
+    robots = [(ModuleHarness(GameStateProvider, rate_hz=1 / step),
+               ModuleHarness(TeamMessageSender, PlayerRole(), RobotPose(), BallModel(), rate_hz=1 / step, parameters={"half_s": half_s}))
+              for _ in range(5)]
+    sent = [0] * 5
+    for frame in range(int(2 * half_s / step)):
+        now = frame * step
+        first_half = now < half_s
+        remaining = int(math.ceil((half_s if first_half else 2 * half_s) - now))
+        data = packet(players=5, state=3, set_play=0, first_half=int(first_half), kicking=255, remaining=remaining, secondary=0,
+                      teams=((1, 0, 1, 1, 0, 0, 0, max(0, budget - sum(sent))), (2, 1, 3, 1, 0, 0, 0, 1200)))
+        for n, (provider, sender) in enumerate(robots):
+            hears = not (n == 2 and now >= deaf_from_s)
+            datagrams = [Datagram(data=data, host="10.0.0.1", received_ns=int(now * 1e9))] if hears else []
+            game = provider.set(GameControllerPackets(datagrams=datagrams, team_number=1, player_number=n + 1)).execute()[GameState]
+            sent[n] += bool(sender.set(game).execute()[OutgoingTeamMessage].data)
+    assert not robots[2][0].blackboard[GameState].heard and robots[2][0].blackboard[GameState].state is State.playing
+    assert sum(sent) <= budget, sent
+    assert sent[2] > 30 + 100, sent  # about 30 before it went deaf, and it kept talking afterwards
 
 
 # ------------------------------------------------------------------------------------- roles

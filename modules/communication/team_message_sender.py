@@ -36,8 +36,13 @@ def remaining_game_s(game: GameState, half_s: float) -> float:
 class TeamMessageSender(Module):
     """Sends while PLAYING. With a GameController, the interval is this robot's share of the team's
     ``messageBudget`` over the playing time left (``send_interval``): the players on the field (not
-    substitutes) share it, and ``reserve`` messages are kept back for the end. Without one (manual
-    mode) it sends every ``interval_without_game_controller`` s."""
+    substitutes) share it, and ``reserve`` messages are kept back for the end.
+
+    When the GameController goes quiet (``heard`` false after it was heard), the pacing goes on from
+    the last budget heard, as B-Human's and HULKs' do: each message this robot sends meanwhile counts
+    as one from every player (they share alike), and the time left stays what was last heard, so the
+    interval only grows and the team never spends more than its budget. A robot that never heard one
+    (the rules' manual mode) sends every ``interval_without_game_controller`` s."""
 
     @dataclass
     class Parameters:
@@ -52,6 +57,8 @@ class TeamMessageSender(Module):
     def __init__(self) -> None:
         self.last_sent_s = -math.inf
         self.ball_seen_s: float | None = None
+        self.last_heard: tuple[int, int, float] | None = None  # budget, players, playing s left: the last pacing heard
+        self.sent_since_heard = 0  # messages sent since the GameController was last heard
 
     def execute(self) -> None:
         game, out, now = self.game_state, self.outgoing_team_message, self.frame_info.time_s
@@ -61,17 +68,24 @@ class TeamMessageSender(Module):
         out.data = b""
         if game.state is not State.playing:
             return
-        team = game.own_team()
-        if game.heard and team is not None:
-            players = sum(1 for robot in team.players[: max(1, game.players_per_team)] if robot.penalty is not Penalty.substitute)
-            interval = send_interval(team.message_budget, players, remaining_game_s(game, p.half_s), p.reserve, p.min_interval)
-        else:
-            interval = p.interval_without_game_controller
+        interval = self.interval(game)
         if now - self.last_sent_s < interval - SEND_SLACK_S:
             return
         self.last_sent_s = now
+        self.sent_since_heard += 1
         out.data = pack_message(self.message(game, now))
         out.sent += 1
+
+    def interval(self, game: GameState) -> float:
+        """s between this robot's messages: its share of the budget heard, or of the last one heard."""
+        p, team = self.parameters, game.own_team()
+        if game.heard and team is not None and not game.manual:
+            players = sum(1 for robot in team.players[: max(1, game.players_per_team)] if robot.penalty is not Penalty.substitute)
+            self.last_heard, self.sent_since_heard = (team.message_budget, players, remaining_game_s(game, p.half_s)), 0
+        if self.last_heard is None:
+            return p.interval_without_game_controller
+        budget, players, remaining_s = self.last_heard
+        return send_interval(budget - max(1, players) * self.sent_since_heard, players, remaining_s, p.reserve, p.min_interval)
 
     def message(self, game: GameState, now: float) -> TeamMessage:
         pose, ball, role = self.robot_pose, self.ball_model, self.player_role
