@@ -13,6 +13,9 @@ import numpy as np
 from tafel.core import array, bounded, representation
 from tafel.core.representation import counter
 
+#: what the elements of a rotation matrix take: -1 to 1, with room for rounding (1 + 2e-16 after a product)
+ROTATION_ELEMENT = (-1.0 - 1e-9, 1.0 + 1e-9)
+
 JOINT_NAMES: tuple[str, ...] = (
     "HeadYaw", "HeadPitch",
     "LShoulderPitch", "LShoulderRoll", "LElbowYaw", "LElbowRoll", "LWristYaw",
@@ -97,7 +100,7 @@ class CameraMatrix:
     frame, whose x axis is the optical axis, y points left and z up in the image. ``valid`` once
     computed from measured joints."""
 
-    rotation: np.ndarray = field(default_factory=lambda: np.eye(3), metadata={"range": (-1.0, 1.0)})  # a rotation's elements
+    rotation: np.ndarray = field(default_factory=lambda: np.eye(3), metadata={"range": ROTATION_ELEMENT})
     translation: np.ndarray = array((3,))
     valid: bool = False
 
@@ -125,9 +128,9 @@ class CameraMatrixBuffer:
 
     count: int = bounded(0, CAMERA_MATRIX_HISTORY, 0)
     time_ns: np.ndarray = array((CAMERA_MATRIX_HISTORY,), np.int64)
-    top_rotation: np.ndarray = bounded(-1.0, 1.0, array_shape=(CAMERA_MATRIX_HISTORY, 3, 3))
+    top_rotation: np.ndarray = bounded(*ROTATION_ELEMENT, array_shape=(CAMERA_MATRIX_HISTORY, 3, 3))
     top_translation: np.ndarray = array((CAMERA_MATRIX_HISTORY, 3))
-    bottom_rotation: np.ndarray = bounded(-1.0, 1.0, array_shape=(CAMERA_MATRIX_HISTORY, 3, 3))
+    bottom_rotation: np.ndarray = bounded(*ROTATION_ELEMENT, array_shape=(CAMERA_MATRIX_HISTORY, 3, 3))
     bottom_translation: np.ndarray = array((CAMERA_MATRIX_HISTORY, 3))
 
     @classmethod
@@ -195,7 +198,7 @@ class TorsoPose:
     """The torso's pose in the robot frame: ``rotation`` (3x3) and ``translation`` (mm); the
     translation's z is the torso's height above the ground."""
 
-    rotation: np.ndarray = field(default_factory=lambda: np.eye(3), metadata={"range": (-1.0, 1.0)})  # a rotation's elements
+    rotation: np.ndarray = field(default_factory=lambda: np.eye(3), metadata={"range": ROTATION_ELEMENT})
     translation: np.ndarray = array((3,))
 
 
