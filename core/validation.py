@@ -141,8 +141,9 @@ def _check_array(info: FieldInfo, value: Any, where: str, bounds: tuple[float, f
     spec = info.array
     assert spec is not None
     try:
-        array = check_array(value, spec, "a client", where.split(".")[0], where.split(".", 1)[-1]) if spec.declared \
-            else np.asarray(value, dtype=np.float64)
+        with np.errstate(over="ignore", invalid="ignore"):  # 1e308 into float32 becomes inf: refused below, no warning
+            array = check_array(value, spec, "a client", where.split(".")[0], where.split(".", 1)[-1]) if spec.declared \
+                else np.asarray(value, dtype=np.float64)
     except ArrayFieldError:
         shape = "x".join("any" if n is None else str(n) for n in spec.shape)
         got = np.asarray(value)
