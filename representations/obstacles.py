@@ -1,0 +1,55 @@
+"""Other robots near this one, to walk around: what was seen (``RobotsPercept``) and what is known
+(``Obstacles``, from what was seen and what the teammates said). Robot frame, mm."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+from tafel.core import bounded, representation
+
+ROBOT_RADIUS = 150.0  # mm: a NAO's footprint, arms in, seen from above
+
+
+class ObstacleKind(enum.Enum):
+    robot = 0
+    """seen, of a team not known"""
+    teammate = 1
+    """where a teammate said it was"""
+
+
+@dataclass
+class SeenRobot:
+    """A robot seen this frame: its centre on the ground (mm, robot frame)."""
+
+    x: float = 0.0
+    y: float = 0.0
+
+
+@representation
+class RobotsPercept:
+    """Robots seen this frame: by sonar, in the images, or (``tafel match --cameras off``) from the
+    world's ground truth within the robot's view."""
+
+    robots: list[SeenRobot]
+
+
+@dataclass
+class Obstacle:
+    """Something to walk around: its centre (mm, robot frame), its radius (mm: the robot's and the
+    uncertainty of where it is), what it is, and how old the news is (s)."""
+
+    x: float = 0.0
+    y: float = 0.0
+    radius: float = ROBOT_RADIUS
+    kind: ObstacleKind = ObstacleKind.robot
+    age: float = 0.0
+
+
+@representation
+class Obstacles:
+    """Every robot this one knows to be near (robot frame), nearest first."""
+
+    obstacles: list[Obstacle]
+    clearance: float = bounded(0.0, 2000.0, 0.0)
+    """mm between this robot's centre and the nearest obstacle's edge (0: none near or touching)"""
