@@ -39,10 +39,12 @@ from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import RobotPose
 from tafel.representations.motion import HEAD_YAW, JOINT_COUNT, FsrData, InertialSensorData, JointCommand, JointSensorData, TouchSensorData
 from tafel.representations.nao import HORIZONTAL_FOV
+from tafel.representations.obstacles import RobotsPercept, SeenRobot
 from tafel.representations.perception import BallPercept, CameraImageBottom, CameraImageTop
 
 AUTHKEY_ENV = "TAFEL_MATCH_KEY"  # the world's connection key, given to each robot's process by tafel match
 MAX_SEEN_DISTANCE = 6000.0  # mm: the ground-truth perception sees the ball this far
+ROBOT_SEEN_DISTANCE, ROBOT_SEEN_ANGLE = 3000.0, math.radians(100.0)  # mm, rad: and other robots this near, this far round
 
 
 class MatchRobotPlatform(SimulatedRobotPlatform):
@@ -60,7 +62,7 @@ class MatchRobotPlatform(SimulatedRobotPlatform):
         self.address = (host, int(port))
         self.index = int(self.options.get("index") or 0)
         self.side = Side(-1.0 if str(self.options.get("side") or "+x") == "-x" else 1.0)
-        cognition = (FrameInfo, CameraImageTop, CameraImageBottom) if self.cameras else (FrameInfo, BallPercept, RobotPose)
+        cognition = (FrameInfo, CameraImageTop, CameraImageBottom) if self.cameras else (FrameInfo, BallPercept, RobotPose, RobotsPercept)
         self.provides = {"motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData, TouchSensorData),  # type: ignore[misc]
                          "cognition": (*cognition, *NETWORK_INPUTS)}
         self.consumes = {"motion": (JointCommand,), "cognition": NETWORK_OUTPUTS}  # type: ignore[misc]
@@ -139,6 +141,21 @@ class MatchRobotPlatform(SimulatedRobotPlatform):
         spread = 10.0 + 0.02 * distance
         percept.x, percept.y = ((bx + self.rng.normal(0.0, spread), by + self.rng.normal(0.0, spread)) if percept.seen else (0.0, 0.0))
         percept.camera = "top" if percept.seen else ""
+        blackboard[RobotsPercept].robots = self.robots_near(x, y, heading)
+
+    def robots_near(self, x: float, y: float, heading: float) -> list[SeenRobot]:
+        """The other robots within ``ROBOT_SEEN_DISTANCE`` and ``ROBOT_SEEN_ANGLE`` of the torso's heading
+        (what sonar and cameras would tell), robot frame mm, without noise beyond the pose's."""
+        seen, c, s = [], math.cos(heading), math.sin(heading)
+        for index, world in enumerate(self.snapshot.robots if self.snapshot is not None else ()):
+            if index == self.index:
+                continue
+            ox, oy, _ = self.side.to_team(*world)
+            dx, dy = ox - x, oy - y
+            rx, ry = c * dx + s * dy, -s * dx + c * dy
+            if math.hypot(rx, ry) < ROBOT_SEEN_DISTANCE and abs(math.atan2(ry, rx)) < ROBOT_SEEN_ANGLE:
+                seen.append(SeenRobot(rx, ry))
+        return seen
 
     # ----------------------------------------------------------------- what the engine answers
     def joint_angles(self) -> np.ndarray:

@@ -55,6 +55,8 @@ class Snapshot:
     torso_rotation: np.ndarray
     ball: tuple[float, float]
     qpos: np.ndarray | None
+    robots: tuple[tuple[float, float], ...] = ()
+    """every robot's torso on the ground (world mm), for ground-truth perception of the others"""
 
 
 class MatchWorld:
@@ -91,7 +93,8 @@ class MatchWorld:
         position, rotation = robot.torso_pose(data)
         return Snapshot(time_ns=self.time_ns, joints=robot.joint_angles(data), torques=robot.joint_torques(data),
                         accelerometer=accelerometer, gyroscope=gyroscope, fsr=robot.foot_forces(data), torso_position=position,
-                        torso_rotation=rotation, ball=self.ball_position(), qpos=data.qpos.copy() if with_world else None)
+                        torso_rotation=rotation, ball=self.ball_position(), qpos=data.qpos.copy() if with_world else None,
+                        robots=tuple(self.robot_pose(k)[:2] for k in range(len(self.robots))))
 
     # ----------------------------------------------------------------------------- where things are
     def robot_pose(self, index: int) -> tuple[float, float, float]:

@@ -21,8 +21,8 @@ def outside(x: float, y: float, discs: Sequence[Disc], margin: float = 0.0) -> t
         dx, dy = x - cx, y - cy
         distance = math.hypot(dx, dy)
         if distance < reach:
-            if distance < 1e-6:  # at the centre: out towards the robot
-                dx, dy, distance = -cx, -cy, max(math.hypot(cx, cy), 1e-6)
+            if distance < 1e-6:  # at the centre: out towards the robot (or backwards, if it is there too)
+                dx, dy, distance = (-cx, -cy, math.hypot(cx, cy)) if math.hypot(cx, cy) > 1e-6 else (-1.0, 0.0, 1.0)
             x, y = cx + dx / distance * reach, cy + dy / distance * reach
     return x, y
 

@@ -1,0 +1,64 @@
+"""ObstacleModeler: the robots near this one, from what it sees and what its teammates say."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from tafel.core import Module, bounded, provides, requires, uses
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.modeling import RobotPose
+from tafel.representations.obstacles import ROBOT_RADIUS, Obstacle, ObstacleKind, Obstacles, RobotsPercept
+from tafel.representations.team import TeamMates
+
+
+@requires(FrameInfo)
+@uses(RobotsPercept, TeamMates, RobotPose)
+@provides(Obstacles)
+class ObstacleModeler(Module):
+    """Keeps the robots seen (``RobotsPercept``) for ``memory_s`` s, on the field while the pose is
+    valid (so that they stay put while this robot turns and walks), and adds every teammate that said
+    where it is within ``mate_timeout`` s and is not penalized (a penalized robot is off the field).
+    A teammate's radius grows with the age of its message (``mate_spread`` mm/s: it may have walked
+    meanwhile); a seen robot within ``same_robot`` mm of a teammate is that teammate, and one seen
+    again within two robot radii of where it was remembered replaces that memory."""
+
+    @dataclass
+    class Parameters:
+        memory_s: float = bounded(0.0, 10.0, 1.0)
+        """s a seen robot is remembered after it was last seen"""
+        mate_timeout: float = bounded(0.0, 30.0, 6.0)
+        """s after a teammate's message that its position is still used"""
+        mate_spread: float = bounded(0.0, 500.0, 60.0)
+        """mm/s the uncertainty of a teammate's position grows with the age of its message"""
+        same_robot: float = bounded(0.0, 2000.0, 400.0)
+        """mm: a seen robot this near a teammate is the teammate"""
+        max_distance: float = bounded(500.0, 15000.0, 4000.0)
+        """mm: obstacles farther away are left out"""
+
+    def __init__(self) -> None:
+        self.seen: list[tuple[float, float, float]] = []  # field mm, mm, and when (s)
+
+    def execute(self) -> None:
+        p, pose, now, out = self.parameters, self.robot_pose, self.frame_info.time_s, self.obstacles
+        obstacles: list[Obstacle] = []
+        if pose.valid:
+            fresh = [(*pose.to_field(r.x, r.y), now) for r in self.robots_percept.robots]
+            kept = [(x, y, t) for x, y, t in self.seen
+                    if now - t <= p.memory_s and all(math.hypot(x - fx, y - fy) > 2 * ROBOT_RADIUS for fx, fy, _ in fresh)]
+            self.seen = fresh + kept  # a robot seen again replaces its memory
+            mates = [m for m in self.team_mates.fresh(p.mate_timeout) if m.message.pose_valid and not m.message.penalized]
+            for mate in mates:
+                x, y = pose.to_robot(mate.message.x, mate.message.y)
+                obstacles.append(Obstacle(x, y, ROBOT_RADIUS + p.mate_spread * mate.age, ObstacleKind.teammate, mate.age))
+            for fx, fy, when in self.seen:
+                if any(math.hypot(fx - m.message.x, fy - m.message.y) < p.same_robot for m in mates):
+                    continue
+                x, y = pose.to_robot(fx, fy)
+                obstacles.append(Obstacle(x, y, ROBOT_RADIUS, ObstacleKind.robot, now - when))
+        else:  # without a pose: what is seen now, in the robot frame
+            self.seen = []
+            obstacles = [Obstacle(r.x, r.y, ROBOT_RADIUS, ObstacleKind.robot, 0.0) for r in self.robots_percept.robots]
+        obstacles = sorted((o for o in obstacles if math.hypot(o.x, o.y) <= p.max_distance), key=lambda o: math.hypot(o.x, o.y))
+        out.obstacles = obstacles
+        out.clearance = max(0.0, min((math.hypot(o.x, o.y) - o.radius for o in obstacles), default=0.0))

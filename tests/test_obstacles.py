@@ -1,0 +1,69 @@
+"""ObstacleModeler and the way round obstacles (``paths``), through the mocked blackboard."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from tafel.core.testing import ModuleHarness
+from tafel.modules.behavior.paths import blocking, outside, waypoint
+from tafel.modules.modeling.obstacle_modeler import ObstacleModeler
+from tafel.representations.modeling import RobotPose
+from tafel.representations.obstacles import ObstacleKind, Obstacles, RobotsPercept, SeenRobot
+from tafel.representations.team import TeamMate, TeamMates, TeamMessage
+
+
+def mate(player: int, x: float, y: float, *, age: float = 0.5, penalized: bool = False) -> TeamMate:
+    return TeamMate(TeamMessage(team=1, player=player, pose_valid=True, x=x, y=y, penalized=penalized), age=age)
+
+
+def test_teammates_are_obstacles_where_they_said_they_were_growing_with_the_age_of_the_news() -> None:
+    pose = RobotPose(valid=True, x=-1000.0, y=0.0, rotation=math.pi / 2)
+    mates = TeamMates(mates=[mate(3, -1000.0, 1000.0, age=0.5), mate(4, 0.0, 0.0, age=4.0), mate(5, 500.0, 0.0, penalized=True)])
+    found = ModuleHarness(ObstacleModeler, pose, mates).execute()[Obstacles].obstacles
+    assert [(round(o.x), round(o.y), o.kind) for o in found] == [(1000, 0, ObstacleKind.teammate), (0, -1000, ObstacleKind.teammate)]
+    assert found[0].radius < found[1].radius  # four-second-old news is less sure
+
+
+def test_seen_robots_stay_put_on_the_field_while_this_robot_turns_and_are_forgotten_after_a_while() -> None:
+    harness = ModuleHarness(ObstacleModeler, RobotPose(valid=True), RobotsPercept(robots=[SeenRobot(800.0, 0.0)]))
+    harness.execute()
+    harness.set(RobotsPercept(robots=[]), RobotPose(valid=True, rotation=math.pi / 2))  # turned left, no longer seen
+    held = harness.execute()[Obstacles].obstacles
+    assert len(held) == 1 and (held[0].x, held[0].y) == pytest.approx((0.0, -800.0), abs=1e-6)
+    harness.execute(40)  # > 1 s later
+    assert harness.blackboard[Obstacles].obstacles == []
+
+
+def test_a_robot_seen_where_a_teammate_is_counts_once() -> None:
+    harness = ModuleHarness(ObstacleModeler, RobotPose(valid=True), RobotsPercept(robots=[SeenRobot(1000.0, 100.0)]),
+                            TeamMates(mates=[mate(3, 1050.0, 0.0)]))
+    for _ in range(10):  # seen again every frame: one obstacle, not one per frame
+        found = harness.execute()[Obstacles].obstacles
+    assert len(found) == 1 and found[0].kind is ObstacleKind.teammate
+
+
+discs = st.lists(st.tuples(st.floats(-3000, 3000), st.floats(-3000, 3000), st.floats(100, 600)), max_size=4)
+
+
+@given(discs, st.floats(-4000, 4000), st.floats(-4000, 4000))
+def test_the_first_waypoint_never_leads_through_the_first_disc_in_the_way(obstacles: list, x: float, y: float) -> None:
+    way = waypoint(x, y, obstacles, margin=100.0)
+    first = blocking(x, y, obstacles)
+    if first is None:
+        assert way == (x, y)
+    else:
+        _, disc = first
+        hit = blocking(*way, [disc])
+        assert hit is None  # past the disc that was in the way
+
+
+@given(discs, st.floats(-4000, 4000), st.floats(-4000, 4000))
+def test_a_target_in_a_forbidden_disc_moves_to_its_edge(zones: list, x: float, y: float) -> None:
+    zones = zones[:1]
+    ox, oy = outside(x, y, zones)
+    for cx, cy, radius in zones:
+        assert math.hypot(ox - cx, oy - cy) >= radius - 1e-6
