@@ -155,7 +155,7 @@ def load_config(
 MAX_RATE_HZ = 1000.0
 #: [runtime] key -> (what it is, check)
 RUNTIME_KEYS: dict[str, str] = {
-    "cognition_hz": "rate", "motion_hz": "rate", "stall_timeout_s": "seconds", "shutdown_grace_s": "seconds",
+    "cognition_hz": "rate", "motion_hz": "rate", "stall_timeout_s": "seconds", "shutdown_grace_s": "seconds", "stuck_timeout_s": "seconds",
     "default_platform": "name",
 }
 

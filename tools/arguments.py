@@ -185,3 +185,18 @@ def add_console_command(commands: Any) -> None:
     console.add_argument("--port", type=port_number, default=5401)
     console.add_argument("--token", help="send 'auth TOKEN' first")
     console.add_argument("-c", dest="one_command", metavar="COMMAND", help="run one command, print its answer and exit (status 1 on error:)")
+
+
+def add_deploy_commands(commands: Any) -> None:
+    """``tafel robots`` and ``tafel deploy``: the code is in ``tafel.tools.deploy``."""
+    robots = commands.add_parser("robots", help="list the robots of robots.toml, whether they answer and which release they run")
+    deploy = commands.add_parser("deploy", help="build, copy and install the program on a robot and (re)start it there",
+                                 description="Builds the wheel, its dependencies for the robot and the configuration, copies "
+                                             "what changed over SSH (rsync), installs it as a new release and starts it; a "
+                                             "release that fails to install or start leaves the robot on the one it had.")
+    deploy.add_argument("robot", metavar="ROBOT", help="a robot's name in robots.toml")
+    deploy.add_argument("--dry-run", action="store_true", help="say what would be copied and installed; change nothing")
+    deploy.add_argument("--staging", type=Path, metavar="DIR", help="where the release is built (default ~/.cache/tafel/deploy/ROBOT)")
+    for parser in (robots, deploy):
+        parser.add_argument("--config", type=Path, metavar="DIR", help="a configuration folder with robots.toml (on top of the shipped one)")
+        parser.add_argument("--ssh-config", type=Path, metavar="FILE", help="an SSH configuration file (default: your own)")
