@@ -60,6 +60,13 @@ def host_allowed(host_header: str, bound: str, names: bool = False) -> bool:
     return True
 
 
+def origin_allowed(origin: str | None, host_header: str, allowed: Iterable[str] = ()) -> bool:
+    """Whether a WebSocket with this ``Origin`` may connect: none (not a browser page), a page of this very
+    server (same host and port as ``Host``), or one of the ``allowed`` origins; any other site's page is refused
+    (cross-site WebSocket hijacking). Shared by every server the program opens to WebSockets."""
+    return origin is None or urlsplit(origin).netloc == host_header or origin.rstrip("/") in {a.rstrip("/") for a in allowed}
+
+
 class WebSocketSession(Session):
     """One page over a WebSocket: command lines in, answers and subscribed data out."""
 
@@ -303,7 +310,7 @@ class WebServer:
         path = urlsplit(request.path).path
         if path == WEBSOCKET_PATH:
             origin = request.headers.get("Origin")
-            if origin is not None and urlsplit(origin).netloc != host:
+            if not origin_allowed(origin, host):
                 self.refused_origin += 1
                 log.warning("web: refused a WebSocket from a page of %s", origin)
                 return connection.respond(403, "a page of another site may not steer this program\n")

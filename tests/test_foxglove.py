@@ -215,3 +215,68 @@ def test_a_wrong_jpeg_quality_is_refused_before_the_run(tmp_path: Path, value: s
                    "--set", f"foxglove.jpeg_quality={value}")
     assert result.returncode == 2 and "foxglove.jpeg_quality takes a whole number from 1 to 100" in result.stderr
     assert "Traceback" not in result.stderr
+
+
+def test_each_json_channel_has_a_schema_its_messages_fit_field_by_field() -> None:
+    """The series topics declare their fields (Foxglove's panels offer them): every message validates, and every
+    field it carries is declared, in recordings (``encoded``) as live (the same schemas)."""
+    import jsonschema
+
+    from tafel.debug.concepts import ModuleTimes
+    from tafel.representations.infrastructure import FrameInfo
+    from tafel.representations.motion import FsrData, InertialSensorData, JointCommand, JointSensorData
+    from tafel.tools.foxglove_channels import JSON_SCHEMAS, FoxgloveTranslator
+
+    translator = FoxgloveTranslator()
+    rng = np.random.default_rng(3)
+    messages = []
+    for frame in range(5):
+        t = frame * 10_000_000
+        for context, value in (("motion", JointSensorData(position=rng.normal(size=25), temperature=rng.uniform(30, 60, 25))),
+                               ("motion", JointCommand(position=rng.normal(size=25), stiffness=rng.uniform(0, 1, 25))),
+                               ("motion", InertialSensorData(accelerometer=rng.normal(size=3), gyroscope=rng.normal(size=3),
+                                                             angles=rng.normal(size=2))),
+                               ("motion", FsrData(pressure=rng.uniform(0, 2, 8))),
+                               ("motion", ModuleTimes(names=["WalkingEngine", "StandMotion"], milliseconds=[0.4, 0.1])),
+                               ("cognition", ModuleTimes(names=["BallDetector"], milliseconds=[2.5])),
+                               ("motion", FrameInfo(frame_number=frame, time_ns=t)), ("cognition", FrameInfo(frame_number=frame, time_ns=t))):
+            messages += translator.feed(context, value, t)
+    by_topic: dict[str, list[dict[str, Any]]] = defaultdict(list)
+    for out in messages:
+        if isinstance(out.message, dict):
+            by_topic[out.topic].append(out.message)
+            assert out.encoded().schema_data == JSON_SCHEMAS[out.topic]
+    assert set(by_topic) == set(JSON_SCHEMAS) == {"/joints", "/imu", "/fsr", "/timing", "/rates"}
+    for topic, sent in by_topic.items():
+        schema = json.loads(JSON_SCHEMAS[topic])
+        jsonschema.Draft202012Validator.check_schema(schema)
+        for message in sent:
+            jsonschema.validate(message, schema)
+            assert set(message) <= set(schema["properties"]), (topic, message)
+    fields = json.loads(JSON_SCHEMAS["/joints"])["properties"]
+    assert set(fields) == {"position", "temperature", "command", "stiffness"} and fields["command"]["properties"]["LKneePitch"] == {"type": "number"}
+    assert json.loads(JSON_SCHEMAS["/imu"])["properties"]["angles"]["properties"] == {"roll": {"type": "number"}, "pitch": {"type": "number"}}
+    with pytest.raises(jsonschema.ValidationError):  # a schema that says something: a wrong message does not fit
+        jsonschema.validate({"accelerometer": {"x": "high"}}, json.loads(JSON_SCHEMAS["/imu"]))
+
+
+def test_the_layout_ships_in_the_package() -> None:
+    """Every file of config/foxglove/ is package data of ``tafel.config`` (the wheel test installs and finds it)."""
+    import fnmatch
+    import tomllib
+
+    patterns = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]["tafel.config"]
+    shipped = sorted(path.relative_to(REPO / "config").as_posix() for path in (REPO / "config" / "foxglove").iterdir() if path.is_file())
+    assert "foxglove/tafel-layout.json" in shipped
+    missing = [name for name in shipped if not any(fnmatch.fnmatch(name, pattern) for pattern in patterns)]
+    assert not missing, f"add to [tool.setuptools.package-data] tafel.config in pyproject.toml: {missing}"
+
+
+def test_json_command_requests_say_what_to_send() -> None:
+    from tafel.tools.foxglove_live import command_from_json
+
+    assert command_from_json('{"command": " modules:list "}') == "modules:list"
+    assert command_from_json('"ping"') == "ping"
+    for bad in ("{", "{}", '{"command": ""}', '{"command": 5}', '{"command": "ping", "x": 1}', "[]", "null"):
+        with pytest.raises(ValueError, match=r'send \{"command": "COMMAND LINE"\}'):
+            command_from_json(bad)

@@ -3,17 +3,22 @@ specification, on the ``websockets`` package) watches and steers the default sim
 
 from __future__ import annotations
 
+import json
 import re
+import socket
+import struct
 import time
 from collections.abc import Iterator
 from typing import Any
 
 import cv2
+import jsonschema
 import numpy as np
 import pytest
 from websockets.exceptions import InvalidStatus
 
-from tests.support.foxglove_client import FoxgloveClient
+from tests.support.foxglove_client import FoxgloveClient, ServiceCallFailure
+from tests.test_cli_runtime import tafel
 from tests.test_debug_server import Program
 from tests.test_foxglove import sdk_class
 
@@ -142,3 +147,130 @@ def test_contexts_in_their_own_processes_are_served_too() -> None:
         client.close()
     finally:
         program.stop()
+
+
+@pytest.mark.slow
+def test_a_client_that_asks_for_the_old_protocol_name_gets_in_without_a_token(live: tuple[Program, str]) -> None:
+    """Older Lichtblick and third-party clients offer only ``foxglove.websocket.v1`` (the SDK knows only the new name)."""
+    _, url = live
+    client = FoxgloveClient(url, subprotocol="foxglove.websocket.v1")
+    try:
+        assert client.socket.subprotocol == "foxglove.websocket.v1"
+        assert "/camera/top" in client.wait_for(client.topics)
+        assert client.call_service("/tafel/command", b"ping") == b"pong"
+    finally:
+        client.close()
+    with pytest.raises(InvalidStatus, match="400"):  # neither name: refused, saying which to ask for
+        FoxgloveClient(url, subprotocol="chat")
+
+
+@pytest.mark.slow
+def test_pages_of_other_sites_and_rebinding_names_are_refused(live: tuple[Program, str]) -> None:
+    """Without a token: a page of another site (cross-site WebSocket hijacking) and a DNS name pointed at the
+    robot (DNS rebinding) get no connection, so never ``/tafel/command``; a desktop app (no Origin) and a page
+    of the server's own origin do."""
+    program, url = live
+    port = int(url.rsplit(":", 1)[1])
+    with pytest.raises(InvalidStatus, match="403"):
+        FoxgloveClient(url, origin="http://attacker.example")
+    with pytest.raises(InvalidStatus, match="403"):
+        FoxgloveClient(url, host="rebind.attacker.example")
+    with pytest.raises(InvalidStatus, match="403"):  # the rebinding page's own origin does not help
+        FoxgloveClient(url, host="rebind.attacker.example", origin=f"http://rebind.attacker.example:{port}")
+    assert "may not steer this program" in "".join(program.errors)
+    for allowed in (FoxgloveClient(url), FoxgloveClient(url, origin=f"http://127.0.0.1:{port}"), FoxgloveClient(url, host="localhost")):
+        try:
+            assert allowed.call_service("/tafel/command", b"ping") == b"pong"
+        finally:
+            allowed.close()
+
+
+@pytest.mark.slow
+def test_the_command_service_takes_json_as_the_service_call_panel_sends_it(clients: tuple[FoxgloveClient, Any]) -> None:
+    client, debug = clients
+    assert "json" in client.wait_for(lambda: client.server_info)["supportedEncodings"]
+    answer = json.loads(client.call_service("/tafel/command", b'{"command": "ping"}', encoding="json"))
+    assert answer == {"answer": "pong"}
+    listed = json.loads(client.call_service("/tafel/command", json.dumps({"command": "modules:list"}).encode(), encoding="json"))
+    assert listed["answer"][:20] == debug.ask("modules:list")[:20]
+    for bad, says in ((b'{"command": ', "not JSON"), (b"{}", "names no command"), (b'{"cmd": "ping"}', "unknown field 'cmd'"),
+                      (b'{"command": 5}', "names no command")):
+        with pytest.raises(ServiceCallFailure) as failure:
+            client.call_service("/tafel/command", bad, encoding="json")
+        assert says in str(failure.value) and '{"command": "' in str(failure.value), failure.value  # and what to send
+
+
+@pytest.mark.slow
+def test_a_refused_parameter_answers_with_its_value_and_says_why(clients: tuple[FoxgloveClient, Any]) -> None:
+    client, _ = clients
+    before = client.get_parameters("/SoccerBehavior/search_turn")["/SoccerBehavior/search_turn"]
+    answer = client.set_parameters({"/SoccerBehavior/search_turn": 1e9})
+    assert answer == {"/SoccerBehavior/search_turn": pytest.approx(before)}
+    status = client.wait_for(lambda: next((r for r in client.replies if r.get("op") == "status"), None))
+    assert status["level"] == 1  # a warning, shown by Foxglove and Lichtblick
+    assert "/SoccerBehavior/search_turn" in status["message"] and "takes 0 to 2" in status["message"], status
+    client.replies.clear()
+    assert client.set_parameters({"/NoSuch": 1.0}) == {}
+    status = client.wait_for(lambda: next((r for r in client.replies if r.get("op") == "status"), None))
+    assert "/MODULE/NAME" in status["message"]
+
+
+@pytest.mark.slow
+def test_each_json_channel_declares_the_fields_its_messages_carry(clients: tuple[FoxgloveClient, Any]) -> None:
+    client, _ = clients
+    json_topics = ("/joints", "/imu", "/fsr", "/timing", "/rates")
+    client.subscribe(*json_topics)
+    client.wait_for(lambda: all(len(client.received.get(topic, [])) >= 20 for topic in json_topics), 20)
+    channels = client.topics()
+    for topic in json_topics:
+        assert channels[topic]["schemaEncoding"] == "jsonschema"
+        schema = json.loads(channels[topic]["schema"])
+        jsonschema.Draft202012Validator.check_schema(schema)
+        declared = set(schema["properties"])
+        for _, payload in client.received[topic]:
+            message = json.loads(payload)
+            jsonschema.validate(message, schema)
+            assert set(message) <= declared, (topic, set(message) - declared)
+        assert declared, topic
+    joints = json.loads(channels["/joints"]["schema"])["properties"]["position"]["properties"]
+    assert "LKneePitch" in joints and joints["LKneePitch"] == {"type": "number"}
+
+
+@pytest.mark.slow
+def test_a_subscriber_that_goes_away_costs_one_line() -> None:
+    """A client that streams everything and disappears (its socket closed under it, or reset) leaves at most one
+    line about it on the program's stderr, not one per message the server still had for it (hundreds)."""
+    program = Program("--platform", "mujoco", "--foxglove", "0")
+    try:
+        url = foxglove_url(program)
+        for how in ("closed", "reset", "closed", "closed", "closed", "closed"):
+            before = len(program.errors)
+            client = FoxgloveClient(url)
+            client.subscribe(*sorted(client.wait_for(client.topics)))
+            client.pump(1.0)
+            raw = client.socket.socket
+            if how == "reset":
+                raw.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+            raw.close()  # under the client's reading thread, as when its process dies
+            time.sleep(2.0)
+            lines = [line for line in program.errors[before:] if "foxglove" in line and "[tafel]" not in line]
+            assert len(lines) <= 1, f"{how}: {len(lines)} lines, " + "".join(lines[:3])
+    finally:
+        program.stop()
+
+
+@pytest.mark.slow
+def test_configured_origins_are_let_in_and_a_wrong_list_is_refused_at_start() -> None:
+    """``[foxglove] origins``: a browser app the user trusts (Foxglove's web app) gets in, other pages still not."""
+    program = Program("--platform", "dummy", "--foxglove", "0", "--set", 'foxglove.origins=["https://app.foxglove.dev"]')
+    try:
+        url = foxglove_url(program)
+        client = FoxgloveClient(url, origin="https://app.foxglove.dev")
+        assert client.call_service("/tafel/command", b"ping") == b"pong"
+        client.close()
+        with pytest.raises(InvalidStatus, match="403"):
+            FoxgloveClient(url, origin="https://app.foxglove.dev.attacker.example")
+    finally:
+        program.stop()
+    wrong = tafel("run", "--platform", "dummy", "--seconds", "0.2", "--no-debug", "--foxglove", "0", "--set", "foxglove.origins=5")
+    assert wrong.returncode == 2 and "foxglove.origins takes a list of web origins" in wrong.stderr and "Traceback" not in wrong.stderr

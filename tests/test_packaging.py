@@ -72,6 +72,7 @@ def test_a_built_wheel_runs_from_anywhere(tmp_path: Path) -> None:
                            cwd=work, env=env, check=True, capture_output=True, text=True).stdout.split()
     assert all(str(REPO) not in line for line in where), f"the installed package resolves into the source tree: {where}"
     assert Path(where[1], "general.toml").is_file(), "the default configuration does not ship inside the package"
+    assert Path(where[1], "foxglove", "tafel-layout.json").is_file(), "the Foxglove layout does not ship inside the package"
     tafel = str(env_dir / "bin" / "tafel")
     run = subprocess.run([tafel, "run", "--platform", "dummy", "--seconds", "2", "--speed", "max", "--no-debug",
                           "--record", "run.mcap"], cwd=work, env=env, capture_output=True, text=True, timeout=120)

@@ -446,7 +446,7 @@ def start_foxglove(args: argparse.Namespace, debug: ProgramDebug | None, config:
         print(f"warning: the Foxglove server listens on {host} without a token: anybody on that network can watch and "
               "steer this program; give one with --debug-token-file F", file=sys.stderr, flush=True)
     live = FoxgloveLive(host, port, ask=debug.server.ask if debug is not None else None, jpeg_quality=jpeg_quality(config), token=token,
-                        flags=flags)
+                        flags=flags, origins=foxglove_origins(config))
     try:
         host, port = live.start()
     except Exception as exc:  # noqa: BLE001 - the SDK reports a taken port as a plain RuntimeError
@@ -675,6 +675,15 @@ def jpeg_quality(config: dict[str, Any]) -> int:
     value = config.get("foxglove", {}).get("jpeg_quality", 80)
     if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 100:
         fail(f"foxglove.jpeg_quality takes a whole number from 1 to 100 (JPEG quality of the images), got {value!r}")
+    return value
+
+
+def foxglove_origins(config: dict[str, Any]) -> list[str]:
+    """``[foxglove] origins``: web pages (``"https://app.foxglove.dev"``) whose WebSockets the live server takes besides
+    clients that send no Origin (desktop apps); anything but a list of such origins exits with status 2."""
+    value = config.get("foxglove", {}).get("origins", [])
+    if not isinstance(value, list) or not all(isinstance(o, str) and re.fullmatch(r"https?://[^/\s]+/?", o) for o in value):
+        fail(f'foxglove.origins takes a list of web origins such as ["https://app.foxglove.dev"], got {value!r}')
     return value
 
 

@@ -74,7 +74,30 @@ USED = frozenset(rep for reps in NEEDS.values() for rep in reps) | frozenset(CAM
 COLORS = {"black": (0, 0, 0), "white": (1, 1, 1), "red": (1, 0, 0), "green": (0, 0.6, 0), "blue": (0, 0, 1), "yellow": (1, 1, 0),
           "orange": (1, 0.55, 0), "gray": (0.5, 0.5, 0.5), "grey": (0.5, 0.5, 0.5), "cyan": (0, 1, 1), "magenta": (1, 0, 1),
           "purple": (0.5, 0, 0.5), "pink": (1, 0.75, 0.8), "brown": (0.6, 0.3, 0.1)}
-JSON_SCHEMA = json.dumps({"type": "object", "additionalProperties": True}).encode()
+
+
+def _numbers(names: Iterable[str]) -> dict[str, Any]:
+    """An object of these named numbers (any of them may be missing, no others)."""
+    return {"type": "object", "properties": {name: {"type": "number"} for name in names}, "additionalProperties": False}
+
+
+def _per_context(values: dict[str, Any]) -> dict[str, Any]:
+    """An object by context name (one context a message); the two of the program's plan are named."""
+    return {"type": "object", "properties": {context: values for context in ("cognition", "motion")}, "additionalProperties": values}
+
+
+#: the JSON Schema of each JSON topic: what Foxglove's panels (Plot, Raw Messages) offer as fields
+JSON_SCHEMAS: dict[str, bytes] = {topic: json.dumps({"title": title, **schema}).encode() for topic, title, schema in (
+    ("/joints", "Joint values by name: measured (position, temperature) and commanded (command, stiffness)",
+     {"type": "object", "properties": {key: _numbers(JOINT_NAMES) for key in ("position", "temperature", "command", "stiffness")},
+      "required": ["command", "stiffness"], "additionalProperties": False}),
+    ("/imu", "Inertial sensors: accelerometer (m/s^2), gyroscope (rad/s), torso angles (rad)",
+     {"type": "object", "properties": {"accelerometer": _numbers("xyz"), "gyroscope": _numbers("xyz"), "angles": _numbers(("roll", "pitch"))},
+      "required": ["accelerometer", "gyroscope", "angles"], "additionalProperties": False}),
+    ("/fsr", "Foot pressure sensors by name (kg)", {**_numbers(FSR_NAMES), "required": list(FSR_NAMES)}),
+    ("/timing", "Module times (ms) by context and module", _per_context({"type": "object", "additionalProperties": {"type": "number"}})),
+    ("/rates", "Frames per second by context", _per_context({"type": "number"})),
+)}
 
 
 @dataclass
@@ -89,11 +112,16 @@ class Outgoing:
     def encoded(self) -> ExtraMessage:
         """The message as bytes with its schema, for an MCAP file."""
         if isinstance(self.message, dict):
-            return ExtraMessage(self.topic, f"tafel.foxglove{self.topic.replace('/', '.')}", "jsonschema", JSON_SCHEMA,
+            return ExtraMessage(self.topic, json_schema_name(self.topic), "jsonschema", JSON_SCHEMAS[self.topic],
                                 "json", json.dumps(self.message, separators=(",", ":")).encode(), self.time_ns, self.wall_ns)
         schema = self.message.get_schema()
         return ExtraMessage(self.topic, schema.name, schema.encoding, schema.data, "protobuf", self.message.encode(),
                             self.time_ns, self.wall_ns)
+
+
+def json_schema_name(topic: str) -> str:
+    """The schema name of a JSON topic: ``/joints`` is ``tafel.foxglove.joints``."""
+    return f"tafel.foxglove{topic.replace('/', '.')}"
 
 
 def color(name: str, alpha: float = 1.0) -> fm.Color:

@@ -3,8 +3,15 @@
 A Foxglove WebSocket server (``foxglove-sdk``) publishes the channels recordings carry
 (``foxglove_channels``), offers module parameters, modify values and debug requests in the Parameters
 panel (``/BallDetector/min_radius``, ``/modify/NAME``, ``/debug_request/NAME``) and every debug command
-as the service ``/tafel/command`` (a command line in, the answer out). Parameters and commands go
-through the debug server, so they run between frames like a console's and follow its rules.
+as the service ``/tafel/command`` (a command line in, the answer out; as text, or as JSON
+``{"command": LINE}`` answered by ``{"answer": TEXT}``, what Foxglove's Service Call panel sends).
+Parameters and commands go through the debug server, so they run between frames like a console's and
+follow its rules.
+
+Clients reach the SDK's server (on a loopback port of its own) only through a ``Gate``: it applies the
+web view's rules (``Host`` an address, ``localhost`` or the name listened on; ``Origin`` none, the same
+or configured), the token when there is one, and lets in both names of the protocol
+(``foxglove.sdk.v1`` and the older ``foxglove.websocket.v1``).
 
 The loops never wait for it: after each frame they hand over copies of only those representations
 that a subscribed topic needs (nothing when nobody subscribes), into a short queue that drops when
@@ -16,18 +23,22 @@ from __future__ import annotations
 
 import asyncio
 import hmac
+import http.client
+import io
+import json
 import logging
 import re
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any
 from urllib.parse import parse_qs, urlsplit
 
 import foxglove
 from foxglove import messages as fm
-from foxglove.websocket import Capability, ChannelView, Client, MessageSchema, Parameter, Service, ServiceRequest, ServiceSchema
+from foxglove.websocket import Capability, ChannelView, Client, Parameter, Service, ServiceRequest, ServiceSchema, StatusLevel
 
-from tafel.tools.foxglove_channels import JSON_SCHEMA, NEEDS, TOPICS, FoxgloveTranslator
+from tafel.debug.websocket import host_allowed, origin_allowed
+from tafel.tools.foxglove_channels import JSON_SCHEMAS, NEEDS, TOPICS, FoxgloveTranslator, json_schema_name
 from tafel.tools.live_feed import LiveFeed
 
 log = logging.getLogger("tafel.foxglove")
@@ -37,6 +48,9 @@ PROTOBUF_TOPICS = {"/camera/top": fm.CompressedImage, "/camera/bottom": fm.Compr
                    "/camera/top/annotations": fm.ImageAnnotations, "/camera/bottom/annotations": fm.ImageAnnotations,
                    "/scene": fm.SceneUpdate, "/tf": fm.FrameTransforms, "/log": fm.Log}
 COMMAND_SERVICE = "/tafel/command"
+#: how a client may call the command service: JSON first, because Foxglove's Service Call panel takes the first it knows
+SERVICE_ENCODINGS = ["json", "text"]
+COMMAND_USAGE = 'send {"command": "COMMAND LINE"}, e.g. {"command": "modules:list"} (or the command line as text)'
 
 
 #: every representation the bridge may ask the loops for
@@ -48,13 +62,14 @@ class FoxgloveLive(logging.Handler):
     ``take`` (what context processes handed over)."""
 
     def __init__(self, host: str, port: int, *, ask: Callable[[str], str] | None, jpeg_quality: int = 80,
-                 token: str | None = None, flags: Any = None) -> None:
+                 token: str | None = None, flags: Any = None, origins: Iterable[str] = ()) -> None:
         super().__init__(logging.INFO)
         #: what the loops hand over: with contexts in other processes, ``flags`` (shared) say which of ``FED``
         self.feed = LiveFeed(FED, flags=flags)
         self.host, self.port = host, port
         self.token = token
-        self.gate: TokenGate | None = None
+        self.origins = tuple(origins)
+        self.gate: Gate | None = None
         self.ask = ask
         self.subscribers: dict[str, int] = {}
         self.translator = FoxgloveTranslator(jpeg_quality, wanted=lambda topic: self.subscribers.get(topic, 0) > 0)
@@ -73,21 +88,21 @@ class FoxgloveLive(logging.Handler):
                                                         schema=foxglove.Schema(name=schema.name, encoding=schema.encoding, data=schema.data))
             else:
                 self.channels[topic] = foxglove.Channel(topic, message_encoding="json", schema=foxglove.Schema(
-                    name=f"tafel.foxglove{topic.replace('/', '.')}", encoding="jsonschema", data=JSON_SCHEMA))
+                    name=json_schema_name(topic), encoding="jsonschema", data=JSON_SCHEMAS[topic]))
         capabilities = [Capability.Parameters, Capability.Services] if self.ask is not None else []
-        services = [Service(name=COMMAND_SERVICE, schema=ServiceSchema(
-            name="tafel.command", request=MessageSchema(encoding="text", schema=foxglove.Schema(name="command line", encoding="", data=b"")),
-            response=MessageSchema(encoding="text", schema=foxglove.Schema(name="answer", encoding="", data=b""))),
-            handler=self._command)] if self.ask is not None else []
-        # with a token the SDK's server listens inside, and a gate that checks the token listens outside
-        inside = ("127.0.0.1", 0) if self.token is not None else (self.host, self.port)
-        self.server = foxglove.start_server(name="tafel", host=inside[0], port=inside[1], capabilities=capabilities,
-                                            server_listener=self, services=services)
-        if self.token is not None:
-            self.gate = TokenGate(self.host, self.port, self.token, self.server.port)
+        # no request schema: the SDK then takes a call in any of SERVICE_ENCODINGS (with one, only in that one)
+        services = [Service(name=COMMAND_SERVICE, schema=ServiceSchema(name="tafel.command", request=None, response=None),
+                            handler=self._command)] if self.ask is not None else []
+        # the SDK's server listens on loopback inside; the gate that checks every client listens outside
+        self.server = foxglove.start_server(name="tafel", host="127.0.0.1", port=0, capabilities=capabilities, server_listener=self,
+                                            services=services, supported_encodings=SERVICE_ENCODINGS if services else None)
+        quiet_per_client_errors()
+        self.gate = Gate(self.host, self.port, self.server.port, token=self.token, origins=self.origins)
+        try:
             self.port = self.gate.start()
-        else:
-            self.port = self.server.port
+        except OSError:
+            self.server.stop()
+            raise
         self.thread.start()
         logging.getLogger("tafel").addHandler(self)
         return self.host, self.port
@@ -151,17 +166,30 @@ class FoxgloveLive(logging.Handler):
         return [p for p in parameters if not param_names or p.name in param_names]
 
     def on_set_parameters(self, client: Client, parameters: list[Parameter], request_id: str | None = None) -> list[Parameter]:
+        """Sets what the program takes; answers with every named parameter's value now, so that a refused one
+        shows its old value again, and says why in a status message (and the log) the user sees."""
+        refused = []
         for parameter in parameters:
             line = self._set_command(parameter.name, parameter.get_value())
-            answer = self._ask(line) if line else f"error: no parameter {parameter.name}"
+            answer = self._ask(line) if line else (f"error: there is no parameter {parameter.name!r}; the names are "
+                                                    "/MODULE/NAME, /modify/NAME and /debug_request/NAME")
             if answer.startswith("error:"):
-                log.warning("foxglove: %s: %s", parameter.name, answer)
+                refused.append(f"{parameter.name} stays as it was: {answer[len('error:'):].strip()}")
         names = {p.name for p in parameters}
-        return [p for p in self._parameters() if p.name in names]
+        current = [p for p in self._parameters() if p.name in names]
+        for reason in refused:
+            log.warning("foxglove: %s", reason)
+            if self.server is not None:
+                self.server.publish_status(reason, StatusLevel.Warning)
+        return current
 
     def _command(self, request: ServiceRequest) -> bytes:
-        line = request.payload.decode("utf-8", "replace").strip()
-        return self._ask(line).encode()
+        """A command line as text (answered as text), or as JSON ``{"command": LINE}`` (answered ``{"answer": TEXT}``);
+        JSON that is not such a request fails the call with a message saying what to send."""
+        text = request.payload.decode("utf-8", "replace")
+        if request.encoding != "json":
+            return self._ask(text.strip()).encode()
+        return json.dumps({"answer": self._ask(command_from_json(text))}).encode()
 
     # ------------------------------------------------------------------------------ parameters
     def _ask(self, line: str) -> str:
@@ -200,16 +228,64 @@ class FoxgloveLive(logging.Handler):
         return f"parameter:set -module {group} -name {item} -value {text}"
 
 
-class TokenGate:
-    """The door in front of the SDK's server when the program has a token: a WebSocket connection is let
-    through (to the server listening on loopback inside) only with ``?token=T`` in its URL or an
-    ``Authorization: Bearer T`` header, the way the debug server asks ``auth T`` first. It also lets in
-    clients that ask for the protocol by its old name, ``foxglove.websocket.v1`` (older Lichtblick)."""
+def command_from_json(text: str) -> str:
+    """The command line of a JSON request: ``{"command": LINE}`` or a bare JSON string; anything else is a
+    ``ValueError`` that says what to send."""
+    try:
+        request = json.loads(text)
+    except ValueError as exc:
+        raise ValueError(f"the request is not JSON ({exc}): {COMMAND_USAGE}") from None
+    if isinstance(request, dict):
+        unknown = sorted(set(request) - {"command"})
+        if unknown:
+            raise ValueError(f"unknown field {unknown[0]!r} in the request: {COMMAND_USAGE}")
+        request = request.get("command")
+    if not isinstance(request, str) or not request.strip():
+        raise ValueError(f"the request names no command: {COMMAND_USAGE}")
+    return request.strip()
 
-    SUBPROTOCOLS = ("foxglove.sdk.v1", "foxglove.websocket.v1")
 
-    def __init__(self, host: str, port: int, token: str, inside_port: int) -> None:
+#: what the SDK logs for each message it could not send to, or read from, one of its clients
+PER_CLIENT_ERRORS = ("Error sending message to client", "Error receiving from client")
+
+
+class PerClientErrors(logging.Filter):
+    """Drops the SDK's errors about single connections: its clients are the gate's connections on loopback, and
+    a client that goes away cost one line per queued message (hundreds a second). The gate says it once,
+    naming the real client."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not str(record.msg).startswith(PER_CLIENT_ERRORS)
+
+
+def quiet_per_client_errors() -> None:
+    logger = logging.getLogger("foxglove.websocket.connected_client.poller")
+    if not any(isinstance(f, PerClientErrors) for f in logger.filters):
+        logger.addFilter(PerClientErrors())
+
+
+class Gate:
+    """The door in front of the SDK's server, which listens on loopback inside: a connection is let through
+    (its bytes passed on unchanged) only when
+
+    - its ``Host`` is an address, ``localhost`` or the name listened on (any name with a token), and its
+      ``Origin`` is none (desktop apps, scripts), the same as ``Host`` or one of ``origins``: the web view's
+      rules, so that no web page and no DNS-rebinding name reaches the program;
+    - with a token: ``?token=T`` in its URL or an ``Authorization: Bearer T`` header;
+    - it asks for the protocol by either name: ``foxglove.sdk.v1`` or the older ``foxglove.websocket.v1``
+      (older Lichtblick, third-party clients), which the SDK does not know and the gate translates.
+
+    Every refusal is an HTTP answer that says what was wrong, and a warning in the log."""
+
+    NEW_NAME, OLD_NAME = "foxglove.sdk.v1", "foxglove.websocket.v1"
+    HEAD_LIMIT = 16 * 1024  # bytes of a handshake's head
+    HEAD_TIMEOUT_S = 10.0
+    DRAIN_TIMEOUT_S = 5.0  # after a client went away, how long the SDK's side is read before it is cut
+    CHUNK = 1 << 16
+
+    def __init__(self, host: str, port: int, inside_port: int, *, token: str | None = None, origins: Iterable[str] = ()) -> None:
         self.host, self.port, self.token, self.inside_port = host, port, token, inside_port
+        self.origins = tuple(origins)
         self.loop: asyncio.AbstractEventLoop | None = None
         self.stopping: asyncio.Event | None = None
         self.ready = threading.Event()
@@ -229,43 +305,44 @@ class TokenGate:
             self.loop.call_soon_threadsafe(self.stopping.set)
             self.thread.join(timeout=5)
 
-    def allowed(self, path: str, authorization: str | None) -> bool:
+    # ------------------------------------------------------------------------------- the rules
+    def token_given(self, path: str, authorization: str | None) -> bool:
+        assert self.token is not None
         given = parse_qs(urlsplit(path).query).get("token", [""])[0]
         if not given and authorization and authorization.startswith("Bearer "):
             given = authorization[len("Bearer "):]
         return bool(given) and hmac.compare_digest(given.encode(), self.token.encode())
 
+    def refusal(self, path: str, headers: http.client.HTTPMessage) -> tuple[int, str] | None:
+        """Why a handshake is refused, as (HTTP status, text saying what would be right); None: let it in."""
+        if len(headers.get_all("Host") or ()) != 1:
+            return 400, "a WebSocket handshake has exactly one Host header"
+        host = headers.get("Host", "")
+        if not host_allowed(host, self.host, names=self.token is not None):
+            return 403, (f"this program answers requests for its address, not for {host!r}: connect to ws://ADDRESS:PORT "
+                         "(with --debug-token, names are taken too)")
+        origin = headers.get("Origin")
+        if not origin_allowed(origin, host, self.origins):
+            return 403, (f"a page of {origin} may not steer this program; if it is yours, allow it with "
+                         f"[foxglove] origins = [\"{origin}\"]")
+        if self.token is not None and not self.token_given(path, headers.get("Authorization")):
+            return 401, "this program needs its token: connect to ws://HOST:PORT/?token=TOKEN"
+        if headers.get("Upgrade", "").lower() != "websocket":
+            return 426, "this is a Foxglove WebSocket server: open a Foxglove WebSocket connection to ws://HOST:PORT"
+        if not self.offered(headers) & {self.NEW_NAME, self.OLD_NAME}:
+            return 400, f"ask for the subprotocol {self.NEW_NAME} (or its older name {self.OLD_NAME}) in Sec-WebSocket-Protocol"
+        return None
+
+    @staticmethod
+    def offered(headers: http.client.HTTPMessage) -> set[str]:
+        return {name.strip() for value in headers.get_all("Sec-WebSocket-Protocol") or () for name in value.split(",")}
+
+    # ------------------------------------------------------------------------------ the thread
     def _run(self) -> None:
-        from websockets.asyncio.client import connect
-        from websockets.asyncio.server import serve
-        from websockets.exceptions import ConnectionClosed
-
-        def check(connection: Any, request: Any) -> Any:
-            if self.allowed(request.path, request.headers.get("Authorization")):
-                return None
-            self.refused += 1
-            log.warning("foxglove: refused a connection without the right token (%d so far)", self.refused)
-            return connection.respond(401, "this program needs its token: connect to ws://HOST:PORT/?token=TOKEN\n")
-
-        async def relay(client: Any) -> None:
-            try:  # the SDK speaks the one protocol under its new name only
-                async with connect(f"ws://127.0.0.1:{self.inside_port}", subprotocols=[self.SUBPROTOCOLS[0]], max_size=None) as inside:
-                    async def pump(source: Any, target: Any) -> None:
-                        async for message in source:
-                            await target.send(message)
-                    done, pending = await asyncio.wait([asyncio.create_task(pump(client, inside)),
-                                                        asyncio.create_task(pump(inside, client))],
-                                                       return_when=asyncio.FIRST_COMPLETED)
-                    for task in pending:
-                        task.cancel()
-            except (ConnectionClosed, OSError):
-                pass
-
         async def main() -> None:
             self.stopping = asyncio.Event()
             try:
-                server = await serve(relay, self.host, self.port, process_request=check, subprotocols=list(self.SUBPROTOCOLS),
-                                     max_size=None)
+                server = await asyncio.start_server(self._connection, self.host, self.port, limit=self.HEAD_LIMIT)
             except OSError as exc:
                 self.error = exc
                 self.ready.set()
@@ -280,6 +357,105 @@ class TokenGate:
             self.loop.run_until_complete(main())
         finally:
             self.loop.close()
+
+    async def _connection(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        peer = writer.get_extra_info("peername")
+        inside: asyncio.StreamWriter | None = None
+        try:
+            try:
+                head = await asyncio.wait_for(reader.readuntil(b"\r\n\r\n"), self.HEAD_TIMEOUT_S)
+            except asyncio.LimitOverrunError:
+                return await self._refuse(writer, peer, 431, f"the handshake's head is over {self.HEAD_LIMIT} bytes")
+            except (asyncio.IncompleteReadError, TimeoutError, ConnectionError):
+                return
+            request_line, _, rest = head.partition(b"\r\n")
+            try:
+                headers = http.client.parse_headers(io.BytesIO(rest))
+            except http.client.HTTPException as exc:
+                return await self._refuse(writer, peer, 431, f"the handshake's headers cannot be read: {exc}")
+            parts = request_line.decode("latin-1").split()
+            if len(parts) != 3 or parts[0] != "GET":
+                return await self._refuse(writer, peer, 400, "this is a Foxglove WebSocket server: a WebSocket handshake (GET) was expected")
+            refusal = self.refusal(parts[1], headers)
+            if refusal is not None:
+                return await self._refuse(writer, peer, *refusal)
+            old_name = self.NEW_NAME not in self.offered(headers)
+            if old_name:
+                del headers["Sec-WebSocket-Protocol"]
+                headers["Sec-WebSocket-Protocol"] = self.NEW_NAME
+            upstream, inside = await asyncio.open_connection("127.0.0.1", self.inside_port, limit=self.CHUNK * 4)
+            inside.write(request_line + b"\r\n" + "".join(f"{k}: {v}\r\n" for k, v in headers.items()).encode("latin-1") + b"\r\n")
+            answer = await asyncio.wait_for(upstream.readuntil(b"\r\n\r\n"), self.HEAD_TIMEOUT_S)
+            if old_name:  # the client hears the name it asked for
+                answer = re.sub(rb"(?im)^(sec-websocket-protocol:[ \t]*)foxglove\.sdk\.v1", rb"\1" + self.OLD_NAME.encode(), answer)
+            writer.write(answer)
+            await self._relay(reader, writer, upstream, inside, peer)
+        except (ConnectionError, OSError, asyncio.IncompleteReadError, asyncio.LimitOverrunError, TimeoutError) as exc:
+            log.warning("foxglove: connection of %s ended: %s", _address(peer), exc or type(exc).__name__)
+        finally:
+            for side in (writer, inside):
+                if side is not None:
+                    side.close()
+
+    async def _refuse(self, writer: asyncio.StreamWriter, peer: Any, status: int, text: str) -> None:
+        self.refused += 1
+        log.warning("foxglove: refused a connection from %s (%d so far): %s", _address(peer), self.refused, text)
+        body = (text + "\n").encode()
+        writer.write(f"HTTP/1.1 {status} {http.client.responses.get(status, 'Refused')}\r\nContent-Type: text/plain; charset=utf-8\r\n"
+                     f"Content-Length: {len(body)}\r\nConnection: close\r\n\r\n".encode() + body)
+        try:
+            await writer.drain()
+        except ConnectionError:
+            pass
+
+    async def _relay(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter, upstream: asyncio.StreamReader,
+                     inside: asyncio.StreamWriter, peer: Any) -> None:
+        """Both ways, byte for byte, until the SDK closes. When the client goes, the SDK hears an end of
+        stream and is read to its end, so that it never writes into a dead connection."""
+        gone: list[str] = []
+
+        async def up() -> None:
+            try:
+                while data := await reader.read(self.CHUNK):
+                    inside.write(data)
+                    await inside.drain()
+            except ConnectionError as exc:
+                gone.append(str(exc) or type(exc).__name__)
+            finally:
+                try:
+                    inside.write_eof()  # the SDK reads an end of stream and lets its client go
+                except (OSError, RuntimeError):
+                    pass
+
+        async def down() -> None:
+            try:
+                while data := await upstream.read(self.CHUNK):
+                    writer.write(data)
+                    await writer.drain()
+                return
+            except ConnectionError as exc:
+                gone.append(str(exc) or type(exc).__name__)
+            inside.write_eof()
+            while await upstream.read(self.CHUNK):  # the client is gone: what the SDK still sends goes nowhere
+                pass
+
+        sending, receiving = asyncio.create_task(down()), asyncio.create_task(up())
+        try:
+            await asyncio.wait({sending, receiving}, return_when=asyncio.FIRST_COMPLETED)
+            if not sending.done():
+                await asyncio.wait({sending}, timeout=self.DRAIN_TIMEOUT_S)
+        finally:
+            for task in (sending, receiving):
+                task.cancel()
+            await asyncio.gather(sending, receiving, return_exceptions=True)
+        if gone:
+            log.warning("foxglove: client %s went away without closing its connection (%s)", _address(peer), gone[0])
+
+
+def _address(peer: Any) -> str:
+    if isinstance(peer, tuple) and len(peer) >= 2:
+        return f"[{peer[0]}]:{peer[1]}" if ":" in str(peer[0]) else f"{peer[0]}:{peer[1]}"
+    return str(peer)
 
 
 def _native(text: str) -> Any:

@@ -1,15 +1,17 @@
 """A Foxglove WebSocket client written from the protocol's published specification
 (github.com/foxglove/ws-protocol), with the ``websockets`` package and no ``foxglove-sdk``: what
 Foxglove and Lichtblick do when they connect, for tests and benchmarks. The specification calls the
-subprotocol ``foxglove.websocket.v1``; servers built on foxglove-sdk accept the same protocol only under
-its new name ``foxglove.sdk.v1``, which is what current Foxglove and Lichtblick ask for."""
+subprotocol ``foxglove.websocket.v1``; foxglove-sdk knows the same protocol only under its new name
+``foxglove.sdk.v1`` (what current Foxglove and Lichtblick ask for); Tafel's gate takes both."""
 
 from __future__ import annotations
 
 import json
+import socket
 import struct
 import time
 from typing import Any
+from urllib.parse import urlsplit
 
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
@@ -18,12 +20,28 @@ SUBPROTOCOL = "foxglove.sdk.v1"
 MESSAGE_DATA, SERVICE_CALL_REQUEST, SERVICE_CALL_RESPONSE = 0x01, 0x02, 0x03
 
 
+class ServiceCallFailure(Exception):
+    """The server answered a service call with ``serviceCallFailure`` (its message is the exception's)."""
+
+
 class FoxgloveClient:
-    def __init__(self, url: str, timeout: float = 10.0, subprotocol: str = SUBPROTOCOL, headers: dict[str, str] | None = None) -> None:
+    """``host``: the name the client believes it reaches (its ``Host`` header), while it connects to the
+    address of ``url``: what a browser does after DNS rebinding. ``origin``: the page it runs in."""
+
+    def __init__(self, url: str, timeout: float = 10.0, subprotocol: str = SUBPROTOCOL, headers: dict[str, str] | None = None,
+                 host: str | None = None, origin: str | None = None) -> None:
+        parts = urlsplit(url)
+        sock = socket.create_connection((parts.hostname, parts.port), timeout=timeout)
+        if host is not None:
+            url = parts._replace(netloc=f"{host}:{parts.port}").geturl()
         # close_timeout: a client closing under a stream of images waits at most 1 s for the server's close
         # frame (websockets' default of 10 s made every such teardown take 10 s)
-        self.socket = connect(url, subprotocols=[subprotocol], max_size=None, open_timeout=timeout, additional_headers=headers,
-                              proxy=None, legacy=True, close_timeout=1.0)
+        try:
+            self.socket = connect(url, sock=sock, subprotocols=[subprotocol], max_size=None, open_timeout=timeout,
+                                  additional_headers=headers, origin=origin, proxy=None, legacy=True, close_timeout=1.0)
+        except BaseException:
+            sock.close()
+            raise
         self.timeout = timeout
         self.channels: dict[int, dict[str, Any]] = {}  # channel id -> its advertisement
         self.services: dict[str, dict[str, Any]] = {}
@@ -124,4 +142,11 @@ class FoxgloveClient:
         self.next_id += 1
         data = encoding.encode()
         self.socket.send(struct.pack("<BIII", SERVICE_CALL_REQUEST, service["id"], call, len(data)) + data + payload)
-        return self.wait_for(lambda: self.service_answers.get(call))
+
+        def answered() -> bytes | None:
+            for reply in self.replies:
+                if reply.get("op") == "serviceCallFailure" and reply.get("callId") == call:
+                    raise ServiceCallFailure(reply.get("message", ""))
+            return self.service_answers.get(call)
+
+        return self.wait_for(answered)
