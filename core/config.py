@@ -96,18 +96,93 @@ def merge(base: dict[str, Any], layer: Mapping[str, Any]) -> dict[str, Any]:
     return result
 
 
+#: levels of tables and lists configuration may have (parameters.Module.name = [[1, 2]] has four)
+MAX_DEPTH = 8
+#: the largest magnitude of a whole number in configuration (a signed 64-bit integer)
+MAX_INT = 2**63 - 1
+
+
 def parse_override(text: str) -> tuple[list[str], Any]:
     """``runtime.cognition_hz=15`` -> (["runtime", "cognition_hz"], 15). Values are TOML, else strings."""
     key, sep, raw = text.partition("=")
     key = key.strip()
     if not sep or not key or any(not part for part in key.split(".")):
-        raise ConfigError(f"--set takes KEY=VALUE with a dotted key, e.g. runtime.cognition_hz=15; got {text!r}")
+        raise ConfigError(f"--set takes KEY=VALUE with a dotted key, e.g. runtime.cognition_hz=15; got {_short(text)!r}")
+    if key.count(".") >= MAX_DEPTH:
+        raise ConfigError(f"--set {_short(key)}: a key of {key.count('.') + 1} parts; configuration keys have at most {MAX_DEPTH}")
     raw = raw.strip()
     try:
         value = tomllib.loads(f"v = {raw}")["v"]
     except tomllib.TOMLDecodeError:
         value = raw
+    except RecursionError:
+        raise ConfigError(f"--set {key}: the value is nested too deeply; configuration has {MAX_DEPTH} levels at most") from None
+    except ValueError:  # a number past Python's digit limit (4300 digits)
+        raise ConfigError(f"--set {key}: a number of {len(raw)} characters; whole numbers in configuration fit 64 bits "
+                          f"(at most {MAX_INT})") from None
+    check_value(value, f"--set {key}", depth=key.count(".") + 1)
     return key.split("."), value
+
+
+def _short(text: str, limit: int = 80) -> str:
+    return text if len(text) <= limit else text[:limit] + f"... ({len(text)} characters)"
+
+
+def check_value(value: Any, where: str, depth: int = 0) -> None:
+    """Values configuration can hold: at most ``MAX_DEPTH`` levels deep, whole numbers within 64 bits."""
+    if depth > MAX_DEPTH:
+        raise ConfigError(f"{where}: nested more than {MAX_DEPTH} levels deep; configuration needs a few levels at most")
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_INT:
+        raise ConfigError(f"{where}: the whole number {_short(str(value), 30)} is outside 64 bits (at most {MAX_INT})")
+    children = value.values() if isinstance(value, Mapping) else value if isinstance(value, list) else ()
+    for child in children:
+        check_value(child, where, depth + 1)
+
+
+#: the top-level tables of the configuration: what each holds
+SECTIONS: dict[str, str] = {
+    "runtime": "rates and timeouts", "cognition": "cognition's modules", "motion": "motion's modules",
+    "parameters": "module parameters by module name", "game": "team, player number and network",
+    "status": "the status line", "recording": "what --record records", "foxglove": "Foxglove's channels",
+    "debug": "the debug server's aliases",
+}
+
+
+def check_config(config: Mapping[str, Any], platform_sections: Iterable[str] = (), representations: Iterable[str] | None = None) -> None:
+    """The whole configuration's shape: known top-level tables (``SECTIONS`` and the platform's own),
+    each a table, the lists that name representations naming known ones (when ``representations``
+    is given). ``ConfigError`` with what would be right; the modules' own tables are checked where they
+    are used (parameters by their modules, [game] by the network, [runtime] by ``check_runtime``)."""
+    known = dict(SECTIONS, **{name: "the platform's options" for name in platform_sections})
+    for key, value in config.items():
+        if key.startswith("_"):
+            continue
+        if key not in known:
+            raise ConfigError(f"[{key}] is not a section of the configuration; {did_you_mean(key, known)}; the sections are "
+                              + ", ".join(f"{name} ({what})" for name, what in known.items()))
+        if not isinstance(value, Mapping):
+            raise ConfigError(f"{key} must be a table ([{key}] in a file), got {value!r}")
+        check_value(value, f"[{key}]", depth=1)
+    names = set(representations) if representations is not None else None
+    for section, key in (("recording", "representations"), ("status", "show")):
+        table = config.get(section, {})
+        unknown = sorted(set(table) - {key})
+        if unknown:
+            raise ConfigError(f"[{section}] {unknown[0]} is not a setting; [{section}] has only {key}")
+        if key not in table:
+            continue
+        value = table[key]
+        if not (isinstance(value, list) and all(isinstance(v, str) for v in value)):
+            raise ConfigError(f"{section}.{key} takes a list of representation names, e.g. [\"BallModel\"]; got {value!r}")
+        for name in value if names is not None else ():
+            if name not in names:
+                raise ConfigError(f"{section}.{key}: no representation named {name!r}; {did_you_mean(name, names)}")
+    debug = config.get("debug", {})
+    aliases = debug.get("aliases", {})
+    if not isinstance(aliases, Mapping) or not all(isinstance(v, Mapping) for v in aliases.values()):
+        raise ConfigError(f"debug.aliases takes tables, one per alias ([debug.aliases.\"motion:walk\"] with command = ...); got {aliases!r}")
+    for section in ("cognition", "motion"):
+        context_section(config, section)
 
 
 def apply_overrides(config: dict[str, Any], overrides: Iterable[str]) -> dict[str, Any]:
@@ -143,7 +218,9 @@ def load_config(
     sources = []
     for path in layer_paths(folders, platform, robot):
         if path.is_file():
-            config = apply_module_edits(merge(config, read_toml(path)), str(path))
+            layer = read_toml(path)
+            check_value(layer, str(path))
+            config = apply_module_edits(merge(config, layer), str(path))
             sources.append(str(path))
     config = apply_module_edits(apply_overrides(config, overrides), "--set")
     check_runtime(config)

@@ -68,6 +68,8 @@ class Platform:
     #: True when ``next_step`` decides which contexts run when (log replay); else rates decide
     drives_schedule: ClassVar[bool] = False
     #: False when the contexts cannot run in separate processes (one simulated world feeds both)
+    #: top-level configuration tables of this platform's own (``[video] camera_pose``), besides the general ones
+    config_sections: ClassVar[tuple[str, ...]] = ()
     concurrent: ClassVar[bool] = True
 
     def __init__(self, options: Mapping[str, Any] | None = None) -> None:

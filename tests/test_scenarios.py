@@ -79,14 +79,20 @@ def test_a_good_file_gives_every_value(tmp_path: Path) -> None:
 @pytest.mark.parametrize(("change", "line", "message"), [
     (('predicate = "robot_near_ball"', 'predicate = "robot_near_bal"'), 17,
      "no predicate 'robot_near_bal'; did you mean 'robot_near_ball'"),
-    (("duration_s = 5.0\n", ""), 1, "the file's top level needs duration_s (a number above 0)"),
-    (("duration_s = 5.0", 'duration_s = "long"'), 2, "duration_s in the file's top level takes a number above 0, got 'long'"),
+    (("duration_s = 5.0\n", ""), 1, "the file's top level needs duration_s (a number of seconds above 0 and at most 3600)"),
+    (("duration_s = 5.0", 'duration_s = "long"'), 2, "duration_s in the file's top level takes a number of seconds above 0 and at most 3600, got 'long'"),
+    (("duration_s = 5.0", "duration_s = 1e308"), 2, "takes a number of seconds above 0 and at most 3600, got 1e+308"),
+    (("start = [0.0, 0.0, 0.0]", "start = [1e9, 0.0, 0.0]"), 7, "start in [[robots]] number 1 takes [x_mm, y_mm, rotation_deg], three numbers, x and y on the carpet"),
+    (("position = [1000.0, 0.0]", "position = [0.0, -9000.0]"), 10, "position in [ball] takes [x_mm, y_mm], two numbers on the carpet"),
+    (('set = ["parameters.KalmanBallModeler.friction=0.4"]', 'set = ["parameter.KalmanBallModeler.friction=0.4"]'), 4,
+     "set: [parameter] is not a section of the configuration; did you mean 'parameters'"),
+    (('set = ["parameters.KalmanBallModeler.friction=0.4"]', 'set = ["game=5"]'), 4, "set: game must be a table"),
     (("start = [0.0, 0.0, 0.0]", "start = [0.0, 0.0]"), 7, "start in [[robots]] number 1 takes [x_mm, y_mm, rotation_deg], three numbers"),
     (("within_mm = 400.0", 'within_mm = "near"'), 18, "within_mm in [[success]] number 1 takes a number, got 'near'"),
     (("robot_x_mm = 100.0", "robot_x_mn = 100.0"), 13, "[perturbation] has no key 'robot_x_mn'; did you mean 'robot_x_mm'"),
     (("sensor_noise = [0.5, 2.0]", "sensor_noise = [2.0, 0.5]"), 14, "sensor_noise in [perturbation] takes [low, high], two numbers with low <= high"),
     (("required_success_rate = 0.5", "required_success_rate = 1.5"), 3, "required_success_rate in the file's top level takes a number from 0 to 1"),
-    (('set = ["parameters.KalmanBallModeler.friction=0.4"]', 'set = ["friction"]'), 4, "each entry of set is KEY=VALUE as with --set"),
+    (('set = ["parameters.KalmanBallModeler.friction=0.4"]', 'set = ["friction"]'), 4, "--set takes KEY=VALUE with a dotted key"),
     (("position = [1000.0, 0.0]", "position = 1000.0, 0.0"), 10, "not TOML"),
 ])
 def test_a_bad_file_is_an_error_that_names_the_file_the_line_and_what_would_be_right(
@@ -96,6 +102,12 @@ def test_a_bad_file_is_an_error_that_names_the_file_the_line_and_what_would_be_r
         load_scenario(path)
     assert str(error.value).startswith(f"{path}:{line}: "), str(error.value)
     assert message in str(error.value)
+
+
+def test_a_file_nested_thousands_of_levels_deep_is_a_clear_error(tmp_path: Path) -> None:
+    path = write(tmp_path, GOOD + "deep = " + "[" * 5000 + "]" * 5000 + "\n")
+    with pytest.raises(ScenarioError, match="nested too deeply to be a scenario"):
+        load_scenario(path)
 
 
 def test_a_push_outside_the_run_or_too_strong_is_refused(tmp_path: Path) -> None:

@@ -13,15 +13,22 @@ import re
 from pathlib import Path
 from typing import Any
 
+#: the factors ``--speed`` takes: slower than a thousandth of real time no frame would ever come
+SPEED_RANGE = (0.001, 1000.0)
+
 
 def parse_speed(text: str) -> float | None:
     """``--speed``: a factor against the wall clock, or ``max`` (None: as fast as possible)."""
     if text == "max":
         return None
+    low, high = SPEED_RANGE
     try:
-        return positive(float)(text)
-    except argparse.ArgumentTypeError:
-        raise argparse.ArgumentTypeError(f"--speed takes a positive number or 'max', got {text!r}") from None
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not low <= value <= high:
+        raise argparse.ArgumentTypeError(f"--speed takes a factor from {low:g} to {high:g} or 'max', got {text!r}")
+    return value
 
 
 def positive(kind: type) -> Any:

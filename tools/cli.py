@@ -19,13 +19,14 @@ from importlib.metadata import version
 from pathlib import Path
 from typing import Any, NoReturn
 
-from tafel.core.config import edit_modules, load_config
+from tafel.core.config import check_config, edit_modules, load_config
 from tafel.core.dot import contexts_dot
 from tafel.core.errors import TafelError
 from tafel.core.extensions import load_modules
 from tafel.core.platform import Platform, PlatformError, PlatformOptionError, available_platforms, load_platform
 from tafel.core.program import ContextPlan, plan_program
 from tafel.core.recording import Recorder, select
+from tafel.core.representation import registered_representations
 from tafel.core.runtime import (
     ConcurrentRuntime,
     ContextStats,
@@ -34,9 +35,11 @@ from tafel.core.runtime import (
     install_signal_handlers,
     program_fingerprint,
 )
+from tafel.core.watchdog import STUCK_TIMEOUT_S
 from tafel.debug.commands import frame_number
 from tafel.tools.arguments import (
     add_console_command,
+    add_deploy_commands,
     add_log_commands,
     add_match_command,
     add_module_path_argument,
@@ -148,6 +151,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_match_command(commands)
     add_scenario_commands(commands)
     add_replay_batch_command(commands)
+    add_deploy_commands(commands)
 
     platforms = commands.add_parser("platforms", help="list the platforms and what they provide and consume")
     platforms.add_argument("--verbose", "-v", action="store_true", help="also list each platform's options")
@@ -208,6 +212,7 @@ def prepare(args: argparse.Namespace, extra: Sequence[str]) -> tuple[Platform, d
     overrides = [f"runtime.{context}_hz={hz}" for context, hz in (platform.rates() or {}).items()]
     config = load_config(config_dirs(args), platform.config_layers(), args.robot, [*overrides, *args.overrides])
     config = edit_modules(config, args.add_module, args.remove_module)
+    check_config(config, platform_class.config_sections, registered_representations())
     platform.configure(config)
     plans = plan_program(config, platform, strict=args.strict)
     return platform, platform.options, plans, config
@@ -347,6 +352,8 @@ def command_run(args: argparse.Namespace, extra: Sequence[str]) -> int:
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(name)s %(levelname)s: %(message)s")
     if args.foxglove is not None:
         foxglove_address(args.foxglove)  # a wrong address fails before anything starts
+    if args.record_dir.exists() and not args.record_dir.is_dir():
+        fail(f"--record-dir {args.record_dir} is a file; it takes a folder (created when a client records)")
     platform, options, plans, config = prepare(args, extra)
     report_pruned(plans)
     recorder = make_recorder(args, plans, config, platform)
@@ -496,12 +503,17 @@ def shutdown_grace(config: dict[str, Any]) -> float:
     return float(config.get("runtime", {}).get("shutdown_grace_s", 15.0))
 
 
+def stuck_timeout(config: dict[str, Any]) -> float:
+    """``[runtime] stuck_timeout_s``: s one module may run without returning before its context ends."""
+    return float(config.get("runtime", {}).get("stuck_timeout_s", STUCK_TIMEOUT_S))
+
+
 def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, ContextPlan], recorder: Recorder | None,
                  limits: Limits, config: dict[str, Any]) -> int:
     # The loops share the interpreter with the debug server's network thread: hand the lock over within
     # 1 ms instead of the default 5 ms, so a busy server delays a frame by a millisecond at the most.
     sys.setswitchinterval(0.001)
-    runtime = LockstepRuntime(plans, platform, strict=args.strict, recorder=recorder)
+    runtime = LockstepRuntime(plans, platform, strict=args.strict, recorder=recorder, stuck_timeout_s=stuck_timeout(config))
     debug = start_debug(args, recorder, plans, config)
     if debug is not None:
         recorded = debug_recorded(recorder, [] if args.no_web else list(plans))
@@ -552,7 +564,7 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
     print_summary(type(platform).name, "lockstep", stats, runtime.wall_s, runtime.time_ns * 1e-9, stop_reason(signals, runtime.end_reason),
                   simulated=True)
     report_recording(recorder)
-    return 0
+    return 1 if any(s.failure for s in stats.values()) else 0
 
 
 def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[str, Any], plans: dict[str, ContextPlan],
@@ -576,7 +588,8 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
     setup = (worker_setups, setups) if setups else None
     stall = float(config.get("runtime", {}).get("stall_timeout_s", 1.0))
     runtime = ConcurrentRuntime(plans, platform_class, options, strict=args.strict, stall_timeout_s=stall,
-                                recorder=recorder, worker_setup=setup, grace_s=shutdown_grace(config))
+                                recorder=recorder, worker_setup=setup, grace_s=shutdown_grace(config),
+                                stuck_timeout_s=stuck_timeout(config))
     started = time.monotonic()
     last = [started]
     line = StatusLine(platform_class.name, config)
@@ -825,7 +838,8 @@ def command_match(args: argparse.Namespace, extra: Sequence[str]) -> int:
 COMMANDS = {"run": command_run, "view": command_view, "platforms": command_platforms, "modules": command_modules,
             "log": tool_command("log_tools", "run_log_command"), "console": tool_command("console", "run_console"),
             "match": command_match, "scenarios": tool_command("scenarios", "command_scenarios"),
-            "replay-batch": tool_command("replay_batch", "command_replay_batch")}
+            "replay-batch": tool_command("replay_batch", "command_replay_batch"),
+            "deploy": tool_command("deploy", "run_command"), "robots": tool_command("deploy", "run_command")}
 
 
 class PipeSafeStream:

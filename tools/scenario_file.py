@@ -15,14 +15,20 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from tafel.core.config import ConfigError, apply_overrides, check_config
 from tafel.core.naming import did_you_mean
 from tafel.core.representation import fields_of, get_representation
+from tafel.representations.field import BORDER_STRIP, LENGTH, WIDTH
 from tafel.tools.scenario_predicates import PREDICATES, REQUIRED, TIMING, Parameter
 
 PLATFORMS = ("mujoco", "pybullet")
 CONTEXTS = ("cognition", "motion")
 #: N of a push: more throws the robot off the field instead of testing a fall (the simulators' limit)
 MAX_PUSH_N = 500.0
+#: s a scenario may last at the most (an hour of simulated time)
+MAX_DURATION_S = 3600.0
+#: mm from the centre to the carpet's edge: robots and the ball start on it
+CARPET_X_MM, CARPET_Y_MM = LENGTH / 2 + BORDER_STRIP, WIDTH / 2 + BORDER_STRIP
 
 
 class ScenarioError(ValueError):
@@ -99,7 +105,9 @@ KINDS: dict[str, str] = {
     "string": "a string in quotes",
     "bool": "true or false",
     "pair": "[x, y], two numbers",
-    "pose": "[x_mm, y_mm, rotation_deg], three numbers",
+    "pose": "[x_mm, y_mm, rotation_deg], three numbers, x and y on the carpet",
+    "place": "[x_mm, y_mm], two numbers on the carpet",
+    "duration": f"a number of seconds above 0 and at most {MAX_DURATION_S:g}",
     "range": "[low, high], two numbers with low <= high",
     "strings": 'a list of strings, e.g. ["parameters.Striker.kick_distance=200"]',
     "value": "a number, true or false, or a string",
@@ -110,9 +118,19 @@ def _is_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
+def _on_carpet(x: float, y: float) -> bool:
+    return abs(x) <= CARPET_X_MM and abs(y) <= CARPET_Y_MM
+
+
 def _fits(kind: str, value: Any) -> bool:
     if kind == "number":
         return _is_number(value)
+    if kind == "duration":
+        return _is_number(value) and 0 < value <= MAX_DURATION_S
+    if kind == "place":
+        return _fits("pair", value) and _on_carpet(*value)
+    if kind == "pose" and _fits("pair", value[:2] if isinstance(value, list) else None) and not _on_carpet(*value[:2]):
+        return False
     if kind == "positive":
         return _is_number(value) and value > 0
     if kind == "rate":
@@ -133,9 +151,9 @@ def _fits(kind: str, value: Any) -> bool:
 
 
 def _convert(kind: str, value: Any) -> Any:
-    if kind in ("number", "positive", "rate"):
+    if kind in ("number", "positive", "rate", "duration"):
         return float(value)
-    if kind in ("pair", "range", "pose"):
+    if kind in ("pair", "range", "pose", "place"):
         return tuple(float(v) for v in value)
     if kind == "strings":
         return tuple(value)
@@ -156,6 +174,9 @@ class _File:
             raise ScenarioError(f"{path}: cannot be read ({exc})") from None
         try:
             self.data = tomllib.loads(self.text)
+        except RecursionError:
+            raise ScenarioError(f"{path}: nested too deeply to be a scenario (tables or arrays inside each other hundreds "
+                                "of levels deep); a scenario needs three levels at most") from None
         except tomllib.TOMLDecodeError as exc:
             found = re.search(r"\(at line (\d+), column \d+\)", str(exc))
             line = found.group(1) if found else "1"
@@ -224,14 +245,15 @@ def load_scenario(path: str | Path) -> Scenario:
     f = _File(Path(path))
     top = f.data
     f.only((), top, TOP_KEYS)
-    duration = f.take((), top, "duration_s", "positive")
+    duration = f.take((), top, "duration_s", "duration")
     platform = f.take((), top, "platform", "string", "mujoco")
     if platform not in PLATFORMS:
         raise f.error((), "platform", f"platform takes {' or '.join(map(repr, PLATFORMS))}, got {platform!r}")
     overrides = f.take((), top, "set", "strings", ())
-    for override in overrides:
-        if "=" not in override:
-            raise f.error((), "set", f"each entry of set is KEY=VALUE as with --set, got {override!r}")
+    try:
+        check_config(apply_overrides({}, overrides))
+    except ConfigError as exc:
+        raise f.error((), "set", f"set: {exc}") from None
     robots = _tables(f, top, "robots")
     if len(robots) != 1:
         raise f.error(("robots", 0) if robots else (), None,
@@ -255,7 +277,7 @@ def load_scenario(path: str | Path) -> Scenario:
         required_success_rate=f.take((), top, "required_success_rate", "rate"),
         overrides=overrides,
         robot_start=f.take(("robots", 0), robots[0], "start", "pose"),
-        ball=f.take(("ball",), ball, "position", "pair", (0.0, 0.0)),
+        ball=f.take(("ball",), ball, "position", "place", (0.0, 0.0)),
         ball_velocity_mm_s=f.take(("ball",), ball, "velocity", "pair", (0.0, 0.0)),
         perturbation=_perturbation(f, top),
         events=tuple(_push(f, ("events", i), event, duration) for i, event in enumerate(_tables(f, top, "events"))),
