@@ -243,6 +243,10 @@ class ModuleManager:
     def external(self) -> list[type]:
         return list(self._external)
 
+    def module_class(self, name: str) -> type:
+        """The class of the configured module ``name`` (``UnknownModuleError`` with the closest names)."""
+        return resolve_module(name, self._by_name)
+
     def module(self, name: str) -> Any:
         """The running instance of module ``name``."""
         for slot in self._slots:
@@ -381,19 +385,53 @@ class ModuleManager:
     def disabled(self) -> set[str]:
         return set(self._disabled)
 
+    def replace_module(self, new_cls: type, parameters: Mapping[str, Any] | None = None,
+                       slot: _Slot | None = None) -> _Slot | None:
+        """Run ``new_cls`` instead of the module class of the same name, keeping the blackboard: hot reload.
+
+        ``parameters`` are the new instance's values (names the new class lacks are the caller's to drop);
+        ``slot`` brings back a slot taken out before (its instance, with its state: a rollback). Returns
+        the slot taken out. Raises, and changes nothing, when the graph would break or the constructor fails.
+        """
+        old_cls = resolve_module(new_cls.__name__, self._by_name)
+        modules = [new_cls if m is old_cls else m for m in self._modules]
+        effective = {r: m for r, m in self._providers.items() if m not in self._disabled}
+        plan = build_plan(modules, external=self._external, providers=effective, disabled=self._disabled)
+        saved = (self._modules, self._by_name, self._requirements, self._parameters)
+        self._modules, self._by_name = modules, module_names(modules)
+        self._requirements = {m: m.requirements() for m in modules}
+        if parameters is not None:
+            self._parameters = {**self._parameters, new_cls.__name__: dict(parameters)}
+        taken = next((s for s in self._slots if s.cls is old_cls), None)
+        old_provider = {rep: (new_cls if m is old_cls else m) for rep, m in self._plan.provider.items()}
+        try:
+            self._plan = self._apply(plan, old_provider, keep=[slot] if slot is not None else ())
+        except BaseException:
+            self._modules, self._by_name, self._requirements, self._parameters = saved
+            raise
+        self._alternatives = {}
+        for m, req in self._requirements.items():
+            for rep in req.provides:
+                self._alternatives.setdefault(rep.__name__, []).append(m.__name__)
+        return taken
+
+    def slot_of(self, name: str) -> _Slot | None:
+        """The running slot of the module ``name`` (None while it is disabled or idle)."""
+        return next((s for s in self._slots if s.name == name), None)
+
     # ------------------------------------------------------------------ internals
-    def _apply(self, plan: Plan, old_provider: Mapping[type, type | None]) -> Plan:
+    def _apply(self, plan: Plan, old_provider: Mapping[type, type | None], keep: Iterable[_Slot] = ()) -> Plan:
         """Switch to a checked plan: keep running instances, create new ones, reset changed outputs.
 
         New instances are built before anything changes, so a failing constructor leaves the running
-        graph as it was.
+        graph as it was. ``keep`` are slots to run again that are not running now (a rollback).
         """
         for rep in plan.provider:
             self.blackboard.ensure(rep)
         for m in plan.order:
             for rep in m.requirements().reads():
                 self.blackboard.ensure(rep)
-        kept = {slot.cls: slot for slot in self._slots}
+        kept = {slot.cls: slot for slot in (*self._slots, *keep)}
         slots = []
         for m in plan.order:
             slot = kept.get(m)

@@ -27,6 +27,7 @@ from tafel.core.errors import TafelError
 from tafel.core.manager import ModuleManager
 from tafel.core.naming import did_you_mean
 from tafel.core.parameters import ParameterError, make_parameters, parameter_values, set_parameter
+from tafel.core.reload import ModuleReloader
 from tafel.core.representation import FieldInfo, fields_of
 from tafel.core.serialization import SerializationError, deserialize, serialize
 from tafel.core.validation import MAX_MAGNITUDE, ValueCheckError, check_field, check_instance, check_number
@@ -66,6 +67,8 @@ def _spec(name: str, summary: str, usage: str = "", routing: str = "merge") -> N
 _spec("modules:list", "per context: execution order, enabled, providers and alternatives, mean and max time",
       "modules:list [-format json]")
 _spec("modules:set", "enable or disable a module", "modules:set -module NAME -enabled true|false", "first")
+_spec("module:reload", "import a module's source file again and run the new code from the next frame, keeping the "
+      "blackboard and parameters (rolled back if it raises in its first frames)", "module:reload -module NAME", "first")
 _spec("modules:provider", "choose the module that provides a representation", "modules:provider -representation NAME -module NAME", "first")
 _spec("representation:list", "the representations of both contexts and who provides them", "representation:list [-format json]")
 _spec("representation:print", "a representation's current value as readable text (or JSON)", "representation:print -name NAME [-format json]", "first")
@@ -271,6 +274,7 @@ class ContextDebug:
         #: representation name -> the value put on the blackboard before every frame (representation:override)
         self.overrides: dict[str, Any] = {}
         manager.before_frame.append(self._apply_overrides)
+        self.reloader = ModuleReloader(manager)
 
     def _apply_overrides(self) -> None:
         for value in self.overrides.values():
@@ -340,6 +344,9 @@ class ContextDebug:
         enabled = parse_bool(argument(command, "enabled", "value", positional=False), "-enabled")
         self.manager.set_enabled(name, enabled)
         return f"{name} {'enabled' if enabled else 'disabled'} in {self.context}; order: {' -> '.join(self.manager.order)}"
+
+    def cmd_module_reload(self, command: Command) -> str:
+        return self.reloader.reload(self._module_name(command))
 
     def cmd_modules_provider(self, command: Command) -> str:
         rep = argument(command, "representation", "name")

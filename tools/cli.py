@@ -141,6 +141,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="serve RobotControl in the browser on the debug server's address at this port "
                           "(default %(default)s; 0 takes a free one)")
     run.add_argument("--no-web", action="store_true", help="run without the web view")
+    run.add_argument("--watch", action="store_true",
+                     help="reload a module into the running program when its source file changes (keeps the blackboard)")
     run.add_argument("--foxglove", nargs="?", const=f"127.0.0.1:{DEFAULT_FOXGLOVE_PORT}", metavar="[HOST:]PORT",
                      help=f"serve Foxglove and Lichtblick live over WebSocket (default 127.0.0.1:{DEFAULT_FOXGLOVE_PORT}; "
                           "with --debug-token clients must give it: ws://HOST:PORT/?token=T)")
@@ -352,6 +354,8 @@ def command_run(args: argparse.Namespace, extra: Sequence[str]) -> int:
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(name)s %(levelname)s: %(message)s")
     if args.foxglove is not None:
         foxglove_address(args.foxglove)  # a wrong address fails before anything starts
+    if args.watch and args.no_debug:
+        fail("--watch reloads modules through the debug server; leave out --no-debug (--no-web is fine)")
     if args.record_dir.exists() and not args.record_dir.is_dir():
         fail(f"--record-dir {args.record_dir} is a file; it takes a folder (created when a client records)")
     platform, options, plans, config = prepare(args, extra)
@@ -413,6 +417,16 @@ def is_loopback(host: str) -> bool:
         return ipaddress.ip_address(host).is_loopback
     except ValueError:
         return False
+
+
+def watch_sources(args: argparse.Namespace, debug: ProgramDebug | None, plans: Mapping[str, ContextPlan]) -> Any:
+    """``--watch``: reload changed module files through the debug server (None without ``--watch``)."""
+    if not args.watch or debug is None:
+        return None
+    from tafel.tools.source_watch import SourceWatcher, module_files
+
+    classes = [cls for plan in plans.values() for cls in plan.modules]
+    return SourceWatcher(module_files(classes), lambda line: debug.server.ask(line, timeout=10.0), status_print).start()
 
 
 def listen(args: argparse.Namespace, debug: ProgramDebug | None) -> None:
@@ -530,6 +544,7 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
             context_debug(name, runner.manager, recorded.get(name, ()))
     signals = install_signal_handlers(runtime.stop, grace_s=shutdown_grace(config))
     listen(args, debug)
+    watcher = watch_sources(args, debug, plans)
     web = start_web(args, debug, plans, config)
     live = start_foxglove(args, debug, config)
     for viewer in (web, live):
@@ -556,7 +571,7 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
     try:
         stats = runtime.run(limits)
     finally:
-        for viewer in (live, web):
+        for viewer in (live, web, watcher):
             if viewer is not None:
                 viewer.stop()
         if debug is not None:
@@ -611,6 +626,7 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
     if debug is not None:
         listen(args, debug)
         threading.Thread(target=debug.server.dispatch_forever, args=(runtime.stop,), name="tafel-debug-dispatch", daemon=True).start()
+    watcher = watch_sources(args, debug, plans)
     web = start_web(args, debug, plans, config, web_flags)
     live = start_foxglove(args, debug, config, flags)
     for viewer, source in ((web, web_feed), (live, feed)):
@@ -619,7 +635,7 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
     try:
         stats = runtime.run(limits)
     finally:
-        for viewer in (live, web):
+        for viewer in (live, web, watcher):
             if viewer is not None:
                 viewer.stop()
         if debug is not None:
