@@ -7,6 +7,8 @@
   team that stands still (it never hears the GameController: it stands where it entered, on its
   touchline), cameras off.
 - The bytes per team message and the messages each robot and each team sent per minute of PLAYING.
+- The fouls the simulated referee called per team and minute of PLAYING, in every match played
+  (``fouls_per_minute_*``; the goal is none of the own team's).
 
     python benchmarks/match.py [--short]
 
@@ -42,6 +44,12 @@ def playing_s(result: dict) -> float:
     return sum(b["time_s"] - a["time_s"] for a, b in zip(events, events[1:]) if a["event"] == "PLAYING")
 
 
+def fouls_per_minute(result: dict) -> list[float]:
+    """Each team's fouls per minute of PLAYING (team 1 first)."""
+    minutes = playing_s(result) / 60.0
+    return [round(team["fouls"] / minutes, 3) if minutes else 0.0 for team in result["teams"]]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--short", action="store_true", help="a tenth as long")
@@ -55,6 +63,7 @@ def main() -> None:
             figures[f"realtime_factor_{key}"] = result["realtime_factor"]
             figures[f"startup_s_{key}"] = result["startup_s"]
             figures[f"simulated_s_{key}"] = result["simulated_s"]
+            figures[f"fouls_per_minute_{key}"] = fouls_per_minute(result)
     standing = play("--teams", "2v2", "--cameras", "off", "--seconds", f"{300.0 * scale:g}", "--team2-set", "game.enabled=false")
     minutes = playing_s(standing) / 60.0
     messages = standing["teams"][0]["team_messages"]
@@ -66,6 +75,7 @@ def main() -> None:
         "team_messages_per_minute_per_team": round(messages / minutes, 1) if minutes else 0.0,
         "team_messages_per_minute_per_robot": round(messages / 2 / minutes, 1) if minutes else 0.0,
         "message_budget_left": standing["teams"][0]["message_budget_left"],
+        "fouls_per_minute_2v2_against_standing_team": fouls_per_minute(standing),
         "cpu_count": os.cpu_count(),
     })
     print(json.dumps(figures))

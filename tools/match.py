@@ -145,7 +145,7 @@ class Match:
     def play(self) -> str:
         """Tick until the game is over; the reason it ended."""
         speed = self.args.speed
-        started, time_ns, last_score = time.monotonic(), 0, self.referee.score()
+        started, time_ns, last_score, fouls_told = time.monotonic(), 0, self.referee.score(), 0
         connections = {robot.connection: robot for robot in self.robots}
         while True:
             waiting, commands = set(connections), {}
@@ -168,6 +168,10 @@ class Match:
             if self.referee.score() != last_score:
                 last_score = self.referee.score()
                 print(f"[match] t={time_ns * 1e-9:.1f}s goal: {TEAM_NUMBERS[0]}:{TEAM_NUMBERS[1]} {last_score}", flush=True)
+            for foul in self.referee.fouls[fouls_told:]:
+                who = f"team {foul.team} player {foul.player}" if foul.player else f"team {foul.team}"
+                print(f"[match] t={foul.time_s:.1f}s foul: {who} {foul.penalty.name if foul.player else ''} ({foul.reason})", flush=True)
+            fouls_told = len(self.referee.fouls)
             if self.referee.over:
                 return "the game is over"
             for robot in self.robots:
@@ -198,7 +202,12 @@ class Match:
         sent = sum(referee.messages)
         return {
             "teams": [{"team": TEAM_NUMBERS[t], "robots": self.args.teams[t], "score": referee.game.teams[t].score,
-                       "team_messages": referee.messages[t], "message_budget_left": referee.game.teams[t].message_budget} for t in (0, 1)],
+                       "team_messages": referee.messages[t], "team_messages_heard": referee.messages_heard[t],
+                       "message_budget_left": referee.game.teams[t].message_budget,
+                       "fouls": sum(f.team == TEAM_NUMBERS[t] for f in referee.fouls),
+                       "illegal_communication": referee.illegal_communication[t]} for t in (0, 1)],
+            "fouls": [{"time_s": round(f.time_s, 2), "team": f.team, "player": f.player, "penalty": f.penalty.name, "reason": f.reason}
+                      for f in referee.fouls],
             "score": referee.score(),
             "ended": reason,
             "simulated_s": round(self.world.time_ns * 1e-9, 2),
@@ -238,6 +247,7 @@ def command_match(args: argparse.Namespace, extra: Sequence[str]) -> int:
     line = json.dumps(result)
     if args.result is not None:
         args.result.write_text(line + "\n")
-    print(f"[match] {reason}; score {TEAM_NUMBERS[0]}:{TEAM_NUMBERS[1]} {result['score']}", flush=True)
+    fouls = ":".join(str(team["fouls"]) for team in result["teams"])
+    print(f"[match] {reason}; score {TEAM_NUMBERS[0]}:{TEAM_NUMBERS[1]} {result['score']}, fouls {fouls}", flush=True)
     print(line, flush=True)
     return 0 if reason == "the game is over" else 1
