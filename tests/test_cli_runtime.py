@@ -69,7 +69,7 @@ def test_seconds_limit_uses_platform_time() -> None:
     [
         (["run", "--platform", "dumy"], "unknown platform 'dumy': did you mean 'dummy'"),
         (["run", "--set", 'cognition.modules=["KalmanBallModeller"]'], "did you mean 'KalmanBallModeler'"),
-        (["run", "--speed", "fast"], "--speed takes a positive number or 'max'"),
+        (["run", "--speed", "fast"], "--speed takes a factor from 0.001 to 1000 or 'max'"),
         (["run", "--frames", "0"], "expected a number greater than zero"),
         (["run", "--frames", "3", "--seconds", "2"], "not allowed with argument"),
         (["run", "--platform", "dummy", "--bogus"], "unrecognized arguments: --bogus; options of platform dummy: --seed"),

@@ -29,6 +29,7 @@ CALLS: dict[str, dict[str, str]] = {
     "modules:list": {},
     "modules:provider": {"representation": "BallModel", "module": "KalmanBallModeler"},
     "modules:set": {"module": "LookAtBallBehavior", "enabled": "on"},
+    "module:reload": {"module": "DebugUser"},
     "modules:store": {},
     "parameter:get": {"module": "KalmanBallModeler"},
     "parameter:list": {},

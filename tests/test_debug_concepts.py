@@ -185,4 +185,4 @@ def test_debug_data_is_recorded_like_representations(tmp_path) -> None:
     plots = [deserialize(DebugPlots, m.data) for m in contents.messages if m.topic == "cognition/DebugPlots"]
     assert len(plots) == 9
     assert [p.values[p.names.index("DebugUser:frame")] for p in plots] == [float(i) for i in range(1, 10)]
-    assert contents.channels["cognition/DebugPlots"].metadata == {"source": "debug"}
+    assert contents.channels["cognition/DebugPlots"].metadata == {"source": "debug", "state": "false"}  # debug output, no state

@@ -501,7 +501,7 @@ def test_the_default_simulation_holds_its_rates_under_every_attack_at_once(tmp_p
     (["--set", "runtime.shutdown_grace_s=abc"], "runtime.shutdown_grace_s takes a positive number of seconds"),
     (["--seed", "-1"], "--seed takes a whole number from 0 to 4294967295"),
     (["--seconds", "nan"], "argument --seconds: expected a number greater than zero, got nan"),
-    (["--speed", "nan"], "--speed takes a positive number or 'max'"),
+    (["--speed", "nan"], "--speed takes a factor from 0.001 to 1000 or 'max'"),
     (["--set", "runtime.motion_hz=10000"], "above what the runtime supports (1000 Hz at the most)"),
     (["--set", "parameters.HeadMotoin.max_speed=2"], "unknown module 'HeadMotoin': did you mean 'HeadMotion'"),
     (["--robot", "nosuch"], "--robot nosuch: no file robot/nosuch.toml"),
@@ -523,6 +523,30 @@ def test_a_broken_private_configuration_is_an_error_not_a_traceback(tmp_path: Pa
     result = tafel("run", "--platform", "dummy", "--no-debug", "--seconds", "0.2", "--config", str(tmp_path))
     assert result.returncode == 2, result.stderr
     assert message in result.stderr and "Traceback" not in result.stderr
+
+
+# ------------------------------------------------------------------------------ clients never destroy recordings
+def test_log_start_never_replaces_a_file_but_records_under_the_next_free_name(tmp_path: Path) -> None:
+    from tafel.core.logfile import read_log
+
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    (logs / "game.mcap").write_bytes(b"an older game")
+    running = Program("--platform", "dummy", "--record", str(logs / "own.mcap"), cwd=tmp_path)
+    try:
+        time.sleep(0.3)
+        kept = "exists and is kept"
+        assert running.ask("log:start -file own.mcap") == f"recording to {logs / 'own-1.mcap'} (own.mcap {kept})"  # the user's --record
+        assert running.ask("log:start -file game.mcap") == f"recording to {logs / 'game-1.mcap'} (game.mcap {kept})"
+        assert running.ask("log:start -file game.mcap") == f"recording to {logs / 'game-2.mcap'} (game.mcap {kept})"
+        time.sleep(0.3)
+        assert running.ask("log:stop").startswith(f"stopped recording {logs / 'game-2.mcap'}")
+    finally:
+        running.stop()
+    assert (logs / "game.mcap").read_bytes() == b"an older game"
+    own = read_log(logs / "own.mcap")  # finished when the client's recording began, not replaced
+    assert own.complete and len(own.frames("motion")) > 10
+    assert len(read_log(logs / "game-2.mcap").frames("motion")) > 10
 
 
 # ---------------------------------------------------------------------------- team messages in this robot's name
