@@ -17,23 +17,27 @@ at least every ``flush_interval`` seconds, so a process killed with SIGKILL lose
 
 from __future__ import annotations
 
+import atexit
 import io
 import logging
 import os
 import queue
+import re
+import struct
 import threading
 import time
+import zlib
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import zstandard
 from google.protobuf import descriptor_pb2
 from mcap.data_stream import ReadDataStream
+from mcap.exceptions import McapError
 from mcap.opcode import Opcode
-from mcap.reader import SeekingReader
-from mcap.records import Channel, Chunk, Message, Metadata, Schema
-from mcap.stream_reader import breakup_chunk
+from mcap.records import Channel, ChunkIndex, Header, Metadata, MetadataIndex, Schema, Statistics
 from mcap.writer import CompressionType, Writer
 
 from tafel.core.errors import TafelError
@@ -48,6 +52,10 @@ log = logging.getLogger("tafel.log")
 
 class LogError(TafelError, RuntimeError):
     """A log file that cannot be written, or read (with the file and the position)."""
+
+
+class LogExistsError(LogError):
+    """A log that must not replace a file already there (a client's ``log:start``) found one."""
 
 
 #: topics of channels that are not representations (Foxglove's) start with this
@@ -107,13 +115,19 @@ class LogWriter:
     """Writes representation messages to an MCAP file from a background thread."""
 
     def __init__(self, path: str | Path, *, metadata: Mapping[str, str] | None = None, queue_size: int = 4096,
-                 flush_interval: float = 0.5, chunk_size: int = 4 << 20, translate: Translate | None = None) -> None:
+                 flush_interval: float = 0.5, chunk_size: int = 4 << 20, translate: Translate | None = None,
+                 exclusive: bool = False) -> None:
+        """``exclusive``: never replace an existing file (``LogExistsError`` instead), decided atomically."""
         self.path = Path(path)
         self.translate = translate
         try:
-            self._stream = open(self.path, "wb")  # noqa: SIM115 - closed by close()
+            self._stream = open(self.path, "xb" if exclusive else "wb")  # noqa: SIM115 - closed by close()
+        except FileExistsError:
+            raise LogExistsError(f"{self.path} exists; a new recording never replaces it") from None
         except OSError as exc:
             raise LogError(f"cannot write log {self.path}: {exc.strerror}") from None
+        # A program that ends before it records anything (a port taken at start) leaves no empty file behind.
+        atexit.register(self._abandon)
         self._writer = Writer(self._stream, chunk_size=chunk_size, compression=CompressionType.ZSTD)
         self._writer.start(profile=PROFILE, library="tafel")
         if metadata:
@@ -164,6 +178,7 @@ class LogWriter:
         if self._closed:
             return
         self._closed = True
+        atexit.unregister(self._abandon)
         if not self.failed:
             self._queue.put(None)
         self._thread.join()
@@ -176,6 +191,17 @@ class LogWriter:
             self._stream.close()
         except OSError as exc:  # the last buffered bytes did not fit either: what is on disk stays
             self.error = self.error or f"{type(exc).__name__}: {exc}"
+
+    def _abandon(self) -> None:
+        """At exit, a file that was never closed and holds no message is removed, not left empty."""
+        if self._closed or self.written or not self._queue.empty():
+            return
+        self._closed = True
+        try:
+            self._stream.close()
+            self.path.unlink(missing_ok=True)
+        except (OSError, ValueError):  # exiting anyway: a file that stays is no reason to fail
+            pass
 
     def _run(self) -> None:
         last_flush = time.monotonic()
@@ -286,35 +312,99 @@ class ChunkInfo:
     end_ns: int
 
 
-class LogReader:
-    """Reads an MCAP log chunk by chunk, never the whole file at once.
+#: the most one chunk may hold uncompressed: Tafel writes chunks of 4 MiB and one message more (a camera
+#: image is under 3 MB). A chunk that claims more is refused before anything is allocated for it.
+MAX_CHUNK_BYTES = 32 << 20
+#: the most a byte of compressed data can stand for (zstd: a block of 128 KiB repeating one byte costs 4
+#: bytes; LZ4: one byte extends a match by 255): a chunk claiming more is damaged or a bomb
+_MAX_RATIO = {"": 1, "zstd": 32768, "lz4": 255}
+#: what a record outside the chunks (header, schema, channel, metadata) and the summary section may claim
+MAX_RECORD_BYTES = 16 << 20
+MAX_SUMMARY_BYTES = 64 << 20
+#: opcode, length, then the chunk's start and end time, uncompressed size and CRC, compression name length
+_CHUNK_HEAD = struct.Struct("<BQQQQII")
+_FOOTER = struct.Struct("<BQQQI")
+#: where a chunk record may start: its opcode, then 36 bytes, then the length and name of a compression
+_CHUNK_SIGNATURE = re.compile(rb"\x06.{36}(?:\x04\x00\x00\x00zstd|\x03\x00\x00\x00lz4|\x00\x00\x00\x00)", re.DOTALL)
+_SCAN_BLOCK = 1 << 20
 
-    An intact file is read through its summary (channels, metadata and the chunk index); a file
-    without one (the recording was cut off) is walked record by record once to find its chunks.
-    A damaged chunk is skipped with a warning and reading goes on with the next one; a file cut off
-    in the middle yields everything before the cut. ``problems`` lists what was skipped and why.
+
+class _Damage(Exception):
+    """Why a record cannot be trusted (raised inside the reader, reported as a problem with its position)."""
+
+
+class _Exact(ReadDataStream):
+    """A record parser that fails when a field claims more bytes than the record holds."""
+
+    def read(self, length: int) -> bytes:
+        data = super().read(length)
+        if len(data) != length:
+            raise _Damage(f"a field claims {length} bytes where {len(data)} are left")
+        return data
+
+
+def _parse(record_type: Any, body: bytes, *, whole: bool = False) -> Any:
+    """One mcap record from its body; ``_Damage`` when a field runs past its end, or with ``whole``
+    when its fields leave bytes over (where no CRC vouches for the record's length)."""
+    stream = _Exact(io.BytesIO(body))
+    record = record_type.read(stream)
+    if whole and stream.count != len(body):
+        raise _Damage(f"its fields take {stream.count} of its {len(body)} bytes")
+    return record
+
+
+@dataclass(frozen=True)
+class _ChunkHead:
+    """The fields of a chunk record before its compressed data, checked against each other and the limits."""
+
+    offset: int
+    start_ns: int
+    end_ns: int
+    size: int  # uncompressed
+    crc: int
+    compression: str
+    data_offset: int
+    data_length: int
+
+    @property
+    def end(self) -> int:
+        return self.data_offset + self.data_length
+
+
+class LogReader:
+    """Reads an MCAP log chunk by chunk, never the whole file at once, and never more than a bounded
+    amount of memory for one chunk, whatever the file claims.
+
+    An intact file is read through its summary (channels, metadata and the chunk index), which its CRC
+    vouches for; a file without one (the recording was cut off) or with a damaged one is walked record
+    by record once to find its chunks. A damaged chunk is skipped with a warning naming its byte, and
+    reading goes on with the next one: the index says where it is, or the walk finds it by its record
+    signature. So one flipped bit loses at most the chunk it hits. A chunk that claims more than
+    ``max_chunk_bytes`` uncompressed (or more than its compressed bytes can hold) is refused unread.
+    ``problems`` lists what was skipped and why.
     """
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path, *, max_chunk_bytes: int = MAX_CHUNK_BYTES) -> None:
         self.path = Path(path)
+        self.max_chunk_bytes = max_chunk_bytes
         try:
             self._file = open(self.path, "rb")  # noqa: SIM115 - closed by close()
             self.size = os.fstat(self._file.fileno()).st_size
         except OSError as exc:
             raise LogError(f"cannot read log {self.path}: {exc.strerror or exc}") from None
-        if self._file.read(len(MAGIC)) != MAGIC:
-            self.close()
-            raise LogError(f"{self.path} is not an MCAP log (it does not start with the MCAP magic bytes)")
         self.channels: dict[str, LogChannel] = {}
         #: channels that are not representations (topic -> schema name), e.g. the Foxglove ones
         self.extra_channels: dict[str, str] = {}
         self.metadata: dict[str, str] = {}
         self.chunks: list[ChunkInfo] = []
+        #: messages per topic as the summary counts them (None without a trusted summary)
+        self.message_counts: dict[str, int] | None = None
         self.complete = True
         self.problems: list[str] = []
         self._schemas: dict[int, Schema] = {}
         self._topics: dict[int, str] = {}
         self._warned: set[int] = set()
+        self._check_magic()
         if not self._read_summary():
             self._walk()
             for _ in self.iter_chunks():  # channels are defined inside the chunks: find them all once
@@ -324,31 +414,112 @@ class LogReader:
                 raise LogError(f"{self.path}: nothing can be read: {self.problems[0]}")
 
     # ------------------------------------------------------------------------------- opening
+    def _check_magic(self) -> None:
+        """The MCAP magic at the start; one or two flipped bits in it are a damage, not another format."""
+        if self.size == 0:
+            self.close()
+            raise LogError(f"{self.path} is empty (0 bytes): nothing was ever recorded into it "
+                           "(a run that stopped before recording started leaves such a file)")
+        start = self._file.read(len(MAGIC))
+        if start == MAGIC:
+            return
+        flipped = sum(bin(a ^ b).count("1") for a, b in zip(start, MAGIC, strict=False)) if len(start) == len(MAGIC) else 99
+        if flipped <= 2 and self.size > len(MAGIC) and self._file.read(1) == bytes([Opcode.HEADER]):
+            self._problem(f"{self.path}: the MCAP magic at byte 0 is damaged ({flipped} bit{'s' if flipped > 1 else ''}); reading on")
+            return
+        self.close()
+        raise LogError(f"{self.path} is not an MCAP log (it does not start with the MCAP magic bytes)")
+
     def _read_summary(self) -> bool:
-        """Channels, metadata and chunks from the summary section; False when there is none."""
+        """Channels, metadata and chunks from the summary section; False when there is none or it is damaged."""
+        footer_at = self.size - _FOOTER.size - len(MAGIC)
+        if footer_at < len(MAGIC):
+            return False
+        self._file.seek(footer_at)
+        footer = self._file.read(_FOOTER.size)
+        opcode, length, summary_start, _offsets_start, crc = _FOOTER.unpack(footer)
+        if opcode != Opcode.FOOTER or length != _FOOTER.size - 9:
+            return False  # cut off, or the footer is damaged: the walk says which
+        if summary_start == 0:
+            return False  # written without a summary
+        if not len(MAGIC) <= summary_start <= footer_at or footer_at - summary_start > MAX_SUMMARY_BYTES:
+            self._problem(f"{self.path}: the footer at byte {footer_at} points to a summary at byte {summary_start}, "
+                          "which cannot be; walking the file instead")
+            return False
+        self._file.seek(summary_start)
+        data = self._file.read(footer_at - summary_start)
+        if crc != 0 and zlib.crc32(footer[:-4], zlib.crc32(data)) != crc:
+            self._problem(f"{self.path}: the summary section at byte {summary_start} is damaged (its CRC does not match); "
+                          "walking the file instead")
+            return False
         try:
-            reader = SeekingReader(self._file, record_size_limit=self.size)
-            summary = reader.get_summary()
-        except Exception:  # noqa: BLE001 - no intact summary: walk the file instead
+            schemas, channels, chunks, metadata, counts = self._summary_records(data, summary_start)
+        except (_Damage, ValueError, struct.error, UnicodeDecodeError, McapError) as exc:
+            self._problem(f"{self.path}: the summary section at byte {summary_start} cannot be read ({exc}); walking the file instead")
             return False
-        if summary is None:
-            return False
-        for schema in summary.schemas.values():
-            self._schemas[schema.id] = schema
-        for channel in summary.channels.values():
+        self._schemas.update(schemas)
+        for channel in channels:
             self._add_channel(channel)
-        try:
-            for record in reader.iter_metadata():
-                if record.name == PROFILE:
-                    self.metadata.update(record.metadata)
-        except Exception as exc:  # noqa: BLE001 - metadata is a convenience; the messages matter
-            self._problem(f"{self.path}: the run's metadata cannot be read: {exc}")
-        self.chunks = sorted((ChunkInfo(c.chunk_start_offset, c.message_start_time, c.message_end_time)
-                              for c in summary.chunk_indexes), key=lambda c: c.offset)
+        self.chunks = sorted(chunks, key=lambda c: c.offset)
+        self.message_counts = {topic: counts.get(channel_id, 0) for channel_id, topic in self._topics.items()}
+        for offset, size in metadata:
+            try:
+                self._register(_parse(Metadata, self._record_body(offset, Opcode.METADATA, size)))
+            except (_Damage, ValueError, struct.error, UnicodeDecodeError, McapError) as exc:  # the messages matter more
+                self._problem(f"{self.path}: the run's metadata at byte {offset} cannot be read ({exc})")
         return True
 
+    def _summary_records(self, data: bytes, start: int) -> tuple[dict[int, Schema], list[Channel], list[ChunkInfo], list[tuple[int, int]], dict[int, int]]:
+        """The summary's schemas, channels, chunk index, metadata index (offset, length) and message counts."""
+        schemas: dict[int, Schema] = {}
+        channels: list[Channel] = []
+        chunks: list[ChunkInfo] = []
+        metadata: list[tuple[int, int]] = []
+        counts: dict[int, int] = {}
+        position = 0
+        while position < len(data):
+            if position + 9 > len(data):
+                raise _Damage(f"a record at byte {start + position} is cut off")
+            opcode, length = struct.unpack_from("<BQ", data, position)
+            body = data[position + 9:position + 9 + length]
+            if len(body) != length:
+                raise _Damage(f"the record at byte {start + position} runs past the summary's end")
+            if opcode == Opcode.SCHEMA:
+                schema = _parse(Schema, body)
+                schemas[schema.id] = schema
+            elif opcode == Opcode.CHANNEL:
+                channels.append(_parse(Channel, body))
+            elif opcode == Opcode.CHUNK_INDEX:
+                index = _parse(ChunkIndex, body)
+                if not len(MAGIC) <= index.chunk_start_offset <= start - 9 - index.chunk_length:
+                    raise _Damage(f"its chunk index names byte {index.chunk_start_offset}, outside the data section")
+                chunks.append(ChunkInfo(index.chunk_start_offset, index.message_start_time, index.message_end_time))
+            elif opcode == Opcode.METADATA_INDEX:
+                index = _parse(MetadataIndex, body)
+                if index.name == PROFILE:
+                    metadata.append((index.offset, index.length))
+            elif opcode == Opcode.STATISTICS:
+                counts = dict(_parse(Statistics, body).channel_message_counts)
+            position += 9 + length
+        return schemas, channels, chunks, metadata, counts
+
+    def _record_body(self, offset: int, opcode: int, expected: int | None = None) -> bytes:
+        """The body of the record at ``offset``, which must have ``opcode`` and a bounded, fitting length."""
+        self._file.seek(offset)
+        head = self._file.read(9)
+        if len(head) < 9 or head[0] != opcode:
+            raise _Damage(f"no {Opcode(opcode).name.lower()} record there")
+        length = int.from_bytes(head[1:], "little")
+        if length > MAX_RECORD_BYTES or offset + 9 + length > self.size or (expected is not None and 9 + length != expected):
+            raise _Damage(f"its length ({length} bytes) cannot be right")
+        return self._file.read(length)
+
     def _walk(self) -> None:
-        """Find chunks, schemas, channels and metadata by walking the records from the start."""
+        """Find chunks, schemas, channels and metadata by walking the records from the start.
+
+        A record that cannot be right (an unknown opcode, lengths that disagree, a chunk over the
+        limits) is reported, and the walk goes on from the next chunk record a scan finds.
+        """
         position = len(MAGIC)
         while True:
             self._file.seek(position)
@@ -358,26 +529,114 @@ class LogReader:
                 self._problem(f"{self.path}: the file ends at byte {self.size} without the MCAP footer (the recording was cut off)")
                 return
             opcode, length = head[0], int.from_bytes(head[1:], "little")
-            if position + 9 + length > self.size:
-                self.complete = False
-                self._problem(f"{self.path}: the record at byte {position} runs past the end of the file "
-                              f"(byte {self.size}): the recording was cut off")
-                return
-            if opcode == Opcode.CHUNK:
-                times = self._file.read(16)
-                self.chunks.append(ChunkInfo(position, int.from_bytes(times[:8], "little"), int.from_bytes(times[8:], "little")))
-            elif opcode in (Opcode.SCHEMA, Opcode.CHANNEL, Opcode.METADATA):
+            try:
+                if position + 9 + length > self.size:
+                    raise _Damage(f"it runs past the end of the file (byte {self.size})")
+                if opcode == Opcode.CHUNK:
+                    chunk = self._chunk_head(position)
+                    self.chunks.append(ChunkInfo(position, chunk.start_ns, chunk.end_ns))
+                elif opcode in (Opcode.SCHEMA, Opcode.CHANNEL, Opcode.METADATA):
+                    self._register(_parse(_RECORD_TYPES[opcode], self._record_body(position, opcode), whole=True))
+                elif opcode == Opcode.HEADER:
+                    if position != len(MAGIC):
+                        raise _Damage("a header in the middle of the file")
+                    _parse(Header, self._record_body(position, opcode), whole=True)
+                elif opcode == Opcode.MESSAGE_INDEX:
+                    entries = int.from_bytes(self._file.read(6)[2:], "little")
+                    if length != 6 + entries or entries % 16:
+                        raise _Damage("its lengths disagree")
+                elif opcode in (Opcode.DATA_END, Opcode.FOOTER):
+                    if length != (4 if opcode == Opcode.DATA_END else 20):
+                        raise _Damage("its length is wrong for its kind")
+                    return
+                elif opcode != Opcode.ATTACHMENT and opcode < 0x80:  # 0x80 and up: records of other writers
+                    raise _Damage(f"opcode {opcode:#04x} does not belong in the data section")
+                position += 9 + length
+            except (_Damage, ValueError, struct.error, UnicodeDecodeError, McapError) as exc:
+                following = self._next_chunk(position + 1)
+                kind = "chunk" if opcode == Opcode.CHUNK else "record"
+                if following is None:
+                    self.complete = False
+                    cut = "runs past the end of the file" in str(exc)
+                    self._problem(f"{self.path}: the {kind} at byte {position} " + (
+                        f"runs past the end of the file (byte {self.size}): the recording was cut off" if cut else
+                        f"is damaged ({exc}), and no intact chunk follows it: the file is damaged from here on"))
+                    return
+                self._problem(f"{self.path}: the {kind} at byte {position} is damaged ({exc}); "
+                              f"{following - position} bytes skipped, reading on with the chunk at byte {following}")
+                position = following
+
+    def _next_chunk(self, start: int) -> int | None:
+        """The offset of the next intact-looking chunk record from ``start`` on (a scan through a damaged file)."""
+        block = start
+        while block < self.size:
+            self._file.seek(block)
+            data = self._file.read(_SCAN_BLOCK + 64)  # a signature that starts in this block ends in it
+            found = _CHUNK_SIGNATURE.search(data)
+            while found is not None and found.start() < _SCAN_BLOCK:
                 try:
-                    self._register(_RECORD_TYPES[opcode].read(ReadDataStream(io.BytesIO(self._file.read(length)))))
-                except Exception as exc:  # noqa: BLE001 - a damaged record is skipped, the rest read
-                    self._problem(f"{self.path}: damaged record at byte {position} skipped ({type(exc).__name__}: {exc})")
-            elif opcode in (Opcode.DATA_END, Opcode.FOOTER):
-                return
-            elif opcode not in _KNOWN_OPCODES:
-                self.complete = False
-                self._problem(f"{self.path}: unknown record (opcode {opcode:#x}) at byte {position}: the file is damaged from here on")
-                return
-            position += 9 + length
+                    self._chunk_head(block + found.start())
+                    return block + found.start()
+                except _Damage:
+                    found = _CHUNK_SIGNATURE.search(data, found.start() + 1)
+            block += _SCAN_BLOCK
+        return None
+
+    def _chunk_head(self, offset: int) -> _ChunkHead:
+        """The chunk record at ``offset``, its fields checked against each other, the file and the limits."""
+        self._file.seek(offset)
+        head = self._file.read(_CHUNK_HEAD.size)
+        if len(head) < _CHUNK_HEAD.size:
+            raise _Damage("the file ends inside it")
+        opcode, length, start_ns, end_ns, size, crc, name_length = _CHUNK_HEAD.unpack(head)
+        if opcode != Opcode.CHUNK:
+            raise _Damage(f"no chunk record there (opcode {opcode:#04x})")
+        if name_length > 8:
+            raise _Damage(f"its compression's name claims {name_length} bytes")
+        rest = self._file.read(name_length + 8)
+        if len(rest) < name_length + 8:
+            raise _Damage("the file ends inside it")
+        compression = rest[:name_length].decode("latin-1")
+        data_length = int.from_bytes(rest[name_length:], "little")
+        if length != 40 + name_length + data_length:
+            raise _Damage(f"its length ({length} bytes) disagrees with its contents ({40 + name_length + data_length} bytes)")
+        if offset + 9 + length > self.size:
+            raise _Damage(f"it runs past the end of the file (byte {self.size})")
+        if compression not in _MAX_RATIO:
+            raise _Damage(f"unknown compression {compression!r} (Tafel reads zstd, lz4 and none)")
+        if size > self.max_chunk_bytes:
+            raise _Damage(f"it claims {size} bytes uncompressed, more than the {self.max_chunk_bytes} a chunk may hold "
+                          "(LogReader's max_chunk_bytes); a damaged or hostile file")
+        if size > data_length * _MAX_RATIO[compression] or data_length > size + size // 64 + 1024:
+            raise _Damage(f"it claims {size} bytes uncompressed from {data_length} bytes of {compression or 'uncompressed'} "
+                          "data, which no compression gives; a damaged or hostile file")
+        return _ChunkHead(offset, start_ns, end_ns, size, crc, compression, offset + len(head) + len(rest), data_length)
+
+    def _inflate(self, chunk: _ChunkHead) -> bytes:
+        """The chunk's records, decompressed into at most its (bounded) declared size and checked against its CRC."""
+        self._file.seek(chunk.data_offset)
+        data = self._file.read(chunk.data_length)
+        if len(data) != chunk.data_length:
+            raise _Damage("the file ends inside it")
+        if chunk.compression == "zstd":
+            declared = zstandard.frame_content_size(data)
+            if declared not in (-1, chunk.size):  # the frame's own claim decides what zstd allocates
+                raise _Damage(f"its zstd frame claims {declared} bytes, the chunk {chunk.size}")
+            records = zstandard.ZstdDecompressor().decompress(data, max_output_size=chunk.size)
+        elif chunk.compression == "lz4":
+            import lz4.frame  # an mcap dependency; Tafel itself writes zstd
+
+            decompressor = lz4.frame.LZ4FrameDecompressor()
+            records = decompressor.decompress(data, max_length=chunk.size)
+            if not decompressor.eof:
+                raise _Damage(f"it holds more than the {chunk.size} bytes it claims")
+        else:
+            records = data
+        if len(records) != chunk.size:
+            raise _Damage(f"it holds {len(records)} bytes uncompressed, not the {chunk.size} it claims")
+        if chunk.crc != 0 and zlib.crc32(records) != chunk.crc:
+            raise _Damage("its CRC does not match its contents")
+        return records
 
     def _register(self, record: Any) -> None:
         if isinstance(record, Schema):
@@ -413,35 +672,59 @@ class LogReader:
 
     def read_chunk(self, number: int) -> list[LogMessage] | None:
         """The messages of one chunk; None (and a warning, once) when the chunk is damaged."""
+        messages = self._chunk_messages(number)
+        first = next(messages, None)
+        if first is None and number in self._warned:
+            return None
+        return ([] if first is None else [first]) + list(messages)
+
+    def _chunk_messages(self, number: int) -> Iterator[LogMessage]:
+        """The messages of one chunk, one by one, from its decompressed records (never more than one chunk in memory).
+
+        A chunk whose head, size or CRC is wrong yields nothing; one without a CRC whose records turn
+        out wrong half-way yields those before (both with a warning naming its byte).
+        """
         chunk = self.chunks[number]
         try:
-            self._file.seek(chunk.offset)
-            head = self._file.read(9)
-            if len(head) < 9 or head[0] != Opcode.CHUNK:
-                raise LogError("no chunk record there")
-            records = breakup_chunk(Chunk.read(ReadDataStream(io.BytesIO(self._file.read(int.from_bytes(head[1:], "little"))))),
-                                    validate_crc=True)
-        except Exception as exc:  # noqa: BLE001 - whatever the damage, skip this chunk and go on
-            if number not in self._warned:
-                self._warned.add(number)
-                self._problem(f"{self.path}: the chunk at byte {chunk.offset} is damaged ({type(exc).__name__}: {exc}); "
-                              "skipped, reading on with the next chunk")
-            return None
-        messages = []
-        for record in records:
-            if isinstance(record, Message):
-                topic = self._topics.get(record.channel_id)
+            records = self._inflate(self._chunk_head(chunk.offset))
+        except (_Damage, ValueError, zstandard.ZstdError, RuntimeError, OSError) as exc:  # skip this chunk and go on
+            self._chunk_problem(number, f"is damaged ({exc}); skipped, reading on with the next chunk")
+            return
+        position, end = 0, len(records)
+        while position < end:
+            if position + 9 > end:
+                self._chunk_problem(number, f"is damaged: its last record is cut off at byte {position} of its contents")
+                return
+            opcode, length = struct.unpack_from("<BQ", records, position)
+            body_at, position = position + 9, position + 9 + length
+            if position > end:
+                self._chunk_problem(number, f"is damaged: a record at byte {body_at - 9} of its contents runs past its end")
+                return
+            if opcode == Opcode.MESSAGE and length >= 22:
+                channel_id, sequence, log_time, publish_time = struct.unpack_from("<HIQQ", records, body_at)
+                topic = self._topics.get(channel_id)
                 if topic is not None:
-                    messages.append(LogMessage(topic, record.publish_time, record.sequence, record.data, record.log_time))
-            else:
-                self._register(record)
-        return messages
+                    yield LogMessage(topic, publish_time, sequence, records[body_at + 22:position], log_time)
+            elif opcode in (Opcode.SCHEMA, Opcode.CHANNEL):
+                try:
+                    self._register(_parse(_RECORD_TYPES[opcode], records[body_at:position]))
+                except (_Damage, ValueError, struct.error, UnicodeDecodeError, McapError) as exc:
+                    self._chunk_problem(number, f"holds a damaged {Opcode(opcode).name.lower()} record ({exc}); skipped it")
+            elif opcode < 0x80:  # 0x80 and up: records of other writers, skipped
+                self._chunk_problem(number, f"is damaged: a record of opcode {opcode:#04x} (length {length}) at byte "
+                                            f"{body_at - 9} of its contents, which a chunk cannot hold; the rest of it skipped")
+                return
+
+    def _chunk_problem(self, number: int, text: str) -> None:
+        if number not in self._warned:
+            self._warned.add(number)
+            self._problem(f"{self.path}: the chunk at byte {self.chunks[number].offset} {text}")
 
     def messages(self, topics: Iterable[str] | None = None, start_ns: int | None = None) -> Iterator[LogMessage]:
         """Every readable message (of ``topics``, from frame time ``start_ns`` on), chunk by chunk in file order."""
         wanted = None if topics is None else set(topics)
-        for _number, messages in self.iter_chunks():  # chunks are indexed by log (wall) time, not frame time
-            for message in messages:
+        for number in range(len(self.chunks)):  # chunks are indexed by log (wall) time, not frame time
+            for message in self._chunk_messages(number):
                 if (wanted is None or message.topic in wanted) and (start_ns is None or message.time_ns >= start_ns):
                     yield message
 
@@ -484,7 +767,6 @@ class LogReader:
 
 
 _RECORD_TYPES: dict[int, Any] = {Opcode.SCHEMA: Schema, Opcode.CHANNEL: Channel, Opcode.METADATA: Metadata}
-_KNOWN_OPCODES = {int(op) for op in Opcode}
 
 
 @dataclass
@@ -548,7 +830,7 @@ def write_slice(source: str | Path, target: str | Path, *, representations: Iter
             raise LogError(f"{source} holds no representation {name!r}; {did_you_mean(name, names)}")
         first = next(iter(reader.messages(topics)), None)
         if first is None:
-            raise LogError(f"{source} holds no messages of {', '.join(sorted(wanted or []) or 'any channel')}")
+            raise LogError(f"{source} holds no messages of {', '.join(sorted(wanted)) if wanted else 'any channel'}")
         begin = first.time_ns + int(start_s * 1e9)
         end = None if seconds is None else begin + int(seconds * 1e9)
         last_ns = max((c.end_ns for c in reader.chunks), default=0)

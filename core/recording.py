@@ -121,15 +121,16 @@ class Recorder:
         writer = self.writer or self._last_writer
         return writer.error if writer is not None and writer.failed else ""
 
-    def start(self, path: str | Path, *, blocking: bool | None = None) -> None:
+    def start(self, path: str | Path, *, blocking: bool | None = None, exclusive: bool = False) -> None:
         """Start writing to a new file (stops the current one first).
 
         ``blocking`` makes a full queue wait instead of dropping: for runs without a beat to keep.
+        ``exclusive`` refuses to replace an existing file (``LogExistsError``): for names a client chose.
         """
         self.stop()
         if blocking is not None:
             self.blocking = blocking
-        self.writer = LogWriter(path, metadata=self.metadata,
+        self.writer = LogWriter(path, metadata=self.metadata, exclusive=exclusive,
                                 translate=self.translate_factory() if self.translate_factory is not None else None)
         self.writer.blocking = self.blocking
         for listener in self.listeners:

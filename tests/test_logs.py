@@ -6,11 +6,14 @@ import csv
 import json
 import os
 import re
+import resource
 import signal
+import socket
 import subprocess
 import sys
 import textwrap
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +24,17 @@ from tafel.core.logfile import LogWriter, read_log
 from tafel.core.platform import PlatformError, PlatformOptionError
 from tafel.core.serialization import serialize
 from tafel.platforms.log import LogPlatform
+from tests.support.mcap_files import (
+    chunk_offsets,
+    chunk_record,
+    cpu_bomb,
+    flip_offsets,
+    flipped,
+    good_chunk,
+    mcap_file,
+    with_chunk_inserted,
+    zstd_rle,
+)
 from tests.test_cli_runtime import REPO, dummy, frames, tafel
 
 
@@ -153,7 +167,7 @@ def test_truncated_files_yield_what_was_complete_and_name_the_position(recorded:
     result = tafel("log", "info", str(cut))
     assert result.returncode == 0, result.stderr
     assert "recovered what was complete" in result.stdout
-    assert re.search(r"(stopped reading at byte \d+|ends at byte \d+|record at byte \d+ runs past the end)", result.stdout)
+    assert re.search(r"(stopped reading at byte \d+|ends at byte \d+|(record|chunk) at byte \d+ runs past the end)", result.stdout)
     assert "Traceback" not in result.stderr + result.stdout
 
 
@@ -334,3 +348,163 @@ def test_the_summary_goes_to_one_stream_and_ran_is_the_length() -> None:
     assert result.returncode == 0
     assert "platform dummy (lockstep): ran 2.500 s of platform time" in result.stdout
     assert "wall time" in result.stdout and "fingerprint" in result.stdout and result.stderr == ""
+
+
+# ------------------------------------------------------------------------------ logs that fight back
+def _memory_limited(limit: int) -> Callable[[], None]:
+    """For a child process: at most ``limit`` bytes of address space, so a bomb fails it instead of the machine."""
+    def apply() -> None:
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    return apply
+
+
+@pytest.mark.slow
+def test_a_chunk_claiming_gigabytes_is_refused_unread_by_every_log_command(recorded: Path, tmp_path: Path) -> None:
+    claimed = 2 << 30  # 2 GiB of zeros in 64 kB of zstd, put between the recording's chunks
+    bomb = tmp_path / "bomb.mcap"
+    bomb.write_bytes(with_chunk_inserted(recorded.read_bytes(), chunk_record(compressed=zstd_rle(claimed), claimed=claimed), 2))
+    assert bomb.stat().st_size - recorded.stat().st_size < 70_000
+    commands = {
+        "info": ("log", "info", str(bomb)),
+        "export": ("log", "export", str(bomb), "--rep", "BallModel", "--format", "csv", "--out", str(tmp_path / "x.csv")),
+        "convert": ("log", "convert", str(bomb), "--out", str(tmp_path / "converted.mcap")),
+        "compare": ("log", "compare", str(recorded), str(bomb)),
+        "slice": ("log", "slice", str(bomb), "--out", str(tmp_path / "slice.mcap"), "--seconds", "2"),
+        "replay": ("run", "--platform", "log", "--log", str(bomb), "--no-debug", "--speed", "max"),
+        "replay-batch": ("replay-batch", str(bomb), "--workers", "1", "--out", str(tmp_path / "batch.csv"),
+                         "--artifacts", str(tmp_path / "artifacts")),
+    }
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    for name, command in commands.items():
+        result = subprocess.run([sys.executable, "-m", "tafel.tools.cli", *command], capture_output=True, text=True, cwd=REPO,
+                                env=env, timeout=120, preexec_fn=_memory_limited(1536 << 20))
+        output = result.stdout + result.stderr
+        assert "Traceback" not in output and "MemoryError" not in output, f"{name}: {output[-2000:]}"
+        assert result.returncode == 0, f"{name}: {output[-2000:]}"
+        at = chunk_offsets(recorded.read_bytes())[2]
+        assert f"chunk at byte {at} is damaged (it claims {claimed} bytes uncompressed, more than" in output, f"{name}: {output[-2000:]}"
+    # every other chunk is read: the bomb costs nothing but itself
+    assert json.loads(tafel("log", "info", str(bomb), "--json").stdout)["frames"] == {"cognition": 180, "motion": 600}
+
+
+def test_a_chunk_of_zero_bytes_is_refused_at_its_first_record_and_the_next_chunk_is_read(tmp_path: Path) -> None:
+    """8 MiB of zeros are 900,000 empty records of opcode 0, which the mcap library walks one by one (the CPU bomb)."""
+    from tafel.core.logfile import LogReader
+
+    path = cpu_bomb(tmp_path / "cpu.mcap", claimed=8 << 20)
+    with LogReader(path) as reader:
+        assert sum(1 for _ in reader.messages()) == 20  # the good chunks before and after
+        assert len(reader.problems) == 1, reader.problems
+        assert "the chunk at byte 275 is damaged: a record of opcode 0x00" in reader.problems[0]
+
+
+def test_a_chunk_that_claims_more_than_its_compression_can_hold_is_refused(tmp_path: Path) -> None:
+    from tafel.core.logfile import LogReader
+
+    claimed = 4 << 20
+    honest = zstd_rle(claimed)
+    liar = chunk_record(compressed=honest[:40], claimed=claimed)  # 40 bytes of zstd cannot hold 4 MiB
+    path = mcap_file(tmp_path / "ratio.mcap", [good_chunk(0, 5), liar, good_chunk(5, 5)])
+    with LogReader(path) as reader:
+        assert sum(1 for _ in reader.messages()) == 10
+        assert f"chunk at byte {path.read_bytes().index(liar)} is damaged (it claims {claimed} bytes uncompressed from 40 bytes " \
+               "of zstd data, which no compression gives" in reader.problems[0]
+
+
+def _chunk_extents(path: Path) -> list[tuple[int, int, int]]:
+    """(first byte, end, messages) of every chunk record of an intact recording."""
+    from tafel.core.logfile import LogReader
+
+    data = path.read_bytes()
+    with LogReader(path) as reader:
+        extents = []
+        for number, chunk in enumerate(reader.chunks):
+            length = int.from_bytes(data[chunk.offset + 1:chunk.offset + 9], "little")
+            extents.append((chunk.offset, chunk.offset + 9 + length, len(reader.read_chunk(number) or [])))
+    return extents
+
+
+def _survivors(data: bytes, tmp_path: Path) -> tuple[int, list[str]]:
+    from tafel.core.logfile import LogReader
+
+    damaged = tmp_path / "flipped.mcap"
+    damaged.write_bytes(data)
+    with LogReader(damaged) as reader:
+        return sum(1 for _ in reader.messages()), list(reader.problems)
+
+
+def test_one_flipped_bit_in_the_first_chunk_loses_only_that_chunk(recorded: Path, tmp_path: Path) -> None:
+    extents = _chunk_extents(recorded)
+    total = sum(n for _, _, n in extents)
+    first, _end, hit = extents[0]
+    survived, problems = _survivors(flipped(recorded.read_bytes(), first + 200, 3), tmp_path)
+    assert survived == total - hit  # the channels are in the summary, not only in the first chunk
+    assert any(f"chunk at byte {first} is damaged" in p for p in problems), problems
+
+
+def test_one_flipped_bit_in_a_chunk_length_loses_only_that_chunk(recorded: Path, tmp_path: Path) -> None:
+    extents = _chunk_extents(recorded)
+    total = sum(n for _, _, n in extents)
+    start, _end, hit = extents[len(extents) // 2]
+    data = recorded.read_bytes()
+    for bit in (5, 30, 60):  # shorter, longer, past the end of the file: the summary's index still finds the rest
+        survived, problems = _survivors(flipped(data, start + 1 + bit // 8, bit % 8), tmp_path)
+        assert survived == total - hit, (bit, problems)
+        assert any(f"chunk at byte {start} is damaged" in p for p in problems), problems
+    # without the summary (a cut-off recording), the walk finds the next chunk by its signature
+    cut = data[:extents[-1][1]]
+    intact, _ = _survivors(cut, tmp_path)
+    survived, problems = _survivors(flipped(cut, start + 1 + 30 // 8, 30 % 8), tmp_path)
+    assert survived == intact - hit, problems
+    assert any(f"chunk at byte {start} is damaged" in p and "reading on with the chunk at byte" in p for p in problems), problems
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_a_bit_flipped_anywhere_loses_at_most_the_chunk_it_hits(recorded: Path, tmp_path: Path, seed: int) -> None:
+    extents = _chunk_extents(recorded)
+    total = sum(n for _, _, n in extents)
+    data = recorded.read_bytes()
+    for offset, bit in flip_offsets(len(data), 12, seed):
+        hit = next(((start, n) for start, end, n in extents if start <= offset < end), None)
+        survived, problems = _survivors(flipped(data, offset, bit), tmp_path)
+        assert survived >= total - (hit[1] if hit else 0), (offset, bit, problems)
+        if survived < total:
+            assert hit is not None and any(f"byte {hit[0]}" in p for p in problems), (offset, bit, problems)
+
+
+def test_a_flipped_bit_in_the_magic_or_the_summary_loses_nothing(recorded: Path, tmp_path: Path) -> None:
+    data = recorded.read_bytes()
+    total = sum(n for _, _, n in _chunk_extents(recorded))
+    summary_start = int.from_bytes(data[-8 - 20:-8 - 12], "little")
+    for offset, what in ((2, "magic"), (summary_start + 40, "summary")):
+        survived, problems = _survivors(flipped(data, offset, 1), tmp_path)
+        assert survived == total, (what, problems)
+        assert problems and what in problems[0], problems
+
+
+def test_log_slice_says_it_found_no_message_in_words(tmp_path: Path) -> None:
+    empty = tmp_path / "empty.mcap"
+    LogWriter(empty).close()  # a recording stopped before its first frame
+    result = tafel("log", "slice", str(empty), "--out", str(tmp_path / "piece.mcap"))
+    assert result.returncode == 1
+    assert f"{empty} holds no messages of any channel" in result.stderr, result.stderr
+
+
+def test_log_info_on_an_empty_file_says_it_is_empty(tmp_path: Path) -> None:
+    empty = tmp_path / "x.mcap"
+    empty.touch()
+    result = tafel("log", "info", str(empty))
+    assert result.returncode == 1 and f"{empty} is empty (0 bytes)" in result.stderr, result.stderr
+    assert "not an MCAP log" not in result.stderr
+
+
+@pytest.mark.slow
+def test_a_start_that_fails_leaves_no_recording_behind(tmp_path: Path) -> None:
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        result = tafel("run", "--platform", "dummy", "--frames", "50", "--record", str(tmp_path / "x.mcap"), "--debug-port", str(port))
+    assert result.returncode != 0 and f"127.0.0.1:{port} is taken" in result.stderr, result.stderr
+    assert not (tmp_path / "x.mcap").exists()
+    assert list(tmp_path.iterdir()) == []

@@ -21,6 +21,7 @@ from typing import Any
 from tafel.core.config import store_private
 from tafel.core.dot import contexts_dot
 from tafel.core.errors import TafelError
+from tafel.core.logfile import LogExistsError
 from tafel.core.manager import ModuleManager
 from tafel.core.program import ContextPlan
 from tafel.core.recording import Recorder
@@ -397,8 +398,16 @@ class ProgramDebug:
             raise CommandError("this run cannot record (no representations selected)")
         name = argument(command, "file", required=False) or self.record_default.name
         path = recording_path(self.record_dir, name)
-        self.recorder.start(path)
-        return f"recording to {path}"
+        # A client never replaces a file (the user's --record, an older game): it gets the next free name.
+        for candidate in [path, *(path.with_name(f"{path.stem}-{n}{path.suffix}") for n in range(1, 1000))]:
+            if candidate.exists():
+                continue
+            try:
+                self.recorder.start(candidate, exclusive=True)
+            except LogExistsError:  # created meanwhile
+                continue
+            return f"recording to {candidate}" + (f" ({path.name} exists and is kept)" if candidate != path else "")
+        raise CommandError(f"{path} and {path.stem}-1 to -999{path.suffix} exist; choose another name with -file NAME.mcap")
 
     def _log_stop(self, command: Command) -> str:
         if self.recorder is None or not self.recorder.recording:
