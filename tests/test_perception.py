@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
+from types import SimpleNamespace
 
 import cv2
 import numpy as np
@@ -24,8 +25,9 @@ from tafel.modules.perception.image_geometry import ImageProjection
 from tafel.modules.perception.line_detector import longest_arc, white_runs
 from tafel.platforms.field_world import ball_is_black, ball_texture, paint_ball_texture
 from tafel.representations import field
-from tafel.representations.motion import CameraMatrix
+from tafel.representations.motion import CameraMatrix, CameraMatrixBottom, CameraMatrixBuffer, CameraMatrixTop
 from tafel.representations.perception import (
+    BallImagePercept,
     BallPercept,
     CameraImageBottom,
     CameraImageTop,
@@ -198,6 +200,67 @@ def test_the_boundary_ignores_what_stands_on_the_field() -> None:
     rows = ModuleHarness(FieldBoundaryDetector, board[SegmentedImage], board[FieldColor]).execute()[FieldBoundary].top
     assert len(rows) == 320
     assert np.all(np.abs(rows - 80) <= 4)  # also behind the post
+
+
+def test_green_in_the_hall_does_not_lift_the_boundary() -> None:
+    """A green door or board beyond the carpet, with the hall's floor between (as in HULKs' lab), and a wide
+    white line near the camera: the boundary stays on the carpet's edge."""
+    image = field_image((45, 140, 50), boundary_row=120)
+    image[30:100, 20:70] = (45, 140, 50)  # a green board on the wall, 20 px above the field's edge
+    image[180:215, :] = 255  # a line close to the camera, taller than any gap the scan crosses
+    board = ModuleHarness(FieldColorProvider, CameraImageTop(image=image), CameraImageBottom(image=image)).execute()
+    rows = ModuleHarness(FieldBoundaryDetector, board[SegmentedImage], board[FieldColor]).execute()[FieldBoundary].top
+    assert np.all(np.abs(rows - 120) <= 4)
+
+
+def test_nothing_above_the_horizon_is_field() -> None:
+    """With the camera's pose known, green above the horizon (a green wall) is no field."""
+    image = field_image((45, 140, 50), boundary_row=0)  # green everywhere: the wall is green too
+    matrix = CameraMatrix(np.array([[math.cos(0.2), 0, math.sin(0.2)], [0, 1, 0], [-math.sin(0.2), 0, math.cos(0.2)]]),
+                          np.array([0.0, 0.0, 500.0]), True)
+    fov = (math.radians(56.3), math.radians(43.7))
+    top = CameraImageTop(image=image, horizontal_fov=fov[0], vertical_fov=fov[1])
+    board = ModuleHarness(FieldColorProvider, top, CameraImageBottom(image=image)).execute()
+    buffer = CameraMatrixBuffer.of(CameraMatrixTop(matrix.rotation, matrix.translation, True), CameraMatrixBottom(), 0)
+    rows = ModuleHarness(FieldBoundaryDetector, board[SegmentedImage], board[FieldColor], top, buffer).execute()[FieldBoundary].top
+    horizon = ImageProjection(matrix, 320, 240, *fov).horizon(160.0)
+    assert 40 < horizon < 100  # the camera looks down by 0.2 rad: the horizon is in the upper half
+    assert np.all(rows >= horizon - 0.03 * 240 - 4)
+
+
+@pytest.fixture(scope="module")
+def htwk_images() -> list[tuple[np.ndarray, tuple[float, float, float]]]:
+    """Nao-Team HTWK's real images (tests/data/real_images, with their licence) at 320x240, with the labelled ball."""
+    import csv
+    from pathlib import Path
+
+    folder = Path(__file__).parent / "data" / "real_images"
+    found = []
+    for row in csv.DictReader((folder / "labels.csv").open()):
+        image = cv2.cvtColor(cv2.imread(str(folder / row["image"])), cv2.COLOR_BGR2RGB)
+        found.append((cv2.resize(image, (320, 240), interpolation=cv2.INTER_AREA),
+                      tuple(float(row[k]) / 2 for k in ("ball_x", "ball_y", "ball_r"))))
+    return found
+
+
+@pytest.mark.parametrize("index", [0, 1])
+def test_real_balls_in_a_colour_cast_and_in_shadow_are_found(htwk_images, index: int) -> None:
+    """A real ball among feet and lines, and a far one in the image's dark, teal-cast corner: the carpet's
+    green shows faintly on the ball, and its white is darker than the carpet elsewhere."""
+    image, (x, y, r) = htwk_images[index]
+    fov = (math.radians(56.3), math.radians(43.7))
+    board = None
+    for pitch in (0.2, 0.27, 0.35):  # the pose is not known: the check must hold for a range of head pitches
+        matrix = CameraMatrix(np.array([[math.cos(pitch), 0, math.sin(pitch)], [0, 1, 0], [-math.sin(pitch), 0, math.cos(pitch)]]),
+                              np.array([0.0, 0.0, 503.0]), True)
+        perception = Perception()
+        view = SimpleNamespace(image=image, horizontal_fov=fov[0], vertical_fov=fov[1], matrix=matrix)
+        empty = SimpleNamespace(image=np.zeros((0, 0, 3), np.uint8), horizontal_fov=0.0, vertical_fov=0.0, matrix=CameraMatrix())
+        for _ in range(2):
+            board = perception({"top": view, "bottom": empty})
+        candidates = board[BallImagePercept].candidates
+        assert any(math.hypot(c.x - x, c.y - y) <= r for c in candidates), (pitch, candidates)
+        assert all(math.hypot(c.x - x, c.y - y) <= r for c in candidates), "nothing else is a ball"
 
 
 @given(st.lists(st.tuples(st.floats(0, 300), st.floats(0, 200)), min_size=2, max_size=40, unique_by=lambda p: p[0]))

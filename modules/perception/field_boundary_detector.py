@@ -7,9 +7,12 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from tafel.core import Module, bounded, provides, requires
+from tafel.core import Module, bounded, provides, requires, uses
 from tafel.debug import drawing, request
-from tafel.representations.perception import FieldBoundary, FieldColor, SegmentedImage
+from tafel.modules.perception.field_color_provider import WHITE_SATURATION_MAX
+from tafel.modules.perception.image_geometry import camera_views
+from tafel.representations.motion import CameraMatrixBuffer
+from tafel.representations.perception import CameraImageBottom, CameraImageTop, FieldBoundary, FieldColor, SegmentedImage
 
 DRAW = request("FieldBoundaryDetector:draw", "the field boundary in both images")
 
@@ -31,11 +34,18 @@ def lower_hull(xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 @requires(SegmentedImage, FieldColor)
+@uses(CameraImageTop, CameraImageBottom, CameraMatrixBuffer)
 @provides(FieldBoundary)
 class FieldBoundaryDetector(Module):
-    """The green mask shrunk to cells; in each column of cells, the field starts at the highest cell
-    below which green dominates; the lower convex hull of those points is the boundary, because the
-    field seen from inside is convex, and whatever stands on it only hides parts of its edge."""
+    """The green mask shrunk to cells; each column of cells is followed upwards from its lowest field
+    cell, over gaps (lines, the ball, feet) no longer than ``max_gap``, to where the field ends; the
+    lower convex hull of those points is the boundary, because the field seen from inside is convex,
+    and whatever stands on it only hides parts of its edge.
+
+    Real halls hold green too (doors, boards, cases, a robot's teal-lit parts): such green above the
+    field's edge is cut off from the carpet by the hall's floor, so the scan from below never reaches
+    it, and where the camera's pose is known nothing above the horizon can be field at all. One such
+    point above the edge would otherwise pull the whole hull up."""
 
     @dataclass
     class Parameters:
@@ -44,15 +54,35 @@ class FieldBoundaryDetector(Module):
         window: int = bounded(1, 20, 4)
         """cells below a boundary candidate that must be mostly green"""
         green_share: float = bounded(0.1, 1.0, 0.5)
+        max_gap: float = bounded(0.0, 0.5, 0.05)
+        """the longest stretch of a column without field that the scan upwards crosses (share of the image height)"""
+        outlier_window: float = bounded(0.01, 1.0, 0.2)
+        """share of the columns on either side whose median a column's field edge is compared with ..."""
+        outlier_rise: float = bounded(0.0, 1.0, 0.04)
+        """... and the share of the image height it may rise above that median"""
+        white_value: float = bounded(0.1, 1.0, 0.6)
+        """white (a line the scan crosses): unsaturated and at least this share of the image's brightest value"""
+        horizon_margin: float = bounded(0.0, 0.5, 0.03)
+        """share of the image height above the horizon that may still be field (the camera's pose is not exact)"""
 
     def execute(self) -> None:
         if not self.field_color.valid:
             return
+        horizons = {camera: projection for camera, _, projection in
+                    camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer)}
+        p = self.parameters
         for camera in ("top", "bottom"):
             green = self.segmented_image.green(camera)
             if green.size == 0:
                 continue
-            rows = self.boundary(green)
+            projection = horizons.get(camera)
+            horizon = None
+            if projection is not None and (projection.width, projection.height) == (green.shape[1], green.shape[0]):
+                # the horizon is a straight line in the image: its rows at both edges give every column's
+                horizon = np.linspace(projection.horizon(0.0), projection.horizon(green.shape[1] - 1.0), green.shape[1]).astype(np.float32)
+            hsv = self.segmented_image.hsv(camera)
+            white = (hsv[..., 1] <= WHITE_SATURATION_MAX) & (hsv[..., 2] >= p.white_value * self.segmented_image.white(camera))
+            rows = self.boundary(green, horizon, white)
             setattr(self.field_boundary, camera, rows)
             if DRAW:
                 canvas = drawing(f"image:{camera}")
@@ -60,8 +90,10 @@ class FieldBoundaryDetector(Module):
                 for x in range(0, len(rows) - step, step):
                     canvas.line(x, float(rows[x]), x + step, float(rows[x + step]), color="yellow", width=2)
 
-    def boundary(self, green: np.ndarray) -> np.ndarray:
-        """The boundary's row for every column of one image's green mask."""
+    def boundary(self, green: np.ndarray, horizon: np.ndarray | None = None, white: np.ndarray | None = None) -> np.ndarray:
+        """The boundary's row for every column of one image's green mask; ``horizon``: the horizon's row
+        in every column, where the camera's pose is known; ``white``: the white pixels (lines, which the
+        scan upwards crosses however wide they look)."""
         p = self.parameters
         height, width = green.shape
         cells = cv2.resize(green.astype(np.float32), (max(1, width // p.cell), max(1, height // p.cell)), interpolation=cv2.INTER_AREA)
@@ -71,8 +103,32 @@ class FieldBoundaryDetector(Module):
         cumulative = np.vstack([np.zeros((1, n_cols), np.float32), np.cumsum(padded, axis=0)])
         below = (cumulative[p.window : p.window + n_rows] - cumulative[:n_rows]) / np.minimum(p.window, n_rows - np.arange(n_rows))[:, None]
         field = (below >= p.green_share) & (cells >= p.green_share)  # the cell itself is field, and so is what lies below it
-        found = field.any(axis=0)
-        tops = np.where(found, np.argmax(field, axis=0), n_rows).astype(np.float32) * p.cell
+        if horizon is not None:  # nothing above the horizon is field
+            xs_cells = np.minimum(((np.arange(n_cols) + 0.5) * p.cell).astype(int), width - 1)
+            lowest = (horizon[xs_cells] - p.horizon_margin * height) / p.cell
+            field &= np.arange(n_rows)[:, None] >= lowest[None, :]
+        # from each column's lowest field cell upwards, across gaps of at most max_gap
+        max_gap = int(round(p.max_gap * height / p.cell))
+        started = np.zeros(n_cols, bool)
+        alive = np.ones(n_cols, bool)
+        gap = np.zeros(n_cols, int)
+        top = np.full(n_cols, n_rows)
+        lines = np.zeros_like(field)
+        if white is not None and white.shape == green.shape:
+            lines = cv2.resize(white.astype(np.float32), (n_cols, n_rows), interpolation=cv2.INTER_AREA) >= p.green_share
+        for row in range(n_rows - 1, -1, -1):
+            here = field[row]
+            started |= here
+            gap = np.where(here, 0, np.where(lines[row], gap, gap + 1))
+            alive &= ~started | (gap <= max_gap)
+            top = np.where(alive & here, row, top)
+        found = top < n_rows
+        tops = top.astype(np.float32) * p.cell
+        if found.sum() >= 3:  # outliers: far above the median of the columns around them (green in the hall)
+            reach = max(1, int(p.outlier_window * n_cols))
+            indices = np.nonzero(found)[0]
+            local = np.array([np.median(tops[indices[(indices >= i - reach) & (indices <= i + reach)]]) for i in indices])
+            found[indices[tops[indices] < local - p.outlier_rise * height]] = False
         xs = (np.arange(n_cols) + 0.5) * p.cell
         if not found.any():
             return np.full(width, float(height), np.float32)

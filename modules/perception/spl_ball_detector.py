@@ -46,9 +46,15 @@ class SPLBallDetector(Module):
       is the thickest non-green thing of its size: its peak lies about one ball radius from the
       green, while a line of the same distance is half as thick and a robot far thicker. The size a
       ball would have at each pixel comes from the camera matrix of the image's time.
+      The green that hides a ball is the carpet's full green: a white ball in a colour cast or in
+      shadow can look faintly green, so pixels much less saturated than the carpet count as not green
+      here (``strict_saturation``), or such a ball would be proposed too thin or not at all.
     - Check: a ball is not green inside, is green around most of its edge, has black patches (dark
       pixels among bright ones) and no colour. That tells it from line crossings, penalty marks,
       goal posts (their non-green continues upwards) and robots' feet (no black patches, too large).
+      Real light needs the field as the measure: the ball's black patches are darker than the carpet
+      around it (``black_contrast``); dark image corners, shadows and the hall's dark floor are
+      uniformly dark and have no patches darker than the carpet beside them.
     """
 
     @dataclass
@@ -74,6 +80,12 @@ class SPLBallDetector(Module):
         """share of white pixels right above a spot that makes it the foot of a goal post ..."""
         post_white: float = bounded(0.1, 1.0, 0.55)
         """... white being at least this share of the image's brightest value (posts are shaded)"""
+        strict_saturation: float = bounded(0.0, 1.0, 0.75)
+        """share of the carpet's median saturation a pixel needs to hide a ball candidate as green"""
+        black_contrast: float = bounded(0.1, 1.5, 0.85)
+        """the black patches (mean value) must be darker than this share of the carpet's value around"""
+        dark_spot_min: float = bounded(0.0, 1.0, 0.02)
+        """share of dark pixels a candidate needs round its centre (a square of its thickness)"""
 
     def execute(self) -> None:
         found: list[BallCandidate] = []
@@ -83,7 +95,7 @@ class SPLBallDetector(Module):
         for camera, image, projection in camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer):
             with stopwatch("SPLBallDetector:image"):
                 hsv, green = self.segmented_image.hsv(camera), self.segmented_image.green(camera)
-                spots = self.spots(green, self.field_boundary.rows(camera), projection)
+                spots = self.spots(self.strict_green(hsv, green), self.field_boundary.rows(camera), projection, self.dark_pixels(hsv, green))
                 white = self.segmented_image.white(camera)
                 for spot in spots:
                     score, under_post = self.check(hsv, green, spot, white)
@@ -97,8 +109,57 @@ class SPLBallDetector(Module):
                         found.append(self.candidate(camera, image, spot, score))
         found.sort(key=lambda c: -c.fill)
 
-    def spots(self, green: np.ndarray, boundary: np.ndarray, projection: ImageProjection) -> list[Spot]:
-        """Peaks of the non-green field's distance transform whose thickness fits a ball there."""
+    def dark_pixels(self, hsv: np.ndarray, green: np.ndarray) -> np.ndarray | None:
+        """Pixels darker than ``black_contrast`` times the carpet's median value (the ball's black patches
+        are); None without carpet to compare with."""
+        sampled = hsv[::4, ::4, 2][green[::4, ::4]]
+        if sampled.size < 10:
+            return None
+        return hsv[..., 2] < self.parameters.black_contrast * float(np.median(sampled))
+
+    def strict_green(self, hsv: np.ndarray, green: np.ndarray) -> np.ndarray:
+        """The green mask without the pixels much less saturated than the carpet's median."""
+        if not green.any():
+            return green
+        saturation = hsv[..., 1]
+        sampled = saturation[::4, ::4][green[::4, ::4]]
+        median = float(np.median(sampled)) if sampled.size else float(np.median(saturation[green]))
+        return green & (saturation >= self.parameters.strict_saturation * median)
+
+    @staticmethod
+    def dark_share(dark: np.ndarray, xs: np.ndarray, ys: np.ndarray, radii: np.ndarray) -> np.ndarray:
+        """Share of dark pixels in the square of half side ``radii`` round each (x, y), by an integral image."""
+        height, width = dark.shape
+        integral = cv2.integral(dark.astype(np.uint8))
+        x0, x1 = np.clip((xs - radii).astype(int), 0, width), np.clip((xs + radii).astype(int) + 1, 0, width)
+        y0, y1 = np.clip((ys - radii).astype(int), 0, height), np.clip((ys + radii).astype(int) + 1, 0, height)
+        area = np.maximum((x1 - x0) * (y1 - y0), 1)
+        return (integral[y1, x1] - integral[y0, x1] - integral[y1, x0] + integral[y0, x0]) / area
+
+    @staticmethod
+    def inside_image(spot: Spot, solid: np.ndarray) -> Spot:
+        """A spot at the image's edge moved to where the ball's centre is: the peak of a ball cut by the
+        edge lies on the edge, and the ball's far side is one expected radius from its centre."""
+        height, width = solid.shape
+        x, y, e = int(spot.x), int(spot.y), spot.expected
+        if x < e or x > width - 1 - e:
+            row = solid[min(max(y, 0), height - 1)]
+            step = 1 if x < e else -1
+            far = x
+            while 0 <= far + step < width and row[far + step]:
+                far += step
+            spot.x = float(far - step * e)
+        if y > height - 1 - e:  # a close ball cut by the image's bottom edge (its top is always in view)
+            column = solid[:, min(max(int(spot.x), 0), width - 1)]
+            far = min(y, height - 1)
+            while far - 1 >= 0 and column[far - 1]:
+                far -= 1
+            spot.y = float(far + e)
+        return spot
+
+    def spots(self, green: np.ndarray, boundary: np.ndarray, projection: ImageProjection, dark: np.ndarray | None = None) -> list[Spot]:
+        """Peaks of the non-green field's distance transform whose thickness fits a ball there (and, given
+        ``dark``, the pixels darker than the carpet, with black patches near them)."""
         p = self.parameters
         height, width = green.shape
         known = boundary.size == width
@@ -121,12 +182,15 @@ class SPLBallDetector(Module):
         fits = hits & (radii >= p.size_low * expected) & (radii <= p.size_high * expected + 1.0)
         if known:
             fits &= ys >= boundary[xs]  # the centre lies on the field; only the top may reach over its edge
+        if dark is not None:  # a ball has black patches: spots without dark pixels near their centre are none
+            fits &= self.dark_share(dark, xs, ys, np.maximum(radii, 1.0)) >= p.dark_spot_min
         # the spots most like a ball's size first: lines are thinner, robots and the border thicker
         order = np.argsort(np.abs(np.log(np.maximum(radii[fits], 0.5) / np.maximum(expected[fits], 0.5))))
         chosen: list[Spot] = []
         for x, y, r, e in zip(xs[fits][order], ys[fits][order], radii[fits][order], expected[fits][order]):
             if all((x - s.x) ** 2 + (y - s.y) ** 2 > (s.expected * 1.5) ** 2 for s in chosen):
-                chosen.append(Spot(float(x), float(y), float(max(r, 0.5 * (r + e))), float(e)))
+                spot = Spot(float(x), float(y), float(max(r, 0.5 * (r + e))), float(e))
+                chosen.append(self.inside_image(spot, ~green) if spot.x < e or spot.x > width - 1 - e or spot.y > height - 1 - e else spot)
                 if len(chosen) >= p.max_spots:
                     break
         return chosen
@@ -155,11 +219,15 @@ class SPLBallDetector(Module):
         bright = np.percentile(value, 90)
         dark = float((value < p.dark_ratio * bright).mean())
         saturation = float(patch[..., 1][inside].mean())
+        carpet = patch[..., 2][around & patch_green]
+        field_value = float(np.median(carpet if carpet.size >= 3 else patch[..., 2][around]))
+        black = value[value < p.dark_ratio * bright]
+        darkest = float(black.mean()) if black.size else math.inf  # the black patches' value
         first, posts = self.post_columns(hsv, green, spot, white)
         if not beside_post and 0 <= int(spot.x) - first < len(posts) and posts[int(spot.x) - first]:
             return 0.0, True
         if (green_inside > p.green_inside_max or green_around < p.green_around_min or not p.dark_share_min <= dark <= p.dark_share_max
-                or saturation > p.saturation_max):
+                or saturation > p.saturation_max or darkest > p.black_contrast * field_value):
             return 0.0, False
         return float(min(1.0, 0.5 + dark + 0.3 * green_around - green_inside)), False
 
