@@ -6,7 +6,8 @@ one benchmark run: in the concurrent runtime (one process per context, motion as
 and as two threads of this process (the naive baseline, same SCHED_FIFO request for its motion thread).
 Motion period error is the lateness of each frame's start against its absolute deadline. As a floor,
 the same run also times a bare 100 Hz sleep loop with nothing else running: no runtime can beat what
-the machine gives an idle loop. Prints one JSON line.
+the machine gives an idle loop. A third variant keeps the black box on (every representation of both
+contexts, as on the robot) to show what it costs motion. Prints one JSON line.
 """
 
 from __future__ import annotations
@@ -14,11 +15,15 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import tempfile
 import threading
+from pathlib import Path
 
+from tafel.core.blackbox import BlackBox
 from tafel.core.config import load_config
 from tafel.core.handover import LocalChannel
 from tafel.core.program import plan_program
+from tafel.core.recording import select
 from tafel.core.runtime import ConcurrentRuntime, ContextRunner, Limits, StopFlag, cognition_watcher, run_context_loop, try_realtime
 from tafel.platforms.dummy import DummyPlatform
 from tafel.tools.cli import DEFAULT_CONFIG, discover_modules
@@ -47,10 +52,20 @@ def summarize(stats) -> dict:
     }
 
 
-def run_concurrent(frames: int, load_ms: float) -> tuple[dict, dict, str]:
-    runtime = ConcurrentRuntime(plans(load_ms), DummyPlatform, {})
+def run_concurrent(frames: int, load_ms: float, blackbox: bool = False) -> tuple[dict, dict, str]:
+    """The concurrent runtime; with ``blackbox``, every representation of both contexts also goes into a
+    black box (as on the robot), to measure what keeping it costs motion."""
+    program = plans(load_ms)
+    box = BlackBox(Path(tempfile.mkdtemp()), seconds=20.0) if blackbox else None
+    record = {}
+    for selection in select(program, ["all"]) if blackbox else []:
+        record.setdefault(selection.context, []).append(selection)
+    runtime = ConcurrentRuntime(program, DummyPlatform, {}, blackbox=box, blackbox_record=record)
     stats = runtime.run(Limits(frames=frames, speed=1.0))
-    return summarize(stats["motion"]), {"cognition_rate_hz": round(stats["cognition"].rate_hz, 2)}, stats["motion"].realtime
+    extra = {"cognition_rate_hz": round(stats["cognition"].rate_hz, 2)}
+    if box is not None:
+        extra.update(blackbox_mb=round(box.bytes / 1e6, 2), blackbox_messages=len(box.ring))
+    return summarize(stats["motion"]), extra, stats["motion"].realtime
 
 
 def run_threads(frames: int, load_ms: float) -> tuple[dict, dict]:
@@ -118,12 +133,14 @@ def main() -> None:
     args = parser.parse_args()
     frames = int(args.seconds * 100)
     concurrent, concurrent_cognition, realtime = run_concurrent(frames, args.load_ms)
+    with_box, with_box_cognition, _ = run_concurrent(frames, args.load_ms, blackbox=True)
     threads, threads_cognition = run_threads(frames, args.load_ms)
     floor = run_bare_floor(frames)
     print(json.dumps({
         "seconds": args.seconds,
         "cognition_load_ms_per_frame": args.load_ms,
         "runtime": {**concurrent, **concurrent_cognition},
+        "runtime_with_blackbox": {**with_box, **with_box_cognition},
         "threads_baseline": {**threads, **threads_cognition},
         "bare_sleep_loop_floor": floor,
         "realtime": realtime,

@@ -144,7 +144,7 @@ SECTIONS: dict[str, str] = {
     "runtime": "rates and timeouts", "cognition": "cognition's modules", "motion": "motion's modules",
     "parameters": "module parameters by module name", "game": "team, player number and network",
     "status": "the status line", "recording": "what --record records", "foxglove": "Foxglove's channels",
-    "debug": "the debug server's aliases",
+    "debug": "the debug server's aliases", "blackbox": "the black-box recorder",
 }
 
 

@@ -453,6 +453,9 @@ class WorkerSpec:
     module_paths: tuple[str, ...] = ()
     #: s a module may run without returning before the context ends (0: no watchdog)
     stuck_timeout_s: float = STUCK_TIMEOUT_S
+    #: what the black box keeps of this context (every representation), and where it goes
+    blackbox_record: list[Any] = field(default_factory=list)
+    blackbox_queue: Any = None
 
 
 def try_realtime(priority: int) -> str:
@@ -654,6 +657,10 @@ def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
             recorder.attach(sink)
             recorder.gate = spec.record_switch.is_set
             runner.after_step.append(recorder_hook(recorder))
+        if spec.blackbox_record and spec.blackbox_queue is not None:
+            box = Recorder(spec.blackbox_record)
+            box.attach(QueueSink(spec.blackbox_queue))
+            runner.after_step.append(recorder_hook(box))
         if spec.setup is not None:
             function, arguments = spec.setup
             function(runner, arguments)
@@ -700,8 +707,12 @@ class ConcurrentRuntime:
                  platform_options: Mapping[str, Any], *, strict: bool = False, stall_timeout_s: float = 1.0,
                  recorder: Recorder | None = None,
                  worker_setup: tuple[Callable[[ContextRunner, Any], None], Any] | None = None,
-                 grace_s: float = SHUTDOWN_GRACE_S, stuck_timeout_s: float = STUCK_TIMEOUT_S) -> None:
+                 grace_s: float = SHUTDOWN_GRACE_S, stuck_timeout_s: float = STUCK_TIMEOUT_S,
+                 blackbox: Any = None, blackbox_record: Mapping[str, list[Any]] | None = None) -> None:
         self.recorder = recorder
+        #: a sink (``core.blackbox.BlackBox``) that every context's representations reach, always
+        self.blackbox = blackbox
+        self.blackbox_record = dict(blackbox_record or {})
         self.stuck_timeout_s = stuck_timeout_s
         #: s the context processes get to stop once asked; then their stacks are dumped and they are ended
         self.grace_s = grace_s
@@ -742,6 +753,10 @@ class ConcurrentRuntime:
         drain = threading.Thread(target=self._drain, args=(record_queue,), daemon=True) if record_queue else None
         if drain:
             drain.start()
+        box_queue = self._mp.Queue(maxsize=8192) if self.blackbox is not None else None
+        if box_queue is not None:
+            threading.Thread(target=self._drain_into, args=(box_queue, self.blackbox), name="tafel-blackbox-drain",
+                             daemon=True).start()
         try:
             for name, plan in self.plans.items():
                 other = "motion" if name == "cognition" else "cognition"
@@ -754,6 +769,7 @@ class ConcurrentRuntime:
                     record=self.recorder.by_context.get(name, []) if self.recorder else [], record_queue=record_queue,
                     record_switch=self.record_switch, setup=self.worker_setup, clock_origin_ns=clock.origin_ns(),
                     imports=tuple(defining_modules()), module_paths=tuple(loaded_folders()), stuck_timeout_s=self.stuck_timeout_s,
+                    blackbox_record=self.blackbox_record.get(name, []), blackbox_queue=box_queue,
                 )
                 receiver, sender = self._mp.Pipe(duplex=False)
                 process = self._mp.Process(target=_worker_main, args=(spec, self.stop, sender), name=f"tafel-{name}", daemon=True)
@@ -771,10 +787,25 @@ class ConcurrentRuntime:
             if drain is not None and record_queue is not None:
                 record_queue.put(None)
                 drain.join(timeout=30)
+            if box_queue is not None:
+                box_queue.cancel_join_thread()
+                box_queue.put(None)
             if self.recorder is not None:
                 self.recorder.forward_dropped += sum(s.record_dropped for s in self.stats.values())
                 self.recorder.stop()
         return self.stats
+
+    @staticmethod
+    def _drain_into(source: Any, sink: Any) -> None:
+        """Supervisor thread: what the context processes sent the black box, into it."""
+        while True:
+            try:
+                item = source.get()
+            except (EOFError, OSError, ValueError):
+                return
+            if item is None:
+                return
+            sink.write(*item)
 
     def _drain(self, record_queue: Any) -> None:
         """Supervisor thread: write what the context processes recorded into the one log file."""

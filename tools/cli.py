@@ -19,6 +19,8 @@ from importlib.metadata import version
 from pathlib import Path
 from typing import Any, NoReturn
 
+from tafel.core import clock
+from tafel.core.blackbox import MAX_MB, SECONDS, BlackBox, conditions_from_config
 from tafel.core.config import check_config, edit_modules, load_config
 from tafel.core.dot import contexts_dot
 from tafel.core.errors import TafelError
@@ -34,6 +36,7 @@ from tafel.core.runtime import (
     LockstepRuntime,
     install_signal_handlers,
     program_fingerprint,
+    recorder_hook,
 )
 from tafel.core.watchdog import STUCK_TIMEOUT_S
 from tafel.debug.commands import frame_number
@@ -528,7 +531,15 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
     # 1 ms instead of the default 5 ms, so a busy server delays a frame by a millisecond at the most.
     sys.setswitchinterval(0.001)
     runtime = LockstepRuntime(plans, platform, strict=args.strict, recorder=recorder, stuck_timeout_s=stuck_timeout(config))
+    box = make_blackbox(args, plans, config, platform)
+    if box is not None:
+        for runner in runtime.runners.values():
+            runner.after_step.append(recorder_hook(box[1]))
+        trigger = blackbox_triggers(box[0])
+        runtime.after_tick.append(lambda rt: trigger(rt.time_ns, {n: r.stats(0.0) for n, r in rt.runners.items()}
+                                                     if rt.ticks % 10 == 0 else None))
     debug = start_debug(args, recorder, plans, config)
+    add_blackbox_commands(debug, box)
     if debug is not None:
         recorded = debug_recorded(recorder, [] if args.no_web else list(plans))
         for name, runner in runtime.runners.items():
@@ -579,6 +590,8 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
     print_summary(type(platform).name, "lockstep", stats, runtime.wall_s, runtime.time_ns * 1e-9, stop_reason(signals, runtime.end_reason),
                   simulated=True)
     report_recording(recorder)
+    if box is not None:
+        print(box[0].status(), flush=True)
     return 1 if any(s.failure for s in stats.values()) else 0
 
 
@@ -602,9 +615,15 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
     web_flags, web_feed = concurrent_feed(debug is not None and not args.no_web, web_topics(web_representations(plans)), setups)
     setup = (worker_setups, setups) if setups else None
     stall = float(config.get("runtime", {}).get("stall_timeout_s", 1.0))
+    box = make_blackbox(args, plans, config, platform)
+    add_blackbox_commands(debug, box)
     runtime = ConcurrentRuntime(plans, platform_class, options, strict=args.strict, stall_timeout_s=stall,
                                 recorder=recorder, worker_setup=setup, grace_s=shutdown_grace(config),
-                                stuck_timeout_s=stuck_timeout(config))
+                                stuck_timeout_s=stuck_timeout(config), blackbox=box[0] if box else None,
+                                blackbox_record=box[1].by_context if box else None)
+    if box is not None:
+        trigger = blackbox_triggers(box[0])
+        runtime.on_report.append(lambda rt: trigger(clock.now_ns(), rt.stats))
     started = time.monotonic()
     last = [started]
     line = StatusLine(platform_class.name, config)
@@ -646,6 +665,8 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
     print_summary(platform_class.name, "concurrent", stats, time.monotonic() - started, ran, stop_reason(signals, ""), simulated=False,
                   notes=notes)
     report_recording(recorder)
+    if box is not None:
+        print(box[0].status(), flush=True)
     return 1 if any(s.failure for s in stats.values()) else 0
 
 
@@ -679,6 +700,65 @@ def make_recorder(args: argparse.Namespace, plans: dict[str, ContextPlan], confi
     if args.record is not None:
         recorder.start(args.record)
     return recorder
+
+
+def blackbox_triggers(box: BlackBox) -> Callable[[int, Mapping[str, ContextStats] | None], None]:
+    """What the runtime sees that the stream does not say: module exceptions, missed frames, a stalled
+    cognition (from the contexts' statistics; None: nothing new to look at)."""
+    seen: dict[tuple[str, str], int] = {}
+
+    def check(time_ns: int, stats: Mapping[str, ContextStats] | None) -> None:
+        if stats is None:
+            return
+        for name, s in stats.items():
+            for module, count in s.errors_by_module.items():
+                if count > seen.get((name, module), 0):
+                    box.note(f"module exception in {module}", time_ns)
+                seen[(name, module)] = count
+            for what, count in (("missed frames", s.missed_periods), ("frames without cognition", s.frames_without_cognition)):
+                if count > seen.get((name, what), 0) + 9:  # a few late frames (a start, a busy moment) are no event
+                    box.note(f"{name} {what}", time_ns)
+                    seen[(name, what)] = count
+
+    return check
+
+
+def add_blackbox_commands(debug: ProgramDebug | None, box: tuple[BlackBox, Recorder] | None) -> None:
+    if debug is None or box is None:
+        return
+    blackbox = box[0]
+
+    def save(_command: Any) -> str:
+        path = blackbox.save("blackbox:save")
+        return f"saving the last {blackbox.seconds:g} s to {path}" if path else "not saved: a save happened less than 10 s ago"
+
+    debug.router.register("blackbox:save", "write the black box's last seconds to a log file now", "blackbox:save", save)
+    debug.router.register("blackbox:status", "what the black box holds and what it saved", "blackbox:status",
+                          lambda _command: blackbox.status())
+
+
+def make_blackbox(args: argparse.Namespace, plans: dict[str, ContextPlan], config: dict[str, Any],
+                  platform: Platform) -> tuple[BlackBox, Recorder] | None:
+    """The black-box recorder (``[blackbox]``, on by default) and the recorder that feeds it everything."""
+    table = config.get("blackbox", {})
+    known = {"enabled", "seconds", "max_mb", "image_period_s", "triggers"}
+    unknown = sorted(set(table) - known)
+    if unknown:
+        fail(f"[blackbox] {unknown[0]} is not a setting; [blackbox] takes {', '.join(sorted(known))}")
+    if not table.get("enabled", True):
+        return None
+    numbers = {key: table.get(key, default) for key, default in (("seconds", SECONDS), ("max_mb", MAX_MB), ("image_period_s", 0.5))}
+    for key, value in numbers.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value <= 1e6:
+            fail(f"blackbox.{key} takes a positive number, got {value!r}")
+    feeder = program_recorder(plans, config, platform, ["all"], blocking=False)
+    feeder.translate_factory = None
+    box = BlackBox(args.record_dir, seconds=float(numbers["seconds"]), max_bytes=int(numbers["max_mb"] * 1e6),
+                   heavy_period_s=float(numbers["image_period_s"]), metadata=feeder.metadata,
+                   conditions=conditions_from_config(table.get("triggers")))
+    box.on_save.append(lambda trigger, path: status_print(f"black box saved ({trigger}): {path}"))
+    feeder.attach(box)
+    return box, feeder
 
 
 def program_recorder(plans: dict[str, ContextPlan], config: dict[str, Any], platform: Platform, names: list[str] | None = None,
