@@ -1,6 +1,10 @@
 """The web view's cost: the default simulation (MuJoCo, both cameras, speed 1) without a page, then with
 three browser tabs open on every view (headless Chromium).
 
+Also: how soon a page learns every plot name the program has (``plot:get``), the way the page does it
+(the program's ``PlotNames``, sent when a name is new) and the way it did before (``DebugPlots`` sampled
+twice a second across both contexts), each from a fresh WebSocket, 60 s at most.
+
 Reported, for each phase, from the program's own status line (one a second): the loop rates and the
 frames lost (frames the loops should have run at their rates in the phase's wall time but did not).
 With the tabs: the images each tab received per second and camera, what the page's feed dropped for
@@ -27,7 +31,9 @@ import re
 import statistics
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
@@ -101,6 +107,28 @@ def phase(program: WebProgram, seconds: float) -> dict[str, float]:
     return result
 
 
+def name_discovery(program: WebProgram, line: str, names_of: Callable[[dict[str, Any]], list[str]], limit: float = 60.0) -> float | None:
+    """Seconds from subscribing with ``line`` until every plot name ``plot:get`` lists has come; None: not within ``limit``."""
+    from websockets.sync.client import connect
+
+    wanted = {row.split(" (")[0] for row in program.ask("plot:get").splitlines() if row.strip()}
+    url = program.url.replace("http://", "ws://") + "ws"
+    seen: set[str] = set()
+    with connect(url, max_size=None) as socket:
+        started = time.monotonic()
+        socket.send(line)
+        while time.monotonic() - started < limit:
+            try:
+                message = socket.recv(timeout=1.0)
+            except TimeoutError:
+                continue
+            if isinstance(message, str) and "topic" in (parsed := json.loads(message)):
+                seen.update(names_of(parsed))
+                if wanted <= seen:
+                    return round(time.monotonic() - started, 2)
+    return None
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--seconds", type=float, default=10.0, help="length of each phase")
@@ -141,8 +169,11 @@ def main() -> None:
             with_tabs = phase(program, args.seconds)
             after = [page.evaluate(counts) for page in pages]
             served_after = json.loads(program.ask("web:status"))
-            problems = [page.evaluate("document.querySelectorAll('.error').length") for page in pages]
+            problems = [page.evaluate("[...document.querySelectorAll('.error')].map((e) => e.textContent.trim().slice(0, 120))")
+                        for page in pages]
             browser.close()
+        names_now = name_discovery(program, "subscribe PlotNames", lambda m: m["value"]["names"])
+        names_before = name_discovery(program, "subscribe DebugPlots -hz 2", lambda m: m["value"]["names"])
         per_tab = [{"top_per_s": round((a[0] - b[0]) / ((a[2] - b[2]) / 1000), 1),
                     "bottom_per_s": round((a[1] - b[1]) / ((a[2] - b[2]) / 1000), 1)} for a, b in zip(after, before)]
     finally:
@@ -154,7 +185,9 @@ def main() -> None:
         "images_per_tab": per_tab,
         "feed": {key: served_after[key] - served_before[key] for key in ("encoded", "sent", "dropped", "skipped", "handed_over_dropped")},
         "server_cpu_share": with_tabs["web_threads_cpu_share"],
-        "pages_showing_errors": sum(problems),
+        "pages_showing_errors": sum(1 for shown in problems if shown),
+        "errors_shown": sorted({text for shown in problems for text in shown})[:5],
+        "plot_names_s": {"pushed_when_new": names_now, "before_sampled_at_2_hz": names_before},
         "targets": {"cognition_hz": 30.0, "motion_hz": 100.0, "frames_lost": 0, "images_per_tab_and_camera_per_s": 15.0},
     }))
 

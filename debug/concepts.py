@@ -182,6 +182,7 @@ def modify(name: str, value: Any) -> Any:
     found = STATE.modifies.get(name)
     if found is None:
         found = STATE.modifies[name] = Modify(name, context=STATE.context)
+    found.context = STATE.context or found.context  # first used outside a frame (a test): the context it runs in
     found.value = value
     return found.pinned_value if found.pinned else value
 

@@ -307,3 +307,61 @@ def test_the_feed_hands_over_only_what_is_needed_and_drops_when_full() -> None:
     first = feed.queue.get_nowait()
     assert type(first.value) is BallModel and first.frame == 0 and first.value is not manager.blackboard[BallModel]
     assert feed.dropped == 2
+
+
+def test_a_need_limited_to_one_context_hands_over_only_from_it() -> None:
+    manager = ModuleManager([KalmanBallModeler], external=[BallPercept, FrameInfo])
+    manager.execute()
+    flags = [0, 0]
+    feed = LiveFeed([BallModel, BallPercept], flags=flags)
+    feed.need([BallModel, BallPercept], only={BallModel: ["cognition"]})
+    feed.after_frame("motion", manager.blackboard, 0, 1)
+    feed.after_frame("cognition", manager.blackboard, 0, 1)
+    handed = [(item.context, type(item.value).__name__) for item in [feed.queue.get_nowait() for _ in range(feed.queue.qsize())]]
+    assert handed == [("motion", "BallPercept"), ("cognition", "BallModel"), ("cognition", "BallPercept")]
+    assert flags == [1, 0x7F]  # what a context process reads: BallModel from cognition only, BallPercept from every context
+
+
+# ------------------------------------------------------------------------------------ the web view
+def receive_streamed(socket: Any, count: int) -> list[Any]:
+    """The next ``count`` streamed messages (answers skipped): binary images as their JSON header."""
+    got: list[Any] = []
+    while len(got) < count:
+        message = socket.recv(timeout=5)
+        if isinstance(message, bytes):
+            length = int.from_bytes(message[:4], "big")
+            got.append(json.loads(message[4:4 + length]))
+        elif "answer" not in (parsed := json.loads(message)):
+            got.append(parsed)
+    return got
+
+
+def test_an_image_carries_the_drawings_of_its_own_frame_and_plot_names_come_when_new(served: Served) -> None:
+    from tafel.debug.concepts import DebugDrawingPrimitive, DebugDrawings, DebugPlots
+    from tafel.tools.live_feed import Handed
+    from tafel.tools.web.view import WebView
+
+    view = WebView(served.server, [CameraImageTop, BallModel], port=0)
+    view.start()
+    try:
+        with connect(f"ws://127.0.0.1:{view.server.port}/ws") as socket:
+            assert ask(socket, "subscribe CameraImageTop PlotNames").startswith("subscribed")
+            circle = lambda frame: DebugDrawingPrimitive("image:top", "circle", [frame, 10.0, 5.0], "orange")  # noqa: E731
+            field_line = DebugDrawingPrimitive("field", "line", [0.0, 0.0, 1.0, 1.0])
+            for frame in (5, 6):  # as a loop hands them over: the frame's image first, its drawings after it
+                view.feed.take(Handed("cognition", CameraImageTop(), frame * 1000, 0, frame))
+                view.feed.take(Handed("motion", DebugDrawings([]), frame * 1000, 0, 40 + frame))  # the other context's
+                view.feed.take(Handed("cognition", DebugDrawings([circle(frame), field_line]), frame * 1000, 0, frame))
+            view.feed.take(Handed("cognition", CameraImageTop(), 7000, 0, 7))  # its frame's drawings never come
+            view.feed.take(Handed("cognition", DebugPlots(["a"], [1.0]), 7000, 0, 7))
+            view.feed.take(Handed("motion", DebugPlots(["b"], [2.0]), 7000, 0, 80))
+            images, names = [], []
+            while len(images) < 3 or not names or names[-1] != ["a", "b"]:
+                for message in receive_streamed(socket, 1):
+                    (images if message["topic"] == "CameraImageTop" else names).append(
+                        message if message["topic"] == "CameraImageTop" else message["value"]["names"])
+            assert [(m["frame"], m["drawings_frame"], [d["points"][0] for d in m["drawings"]]) for m in images] == \
+                [(5, 5, [5.0]), (6, 6, [6.0]), (7, None, [])]  # each image its own frame's image drawings, only those
+            assert names[0] == ["a"] and names[-1] == ["a", "b"]
+    finally:
+        view.stop()

@@ -21,22 +21,11 @@ import pytest
 from tafel.core.logfile import read_log
 from tafel.core.serialization import deserialize
 from tafel.representations.modeling import RobotPose
-from tests.support.browser import WebProgram, launch, missing_browser
+from tests.support.browser import WebProgram, launch, missing_browser, open_page, wait_for
 
 pytestmark = [pytest.mark.slow, pytest.mark.skipif(missing_browser() is not None, reason=str(missing_browser()))]
 VIEWS = ("field", "images", "status", "remote", "plots", "stopwatches", "modules", "representations", "requests", "modify",
          "parameters")
-
-
-def wait_for(page: Any, expression: str, timeout: float = 20.0) -> Any:
-    """Poll a JavaScript expression of the page until it is truthy; its value."""
-    deadline = time.monotonic() + timeout
-    while True:
-        value = page.evaluate(expression)
-        if value:
-            return value
-        assert time.monotonic() < deadline, f"the page never made {expression} true"
-        time.sleep(0.1)
 
 
 def screenshot_dir(tmp_path_factory: Any) -> Path:
@@ -65,20 +54,13 @@ def program(tmp_path_factory: Any) -> Iterator[WebProgram]:
 @pytest.fixture(scope="module")
 def page(playwright: Any, program: WebProgram) -> Iterator[Any]:
     browser = launch(playwright)
-    context = browser.new_context(viewport={"width": 1600, "height": 1700})
-    view = context.new_page()
-    view.problems = []  # console errors and uncaught exceptions, for the whole session
-    view.on("console", lambda m: view.problems.append(f"console {m.type}: {m.text}") if m.type == "error" else None)
-    view.on("pageerror", lambda e: view.problems.append(f"page error: {e}"))
-    view.goto(program.url)
-    wait_for(view, "window.tafel && tafel.state.ready")
-    yield view
+    yield open_page(browser, program.url)  # its problems: console errors and uncaught exceptions, for the whole session
     browser.close()
 
 
 def test_the_page_loads_without_errors_and_shows_every_view(page: Any, program: WebProgram, tmp_path_factory: Any) -> None:
     wait_for(page, "tafel.state.robot && tafel.state.images.top.drawn > 5 && tafel.state.stopwatches && tafel.state.modules.graphs.cognition")
-    page.evaluate("tafel.state.plots.add('rep:RobotPose', 'x')")
+    page.evaluate("tafel.state.plots.add('rep:RobotPose', 'x'); tafel.state.plots.add('rep:RobotPose', 'rotation')")
     page.select_option("[data-view=representations] select", "BallModel")
     wait_for(page, "tafel.state.inspected && tafel.state.inspected.topic === 'BallModel'")
     time.sleep(1.5)  # a second and a half of plot
@@ -158,6 +140,21 @@ def test_switching_the_ball_model_provider_in_the_modules_view(page: Any, progra
         time.sleep(0.2)
 
 
+def test_the_modify_panel_pins_a_value_of_the_walk(page: Any, program: WebProgram) -> None:
+    field = page.locator("[data-modify='WalkingEngine:foot_lift']")
+    field.wait_for()
+    row = page.locator("[data-view=modify] tr", has=field)
+    field.fill("30")
+    row.locator("button:has-text('pin')").click()
+    wait_for(page, "document.querySelector('[data-view=modify] .ok')?.textContent.includes('pinned to 30')")
+    assert "WalkingEngine:foot_lift = 22  (pinned to 30" in program.ask("modify:list -context motion")
+    row.locator("button:has-text('release')").click()
+    deadline = time.monotonic() + 10
+    while "pinned" in program.ask("modify:list -context motion"):
+        assert time.monotonic() < deadline
+        time.sleep(0.2)
+
+
 def test_the_image_view_updates_at_least_ten_times_a_second(page: Any) -> None:
     before = page.evaluate("[tafel.state.images.top.drawn, tafel.state.images.bottom.drawn, performance.now()]")
     time.sleep(3.0)
@@ -176,6 +173,115 @@ def test_the_motion_remote_control_walks_the_robot(page: Any, program: WebProgra
     page.locator("[data-view=remote] button:has-text('release')").click()
     wait_for(page, "document.querySelector('[data-view=remote] .ok')?.textContent.includes('released')")
     assert page.problems == []
+
+
+def test_every_plot_has_its_own_labelled_axis_and_a_read_out_under_the_mouse(page: Any) -> None:
+    # the charts the page makes, as uPlot instances (the page calls the global uPlot by name)
+    page.evaluate("""() => { if (window.charts) return; const U = window.uPlot; window.charts = [];
+      window.uPlot = Object.assign(function (...a) { const u = new U(...a); charts.push(u); return u; }, U); }""")
+    page.evaluate("""() => { const shown = tafel.state.plots.series.map((s) => s.label);
+      for (const path of ['x', 'rotation', 'y']) if (!shown.includes(`RobotPose.${path}`)) tafel.state.plots.add('rep:RobotPose', path); }""")
+    wait_for(page, "charts.length && charts.at(-1).data[0].length > 20")
+    chart = "charts.at(-1)"
+    count = page.evaluate(f"{chart}.series.length - 1")
+    assert count >= 3  # RobotPose.x and y (thousands, negative too), rotation (about ±3)
+    axes = page.evaluate(f"""{chart}.axes.slice(1).map((a) => ({{scale: a.scale, label: a.label, size: a._size,
+      ticks: a._values, widest: Math.max(...(a._values || []).map((t) => {chart}.ctx.measureText(String(t)).width))}}))""")
+    scales = page.evaluate(f"{chart}.series.slice(1).map((s) => s.scale)")
+    labels = page.evaluate(f"{chart}.series.slice(1).map((s) => s.label)")
+    assert len(set(scales)) == count, scales  # a scale of its own for each series, so none is flattened
+    for scale, label in zip(scales, labels):
+        axis = next(a for a in axes if a["scale"] == scale)
+        assert axis["label"] and label.split(".")[-1] in axis["label"], (label, axis)
+        assert axis["ticks"] and len(set(axis["ticks"])) >= 2, axis  # labelled ticks, not a lone "0"
+        assert axis["widest"] <= axis["size"], axis  # negative labels fit their axis
+    box = page.locator("[data-view=plots] .u-over").bounding_box()
+    page.mouse.move(box["x"] + box["width"] * 0.7, box["y"] + box["height"] / 2)
+    readout = wait_for(page, """(() => { const values = [...document.querySelectorAll('[data-view=plots] .u-legend .u-series')]
+      .slice(1).map((row) => row.querySelector('.u-value')?.textContent); return values.length && values.every((v) => /\d/.test(v)) && values; })()""")
+    assert len(readout) == count
+    legend = page.locator("[data-view=plots] .u-legend").bounding_box()
+    panel = page.locator("[data-view=plots] .panel-body").bounding_box()
+    assert legend["y"] + legend["height"] <= panel["y"] + panel["height"] + 1  # the read-out is inside the panel
+    page.mouse.move(0, 0)
+
+
+def test_the_module_graph_shows_both_contexts_with_arrows_and_fits_and_zooms(page: Any, tmp_path_factory: Any) -> None:
+    graph = "[data-view=modules] svg.graph"
+    page.locator(graph).wait_for()
+    lanes = page.evaluate(f"[...document.querySelectorAll('{graph} g.lane')].map((g) => g.dataset.context)")
+    assert lanes == ["cognition", "motion"]
+    edges = page.evaluate(f"[...document.querySelectorAll('{graph} path.edge')].map((p) => p.getAttribute('marker-end'))")
+    assert edges and all(edges), "every edge ends in an arrowhead"
+    # readable as it opens: module names at least 10 px high on the screen
+    heights = page.evaluate(f"[...document.querySelectorAll('{graph} g.module text.name')].map((t) => t.getBoundingClientRect().height)")
+    assert heights and min(heights) >= 10, heights
+    # fitted: every module and representation lies inside the visible picture
+    page.locator("[data-view=modules] button:has-text('fit')").click()
+    inside = f"""(() => {{ const view = document.querySelector('{graph}').getBoundingClientRect();
+      return [...document.querySelectorAll('{graph} g.node')].every((n) => {{ const b = n.getBoundingClientRect();
+        return b.top >= view.top - 1 && b.bottom <= view.bottom + 1 && b.left >= view.left - 1 && b.right <= view.right + 1; }}); }})()"""
+    assert wait_for(page, inside, timeout=5)
+    # zoom with the wheel, pan by dragging
+    first = page.evaluate(f"document.querySelector('{graph} g.node').getBoundingClientRect().width")
+    box = page.locator(graph).bounding_box()
+    page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    page.mouse.wheel(0, -400)
+    zoomed = wait_for(page, f"(() => {{ const w = document.querySelector('{graph} g.node').getBoundingClientRect().width; return w > {first} * 1.2 && w; }})()")
+    before = page.evaluate(f"document.querySelector('{graph} g.node').getBoundingClientRect().left")
+    page.mouse.down()
+    page.mouse.move(box["x"] + box["width"] / 2 + 120, box["y"] + box["height"] / 2 + 10, steps=5)
+    page.mouse.up()
+    after = page.evaluate(f"document.querySelector('{graph} g.node').getBoundingClientRect().left")
+    assert after - before == pytest.approx(120, abs=3), (before, after, zoomed)
+    page.locator("[data-view=modules] button:has-text('fit')").click()
+
+
+def test_an_invalid_ball_model_is_no_disc_on_the_field(page: Any) -> None:
+    orange = """(() => { const c = document.querySelector('[data-view=field] canvas');
+      const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; let n = 0;
+      for (let i = 0; i < d.length; i += 4) if (d[i] > 200 && d[i + 1] > 100 && d[i + 1] < 170 && d[i + 2] < 60) n++; return n; })()"""
+    # the page as it shows a ball model 6 m uncertain one metre ahead of the robot, then the same model
+    # once it lost the ball (the program's own ball models held back meanwhile): nothing of the first
+    # may stay, on the carpet or beside it
+    page.evaluate("""() => { const c = tafel.connection; c.realDispatch = c.dispatch;
+      c.dispatch = (topic, m) => (topic === 'BallModel' && !m.injected ? undefined : c.realDispatch(topic, m)); }""")
+    try:
+        for valid in (True, False):
+            drawn = page.evaluate("tafel.state.fieldDrawn")
+            page.evaluate("""(valid) => tafel.connection.dispatch('BallModel', {topic: 'BallModel', context: 'cognition', frame: 1,
+              time_ns: 0, injected: true, value: {valid, seen: false, x: 1000, y: 0, vx: 0, vy: 0, position_std: 6000,
+              time_since_seen: valid ? 2 : 4}})""", valid)
+            wait_for(page, f"tafel.state.fieldDrawn >= {drawn + 2}")  # drawn since
+            pixels = page.evaluate(orange)
+            assert (pixels >= 10) if valid else (pixels == 0), (valid, pixels)  # the ball itself, or nothing orange
+    finally:
+        page.evaluate("() => { tafel.connection.dispatch = tafel.connection.realDispatch; }")
+
+
+def test_the_status_panel_shows_game_state_score_and_pose(page: Any, program: WebProgram) -> None:
+    status = "[data-view=status] .panel-body"
+    text = wait_for(page, f"(() => {{ const t = document.querySelector('{status}').innerText; return /score/.test(t) && t; }})()")
+    state = re.search(r'"state": "(\w+)"', program.ask("representation:print -name GameState -format json").replace('":"', '": "'))
+    assert state and state.group(1) in text, text
+    assert re.search(r"score \d+ : \d+", text), text
+    assert re.search(r"pose x=-?\d+ y=-?\d+ mm", text), text
+
+
+def test_the_header_never_covers_a_panel_title(page: Any) -> None:
+    page.set_viewport_size({"width": 1600, "height": 700})  # a laptop's screen: the page scrolls
+    try:
+        for view in ("stopwatches", "modules", "representations"):
+            title = page.locator(f"[data-view={view}] .panel-title")
+            title.evaluate("(t) => t.scrollIntoView()")  # as far up as the page lets it go
+            time.sleep(0.2)
+            box = title.bounding_box()
+            hit = page.evaluate("([x, y]) => document.elementFromPoint(x, y)?.closest('.panel-head') !== null",
+                                [box["x"] + box["width"] / 2, box["y"] + box["height"] / 2])
+            assert hit, f"the {view} panel's title is covered"
+    finally:
+        page.set_viewport_size({"width": 1600, "height": 1700})
+        page.evaluate("window.scrollTo(0, 0); document.querySelector('#scroller')?.scrollTo(0, 0)")
 
 
 @pytest.fixture(scope="module")
@@ -199,6 +305,9 @@ def test_tafel_view_shows_the_recorded_frame_after_a_seek(playwright: Any, recor
         page.goto(viewer.url)
         wait_for(page, "tafel.state.ready && tafel.state.log && tafel.state.log.frame_range[1] > 0")
         assert page.locator("[data-view=log]").is_visible()
+        # a log is watched, not driven: no remote control, no recording
+        assert not page.locator("[data-view=remote]").is_visible()
+        assert not page.locator("[data-view=status] button:has-text('start recording')").is_visible()
         page.select_option("[data-view=representations] select", "RobotPose")
         slider = page.locator("[data-view=log] input[type=range]")
         slider.evaluate("(s) => { s.value = 180; s.dispatchEvent(new Event('input')); s.dispatchEvent(new Event('change')); }")

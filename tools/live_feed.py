@@ -2,9 +2,10 @@
 
 After each frame a loop hands over copies of only those representations a viewer needs right now
 (nothing when nobody looks), into a short queue that drops when full. The viewer's own thread turns
-them into messages. With contexts in other processes, the viewer's needs travel to them as a shared
-array of flags (one per representation, in a fixed order), and the copies come back through a
-multiprocessing queue that a thread of the supervisor forwards.
+them into messages. A need may be limited to some contexts (the web view pairs images with cognition's
+drawings, and has no use for motion's). With contexts in other processes, the viewer's needs travel to
+them as a shared array of flags (one per representation, in a fixed order: a bit per context), and the
+copies come back through a multiprocessing queue that a thread of the supervisor forwards.
 """
 
 from __future__ import annotations
@@ -14,12 +15,19 @@ import dataclasses
 import multiprocessing
 import queue
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
 
 QUEUE_SIZE = 64  # copies waiting for the viewer's thread; beyond that a frame's data is dropped
+#: a context's bit in a feed's flags; a context not named here is served by every flag
+CONTEXT_BITS = {"cognition": 1, "motion": 2}
+EVERY_CONTEXT = 0x7F  # the flags are signed bytes
+
+
+def context_bit(context: str) -> int:
+    return CONTEXT_BITS.get(context, EVERY_CONTEXT)
 
 
 class Handed(NamedTuple):
@@ -71,22 +79,25 @@ class LiveFeed:
         self.reps = feed_order(reps)
         self.index = {rep: i for i, rep in enumerate(self.reps)}
         self.flags = flags  # with contexts in other processes: a shared array, one flag per representation
-        self.needed: frozenset[type] = frozenset()
+        self.needed: dict[type, int] = {}  # representation -> the bits of the contexts it is needed from
         self.queue: queue.Queue[Handed | None] = queue.Queue(maxsize=queue_size)
         self.dropped = 0
 
-    def need(self, reps: Iterable[type]) -> None:
-        """From now on, hand over these (and nothing else)."""
-        self.needed = frozenset(rep for rep in reps if rep in self.index)
+    def need(self, reps: Iterable[type], only: Mapping[type, Collection[str]] | None = None) -> None:
+        """From now on, hand over these (and nothing else); ``only`` limits some of them to the contexts it names."""
+        limits = only or {}
+        self.needed = {rep: sum(context_bit(c) for c in limits[rep]) if rep in limits else EVERY_CONTEXT
+                       for rep in reps if rep in self.index}
         if self.flags is not None:
             for index, rep in enumerate(self.reps):
-                self.flags[index] = rep in self.needed
+                self.flags[index] = self.needed.get(rep, 0)
 
     def after_frame(self, context: str, blackboard: Any, time_ns: int, frame: int = 0) -> None:
-        """In the loop, after each frame: copies of what is needed; never waits."""
+        """In the loop, after each frame: copies of what is needed from this context; never waits."""
         needed = self.needed
         if needed:
-            self.dropped += hand_over(context, blackboard, time_ns, frame, self.reps, lambda i: self.reps[i] in needed,
+            bit = context_bit(context)
+            self.dropped += hand_over(context, blackboard, time_ns, frame, self.reps, lambda i: needed.get(self.reps[i], 0) & bit,
                                       self.queue.put_nowait)
 
     def take(self, item: Handed) -> None:
@@ -96,9 +107,10 @@ class LiveFeed:
         except queue.Full:
             self.dropped += 1
 
-    def get(self) -> Handed | None:
-        """The viewer's thread: the next copy, or None when the feed is closed."""
-        return self.queue.get()
+    def get(self, timeout: float | None = None) -> Handed | None:
+        """The viewer's thread: the next copy, or None when the feed is closed; ``queue.Empty`` when
+        nothing came within ``timeout`` s."""
+        return self.queue.get(timeout=timeout)
 
     def close(self) -> None:
         try:
@@ -122,8 +134,9 @@ def worker_feed_setup(runner: Any, args: dict[str, Any]) -> None:
 
     reps = [get_representation(name) for name in args["names"]]
     flags, out = args["flags"], args["queue"]
+    bit = context_bit(runner.name)
     runner.after_step.append(lambda r: hand_over(r.name, r.manager.blackboard, r.time_ns, frame_number(r.manager), reps,
-                                                 flags.__getitem__, out.put_nowait))
+                                                 lambda i: flags[i] & bit, out.put_nowait))
 
 
 def forward(source: Any, feed: LiveFeed, stop: Any) -> None:

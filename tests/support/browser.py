@@ -43,6 +43,29 @@ def launch(playwright: Any) -> Any:
     return playwright.chromium.launch(executable_path=chromium_path(), args=CHROMIUM_FLAGS)
 
 
+def wait_for(page: Any, expression: str, timeout: float = 20.0) -> Any:
+    """Poll a JavaScript expression of the page until it is truthy; its value."""
+    deadline = time.monotonic() + timeout
+    while True:
+        value = page.evaluate(expression)
+        if value:
+            return value
+        assert time.monotonic() < deadline, f"the page never made {expression} true"
+        time.sleep(0.1)
+
+
+def open_page(browser: Any, url: str, width: int = 1600, height: int = 1700) -> Any:
+    """A tab on ``url``, ready (connected, the program's commands known); ``page.problems`` collects
+    console errors and uncaught exceptions."""
+    view = browser.new_context(viewport={"width": width, "height": height}).new_page()
+    view.problems = []
+    view.on("console", lambda m: view.problems.append(f"console {m.type}: {m.text}") if m.type == "error" else None)
+    view.on("pageerror", lambda e: view.problems.append(f"page error: {e}"))
+    view.goto(url)
+    wait_for(view, "window.tafel && tafel.state.ready")
+    return view
+
+
 class WebProgram:
     """A ``tafel`` subprocess (``run`` or ``view``) with the addresses of its debug server and page."""
 

@@ -10,18 +10,18 @@ import {
 } from "./views.js";
 
 const VIEWS = [
-  { id: "field", title: "Field", make: fieldView, x: 0, y: 0, w: 6, h: 10 },
+  { id: "field", title: "Field", make: fieldView, x: 0, y: 0, w: 6, h: 12 },
   { id: "images", title: "Images", make: imagesView, x: 6, y: 0, w: 6, h: 6 },
-  { id: "status", title: "Status", make: statusView, x: 6, y: 6, w: 3, h: 4 },
-  { id: "remote", title: "Motion remote control", make: remoteView, x: 9, y: 6, w: 3, h: 4, needs: "motion:walk" },
-  { id: "log", title: "Log player", make: logPlayerView, x: 0, y: 10, w: 12, h: 2, needs: "log:play" },
-  { id: "plots", title: "Plots", make: plotsView, x: 0, y: 12, w: 6, h: 6 },
-  { id: "stopwatches", title: "Stopwatches", make: stopwatchesView, x: 6, y: 12, w: 6, h: 6 },
-  { id: "modules", title: "Modules", make: modulesView, x: 0, y: 18, w: 8, h: 10 },
-  { id: "representations", title: "Representations", make: representationsView, x: 8, y: 18, w: 4, h: 10 },
-  { id: "requests", title: "Debug requests", make: debugRequestsView, x: 0, y: 28, w: 4, h: 6 },
-  { id: "modify", title: "Modify", make: modifyView, x: 4, y: 28, w: 4, h: 6 },
-  { id: "parameters", title: "Parameters", make: parametersView, x: 8, y: 28, w: 4, h: 6 },
+  { id: "status", title: "Status", make: statusView, x: 6, y: 6, w: 3, h: 6 },
+  { id: "remote", title: "Motion remote control", make: remoteView, x: 9, y: 6, w: 3, h: 6, needs: "motion:walk", notOn: "log:play" },
+  { id: "log", title: "Log player", make: logPlayerView, x: 0, y: 12, w: 12, h: 2, needs: "log:play" },
+  { id: "plots", title: "Plots", make: plotsView, x: 0, y: 14, w: 6, h: 7 },
+  { id: "stopwatches", title: "Stopwatches", make: stopwatchesView, x: 6, y: 14, w: 6, h: 7 },
+  { id: "modules", title: "Modules", make: modulesView, x: 0, y: 21, w: 8, h: 11 },
+  { id: "representations", title: "Representations", make: representationsView, x: 8, y: 21, w: 4, h: 11 },
+  { id: "requests", title: "Debug requests", make: debugRequestsView, x: 0, y: 32, w: 4, h: 6 },
+  { id: "modify", title: "Modify", make: modifyView, x: 4, y: 32, w: 4, h: 6 },
+  { id: "parameters", title: "Parameters", make: parametersView, x: 8, y: 32, w: 4, h: 6 },
 ];
 const LAYOUT_KEY = "tafel-layout";
 const HIDDEN_KEY = "tafel-hidden";
@@ -131,11 +131,13 @@ connection.on("open", async (hello) => {
   state.commands = new Set(help.split("\n").map((line) => line.split(/\s+/)[0]).filter(Boolean));
   for (const view of VIEWS) {
     if (!view.needs) continue;
-    const can = state.commands.has(view.needs);
+    // a view shows where its commands are, and not where they make no sense (a log is watched, not driven)
+    const can = state.commands.has(view.needs) && !(view.notOn && state.commands.has(view.notOn));
     state.panels[view.id].box.disabled = !can;
     show(view.id, can && !hidden.has(view.id), false);
   }
   state.ready = true;
+  connection.emit("commands");
 });
 connection.on("close", () => { badge.textContent = "offline"; badge.className = "badge off"; state.ready = false; });
 connection.on("auth", () => { tokenForm.hidden = false; identity.textContent = "this program needs its token"; });

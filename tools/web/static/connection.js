@@ -2,7 +2,8 @@
 // Each text message sent is one command line, exactly as typed in telnet; answers come back in
 // order as {"answer": TEXT}. "subscribe NAME" streams a representation: JSON messages
 // {"topic", "context", "frame", "value"} or, for camera images, binary messages
-// (4-byte big-endian header length, JSON header, JPEG).
+// (4-byte big-endian header length, JSON header with the image's drawings, JPEG). "PlotNames" streams
+// the plot names seen so far.
 
 export class Connection {
   constructor(url) {
@@ -102,6 +103,7 @@ export class Connection {
   // The topic's value now, as a first message (a paused log sends nothing new): to every listener of
   // the topic, or to `only`.
   async current(topic, only) {
+    if (topic === "PlotNames") return; // the program's own list, sent as names come (and once a second)
     const deliver = (message) => (only ? only(message) : this.dispatch(topic, message));
     if (topic.startsWith("CameraImage")) {
       const answer = await this.ask(`+image:get -name ${topic}`);

@@ -69,6 +69,7 @@ export function fieldView(body, connection, state, panel) {
     // the field itself is drawn once per size, then copied
     if (!background) background = fieldPicture(g, canvas.width, canvas.height, scale);
     ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.clearRect(0, 0, canvas.width, canvas.height);  // the picture is transparent beside the carpet: old rings stayed there
     ctx.drawImage(background, 0, 0);
     // field frame -> canvas: centre in the middle, y up
     ctx.setTransform(scale, 0, 0, -scale, canvas.width / 2, canvas.height / 2);
@@ -89,11 +90,18 @@ export function fieldView(body, connection, state, panel) {
       }
       if (pose.deviation < 5000) circle(ctx, pose.x, pose.y, Math.max(pose.deviation, 30), null, "rgba(30,79,216,0.6)", 15);
       robot(ctx, pose.x, pose.y, pose.rotation, color, false);
+      // the ball model: the ball with its uncertainty while valid; once it is not (the ball is lost),
+      // only a faint ring where it was last believed, never its (by then meaningless) uncertainty
       const ball = field.ball;
       if (ball && ball.valid) {
         const [bx, by] = toField(pose, ball.x, ball.y);
         circle(ctx, bx, by, Math.max(ball.position_std, g.ball_radius), null, "rgba(255,140,0,0.8)", 15);
         circle(ctx, bx, by, g.ball_radius, "#ff8c00", "#000", 8);
+      } else if (ball && (ball.x || ball.y)) {
+        const [bx, by] = toField(pose, ball.x, ball.y);
+        ctx.save(); ctx.setLineDash([25, 25]);
+        circle(ctx, bx, by, g.ball_radius, null, "rgba(255,255,255,0.35)", 8);
+        ctx.restore();
       }
       const percept = field.percept;
       if (percept && percept.seen) {
@@ -160,8 +168,9 @@ function cone(ctx, pose, yaw, hfov, range, fill) {
   ctx.fillStyle = fill; ctx.fill();
 }
 
-// One debug drawing primitive in field coordinates (robot-frame ones moved by the pose).
-export function drawPrimitive(ctx, p, pose, scale) {
+// One debug drawing primitive in field coordinates (robot-frame ones moved by the pose), or with
+// yUp false in image pixels (y down: text stays upright).
+export function drawPrimitive(ctx, p, pose, scale, yUp = true) {
   ctx.save();
   if (pose) { ctx.translate(pose.x, pose.y); ctx.rotate(pose.rotation); }
   ctx.strokeStyle = p.color || "black"; ctx.fillStyle = p.color || "black";
@@ -172,7 +181,8 @@ export function drawPrimitive(ctx, p, pose, scale) {
   else if (p.kind === "rectangle") { ctx.strokeRect(q[0], q[1], q[2] - q[0], q[3] - q[1]); }
   else if (p.kind === "robot_pose") { robot(ctx, q[0], q[1], q[2], p.color || "blue", true); }
   else if (p.kind === "text") {
-    ctx.translate(q[0], q[1]); ctx.scale(1, -1);
+    ctx.translate(q[0], q[1]);
+    if (yUp) ctx.scale(1, -1);
     ctx.font = `${(p.width || 12) / scale * (window.devicePixelRatio || 1)}px system-ui`;
     ctx.fillText(p.text, 0, 0);
   }

@@ -30,17 +30,8 @@ export function imagesView(body, connection, state, panel) {
   const wrap = el("div", { className: "images" });
   body.append(wrap);
   state.images = {};
-  const drawings = new Map(); // canvas name -> primitives of the last cognition frame
-  panel.follow("DebugDrawings", { hz: 30 }, (message) => {
-    const byCanvas = new Map();
-    for (const p of message.value.primitives) {
-      if (!p.canvas.startsWith("image:")) continue;
-      if (!byCanvas.has(p.canvas)) byCanvas.set(p.canvas, []);
-      byCanvas.get(p.canvas).push(p);
-    }
-    for (const [name, list] of byCanvas) drawings.set(name, list);
-    for (const name of drawings.keys()) if (!byCanvas.has(name) && message.context === "cognition") drawings.set(name, []);
-  });
+  // Each image brings the drawings of the frame it was used in (its header's "drawings"): they are
+  // drawn over that image and no other.
   for (const camera of ["Top", "Bottom"]) {
     const canvas = el("canvas");
     const caption = el("figcaption", { textContent: `${camera.toLowerCase()} camera` });
@@ -68,9 +59,10 @@ export function imagesView(body, connection, state, panel) {
         const ctx = canvas.getContext("2d");
         ctx.drawImage(bitmap, 0, 0);
         bitmap.close();
-        for (const p of drawings.get(`image:${camera.toLowerCase()}`) || []) drawPrimitive(ctx, { ...p, width: p.width }, null, 1);
+        for (const p of message.drawings || []) drawPrimitive(ctx, p, null, 1, false);
         seen.drawn = (seen.drawn || 0) + 1;
         seen.frame = message.frame;
+        seen.drawingsFrame = message.drawings_frame;
       } finally { busy = false; }
       if (now - captionAt > 500) showCaption();  // text changes cost layout and paint: twice a second
     });
@@ -98,6 +90,32 @@ export function imagesView(body, connection, state, panel) {
 }
 
 // ----------------------------------------------------------------------------------------- plots
+const PLOT_COLORS = ["#2563eb", "#dc2626", "#16a34a", "#9333ea", "#ea580c", "#0891b2", "#4d7c0f", "#be185d"];
+
+// A number as an axis or the read-out shows it: short, whatever its size.
+export function formatNumber(v) {
+  if (v == null || !Number.isFinite(v)) return "–";
+  const a = Math.abs(v);
+  if (a !== 0 && (a >= 1e6 || a < 1e-3)) return v.toExponential(2);
+  return String(Number(v.toPrecision(a >= 1000 ? 6 : 4)));
+}
+
+// A series' range: uPlot's, but a constant series gets a narrow band around its value (not 0 to 100).
+function valueRange(u, min, max) {
+  if (min == null || max == null) return [0, 1];
+  if (min === max) { const pad = Math.abs(min) * 0.01 || 1; return [min - pad, max + pad]; }
+  return uPlot.rangeNum(min, max, 0.1, true);
+}
+
+// An axis just wide enough for its longest tick label (negative ones included), as uPlot measures it.
+function axisSize(u, values, index, cycle) {
+  const axis = u.axes[index];
+  if (cycle > 1) return axis._size;
+  const longest = (values || []).reduce((a, v) => (String(v).length > a.length ? String(v) : a), "");
+  u.ctx.font = axis.font[0];
+  return Math.ceil(axis.ticks.size + axis.gap + u.ctx.measureText(longest).width / (window.devicePixelRatio || 1)) + 4;
+}
+
 export function plotsView(body, connection, state, panel) {
   const source = el("select", { title: "what to plot" });
   const field = el("select", { title: "a numeric field", hidden: true });
@@ -105,29 +123,33 @@ export function plotsView(body, connection, state, panel) {
   const windowInput = el("input", { type: "number", value: 10, min: 1, max: 600, className: "wide", title: "window (s)" });
   const pause = el("input", { type: "checkbox" });
   const chosen = el("span");
-  const area = el("div", { style: "flex:1;min-height:0" });
-  body.style.display = "flex"; body.style.flexDirection = "column";
+  const area = el("div", { className: "plot-area" });
+  const readout = el("div", { className: "plot-readout" });  // uPlot's legend: the values under the mouse
+  body.classList.add("plots-body");
   body.append(el("div", { className: "row" }, source, field, add, el("label", {}, "window ", windowInput, " s"),
-    el("label", {}, pause, " pause"), chosen), area);
+    el("label", {}, pause, " pause"), chosen), area, readout);
   const series = []; // {label, xs, ys, stop}
   const plotNames = new Set();
-  state.plots = { series };
+  state.plots = { series, names: plotNames };
 
-  // plot() values: twice a second to learn their names, every one while one of them is plotted
+  // plot() names: the program sends the list when a name is new (and once a second); the values of
+  // every frame only while one of them is plotted
+  panel.follow("PlotNames", (message) => {
+    const before = plotNames.size;
+    for (const name of message.value.names) plotNames.add(name);
+    if (plotNames.size !== before) fillSources();
+  });
   const onPlots = (message) => {
     const t = message.time_ns / 1e9;
     message.value.names.forEach((name, i) => {
-      if (!plotNames.has(name)) { plotNames.add(name); fillSources(); }
       for (const s of series) if (s.plot === name) push(s, t, message.value.values[i]);
     });
   };
-  let stopPlots = panel.follow("DebugPlots", { hz: 2 }, onPlots), plotting = false;
+  let stopPlots = null;
   function followPlots() {
     const wanted = series.some((s) => s.plot);
-    if (wanted === plotting) return;
-    plotting = wanted;
-    stopPlots();
-    stopPlots = panel.follow("DebugPlots", wanted ? {} : { hz: 2 }, onPlots);
+    if (wanted && !stopPlots) stopPlots = panel.follow("DebugPlots", onPlots);
+    if (!wanted && stopPlots) { stopPlots(); stopPlots = null; }
   }
 
   let representations = [];
@@ -187,31 +209,53 @@ export function plotsView(body, connection, state, panel) {
     while (s.xs.length && s.xs[0] < t - keep) { s.xs.shift(); s.ys.shift(); }
   }
 
+  // Each series has a scale and an axis of its own (its name, its colour; left and right in turn), so
+  // a series of thousands and one of tenths are both readable; the legend below reads out every
+  // series under the mouse.
   let plot = null;
+  const size = () => ({ width: Math.max(area.clientWidth, 100), height: Math.max(area.clientHeight, 60) });
   function rebuild() {
     followPlots();
     chosen.replaceChildren(...series.map((s, i) => el("button", {
-      type: "button", textContent: `${s.label} ×`, title: "remove",
+      type: "button", textContent: `${s.label} ×`, title: "remove", style: `color:${PLOT_COLORS[i % PLOT_COLORS.length]}`,
       onclick: () => { series[i].stop?.(); series.splice(i, 1); rebuild(); },
     })));
     plot?.destroy();
-    plot = null;
+    plot = state.plots.chart = null;
+    readout.replaceChildren();
     if (!series.length) return;
-    const colors = ["#2563eb", "#dc2626", "#16a34a", "#9333ea", "#ea580c", "#0891b2", "#4d7c0f", "#be185d"];
-    plot = new uPlot({
-      width: Math.max(area.clientWidth, 100), height: Math.max(area.clientHeight - 30, 80),
-      scales: { x: { time: false } },
-      axes: [{ label: "s" }, {}],
-      series: [{ label: "t" }, ...series.map((s, i) => ({ label: s.label, stroke: colors[i % colors.length], spanGaps: true }))],
+    const color = (i) => PLOT_COLORS[i % PLOT_COLORS.length];
+    plot = state.plots.chart = new uPlot({
+      ...size(),
+      scales: { x: { time: false }, ...Object.fromEntries(series.map((s, i) => [`y${i}`, { auto: true, range: valueRange }])) },
+      cursor: { drag: { x: false, y: false } },
+      legend: { live: true, mount: (u, legend) => readout.replaceChildren(legend) },
+      axes: [
+        { label: "time (s)", labelSize: 18, values: (u, ticks) => ticks.map((t) => t.toFixed(1)) },
+        ...series.map((s, i) => ({
+          scale: `y${i}`, label: s.label.split(/[.:]/).at(-1), labelSize: 18, stroke: color(i), side: i % 2 ? 1 : 3,
+          grid: { show: i === 0 }, ticks: { stroke: color(i) }, size: axisSize,
+          values: (u, ticks) => ticks.map(formatNumber),
+        })),
+      ],
+      // the read-out: the values under the mouse, else the newest ones
+      series: [{ label: "t (s)", value: (u, v, si, i) => formatNumber(i == null ? newest(u, si) : v) },
+        ...series.map((s, i) => ({ label: s.label, scale: `y${i}`, stroke: color(i), width: 1.5, spanGaps: true,
+          value: (u, v, si, at) => formatNumber(at == null ? newest(u, si) : v) }))],
     }, joined(), area);
   }
   function joined() {
     return series.length ? uPlot.join(series.map((s) => [s.xs, s.ys])) : [[]];
   }
+  function newest(u, index) {
+    const values = u.data[index] || [];
+    for (let i = values.length - 1; i >= 0; i--) if (values[i] != null) return values[i];
+    return null;
+  }
   setInterval(() => {
     if (plot && panel.shown() && !pause.checked) plot.setData(joined());
   }, 100);
-  new ResizeObserver(() => plot?.setSize({ width: Math.max(area.clientWidth, 100), height: Math.max(area.clientHeight - 30, 80) })).observe(area);
+  new ResizeObserver(() => plot?.setSize(size())).observe(area);
 }
 
 // Paths of the numeric fields of a JSON value ("x", "ball.x", "segments.0.length").
@@ -265,29 +309,36 @@ export function debugRequestsView(body, connection, state, panel) {
 
 // ---------------------------------------------------------------------------------------- modify
 export function modifyView(body, connection, state, panel) {
-  const table = el("table");
+  const list = el("div");
   const note = el("div");
-  body.append(note, table);
-  async function refresh() {
-    if (table.contains(document.activeElement)) return; // never under the user's fingers
+  body.append(note, list);
+  // by what comes before the name's last ":" (the module: WalkingEngine:step_duration), like the parameters
+  async function refresh(force = false) {
+    if (!force && list.contains(document.activeElement)) return; // never under the user's fingers
     let lists;
     try { lists = await connection.json("modify:list -format json"); } catch (error) { answerNote(note, error.message); return; }
-    const rows = [];
+    if (!force && list.contains(document.activeElement)) return; // the user started typing meanwhile
+    const groups = new Map();
     for (const [context, modifies] of Object.entries(lists)) {
       if (!Array.isArray(modifies)) continue;
       for (const m of modifies) {
-        const input = el("input", { type: "text", className: "wide", value: JSON.stringify(m.pinned ? m.pinned_value : m.value) });
+        const cut = m.name.lastIndexOf(":");
+        const group = cut > 0 ? m.name.slice(0, cut) : "";
+        const input = el("input", { type: "text", className: "narrow", value: JSON.stringify(m.pinned ? m.pinned_value : m.value), dataset: { modify: m.name } });
         const pin = el("button", { type: "button", textContent: "pin" });
         const release = el("button", { type: "button", textContent: "release", disabled: !m.pinned });
-        pin.onclick = async () => { answerNote(note, await connection.ask(`modify:set ${arg("name", m.name)} ${arg("value", input.value)} -context ${context}`)); refresh(); };
-        release.onclick = async () => { answerNote(note, await connection.ask(`modify:release ${arg("name", m.name)} -context ${context}`)); refresh(); };
-        rows.push(el("tr", {}, el("td", { textContent: m.name }), el("td", { className: "num", textContent: JSON.stringify(m.value) }),
-          el("td", {}, input, pin, release), el("td", { textContent: m.pinned ? "pinned" : "", className: "muted" })));
+        pin.onclick = async () => { answerNote(note, await connection.ask(`modify:set ${arg("name", m.name)} ${arg("value", input.value)} -context ${context}`)); refresh(true); };
+        release.onclick = async () => { answerNote(note, await connection.ask(`modify:release ${arg("name", m.name)} -context ${context}`)); refresh(true); };
+        if (!groups.has(group)) groups.set(group, []);
+        groups.get(group).push(el("tr", { className: m.pinned ? "pinned" : "" }, el("td", { textContent: m.name.slice(cut + 1), title: m.name }),
+          el("td", { className: "num", textContent: JSON.stringify(m.value), title: "published by the code" }),
+          el("td", {}, input, pin, release)));
       }
     }
-    table.replaceChildren(el("tr", {}, el("th", { textContent: "name" }), el("th", { textContent: "published" }), el("th", { textContent: "pin to" }), el("th")), ...rows);
+    list.replaceChildren(...[...groups].map(([group, rows]) => el("fieldset", {}, el("legend", { textContent: group || "(no module)" }), el("table", {}, ...rows))));
+    if (!groups.size) list.replaceChildren(el("span", { className: "muted", textContent: "no modify values yet: modules publish them with modify(NAME, VALUE)" }));
   }
-  every(2, panel, connection, refresh);
+  every(2, panel, connection, () => refresh());
 }
 
 // ------------------------------------------------------------------------------------ parameters
@@ -398,17 +449,25 @@ export function stopwatchesView(body, connection, state, panel) {
 // ---------------------------------------------------------------------------------------- status
 export function statusView(body, connection, state, panel) {
   const identity = el("div");
+  const game = el("div", { className: "game" });
+  const pose = el("div");
   const rates = el("div");
   const errors = el("div");
   const file = el("input", { type: "text", className: "wide", placeholder: "file.mcap (optional)" });
   const start = el("button", { type: "button", textContent: "start recording" });
   const stop = el("button", { type: "button", textContent: "stop" });
   const recording = el("span");
+  const recordRow = el("div", { className: "row" }, recording, file, start, stop);
   const note = el("div");
-  body.append(identity, rates, errors, el("div", { className: "row" }, recording, file, start, stop), note);
+  body.append(identity, game, pose, rates, errors, recordRow, note);
   connection.on("open", (hello) => { identity.textContent = hello; });
+  connection.on("commands", () => refresh());  // the page knows the program's commands: is it a log?
   start.onclick = async () => { answerNote(note, await connection.ask(`log:start${file.value ? " " + arg("file", file.value) : ""}`)); refresh(); };
   stop.onclick = async () => { answerNote(note, await connection.ask("log:stop")); refresh(); };
+  // the game (GameState) and where the robot believes it is (RobotPose), twice a second
+  game.textContent = "game: no GameState yet";
+  panel.follow("GameState", { hz: 2 }, (message) => { game.textContent = gameText(message.value); });
+  panel.follow("RobotPose", { hz: 2 }, (message) => { pose.textContent = poseText(message.value); });
   async function refresh() {
     try {
       const watches = await connection.json("stopwatch:list -format json");
@@ -419,6 +478,9 @@ export function statusView(body, connection, state, panel) {
       errors.textContent = failing.length ? `module errors: ${failing.map((m) => `${m.name} ${m.errors} (${m.last_error})`).join("; ")}` : "module errors: none";
       errors.className = failing.length ? "error" : "ok";
     } catch (error) { rates.textContent = error.message; }
+    // a log is watched, not recorded
+    recordRow.hidden = Boolean(state.commands?.has("log:play"));
+    if (recordRow.hidden) return;
     const answer = await connection.ask("log:status");
     let status = null;
     try { status = JSON.parse(answer); } catch { /* "recording: not available" */ }
@@ -428,6 +490,26 @@ export function statusView(body, connection, state, panel) {
     stop.disabled = !status || !status.recording;
   }
   every(1, panel, connection, refresh);
+}
+
+// "game: playing (normal, first half, 412 s left) · score 1 : 0 (team 5 vs 12)" from a GameState: the
+// own team's score first.
+export function gameText(g) {
+  const teams = g.teams || [];
+  const own = teams.find((t) => t.team_number === g.team_number);
+  const other = teams.find((t) => t.team_number !== g.team_number);
+  const half = g.first_half ? "first half" : "second half";
+  const phase = [g.game_phase, g.set_play && g.set_play !== "none" ? g.set_play : "", half,
+    g.secs_remaining ? `${g.secs_remaining} s left` : ""].filter(Boolean).join(", ");
+  const score = `score ${own?.score ?? 0} : ${other?.score ?? 0} (team ${g.team_number}${other ? ` vs ${other.team_number}` : ""})`;
+  const source = g.heard ? "" : (g.manual ? " · set by hand" : " · no GameController heard");
+  return `game: ${g.state} (${phase}) · ${score}${source}`;
+}
+
+// "pose x=1200 y=-340 mm, 12°" and whether the localization trusts it.
+export function poseText(p) {
+  const degrees = Math.round((p.rotation * 180) / Math.PI);
+  return `pose x=${Math.round(p.x)} y=${Math.round(p.y)} mm, ${degrees}°${p.valid ? `, ±${Math.round(p.deviation)} mm` : ", not valid"}`;
 }
 
 // ------------------------------------------------------------------------------------ log player
