@@ -32,7 +32,7 @@ from tafel.core.manager import Blackboard
 from tafel.core.platform import Platform, PlatformError
 from tafel.platforms.actuators import ActuatorGuard
 from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS, NetworkedPlatform
-from tafel.platforms.v4l2 import image_time_ns
+from tafel.platforms.v4l2 import newest_image
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import (
     JOINT_COUNT,
@@ -136,6 +136,9 @@ class NaoPlatform(NetworkedPlatform, Platform):
         self.unpacker = msgpack.Unpacker(raw=False)
         self.packer = msgpack.Packer(use_single_float=True)
         self.captures: dict[str, Any] = {}
+        #: stale camera images dropped per camera, and when that was last said (monotonic s)
+        self.dropped_images: dict[str, int] = {}
+        self.dropped_said = 0.0
         self.measured = np.zeros(JOINT_COUNT)
         self.commanded_stiffness = np.zeros(JOINT_COUNT)
         self.guard = ActuatorGuard("nao")  # joint limits, 0..1, no NaN reaches LoLA
@@ -285,15 +288,27 @@ class NaoPlatform(NetworkedPlatform, Platform):
                 time.sleep(1.0 / 30.0)  # no cameras: keep cognition at its usual pace
                 return
             for camera, rep in (("top", CameraImageTop), ("bottom", CameraImageBottom)):
-                ok, frame = self.captures[camera].read()
+                ok, frame, taken_ns, dropped = newest_image(self.captures[camera], self.camera_devices[camera])
                 if not ok:
                     raise PlatformError(f"the {camera} camera {self.camera_devices[camera]} stopped delivering images")
+                self.report_dropped(camera, dropped)
                 if camera == "top":
                     frame = cv2.rotate(frame, cv2.ROTATE_180)  # mounted upside down
                 image = blackboard[rep]
-                image.time_ns = image_time_ns(self.captures[camera], self.camera_devices[camera])
+                image.time_ns = taken_ns
                 image.image = cv2.cvtColor(frame, cv2.COLOR_BGR2RGB)
                 image.horizontal_fov, image.vertical_fov = HORIZONTAL_FOV, VERTICAL_FOV
+
+    def report_dropped(self, camera: str, dropped: int) -> None:
+        """Stale images dropped (cognition was slower than the camera): counted, said at most once a second."""
+        if not dropped:
+            return
+        self.dropped_images[camera] = self.dropped_images.get(camera, 0) + dropped
+        now = time.monotonic()
+        if now - self.dropped_said >= 1.0:
+            self.dropped_said = now
+            log.warning("cognition is slower than the cameras: dropped stale images (%s so far) to work on the newest",
+                        ", ".join(f"{c} {n}" for c, n in sorted(self.dropped_images.items())))
 
     def frame_time_ns(self, context: str) -> int | None:
         return self.time_ns

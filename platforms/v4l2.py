@@ -35,3 +35,31 @@ def image_time_ns(capture: Any, device: str) -> int:
         _warned.add(device)
         log.warning("camera %s gives no monotonic buffer timestamps; image times are the times of reading", device)
     return read_ns
+
+
+#: s an image may be old when it is read before it counts as stale (a camera at 30 Hz: 1.5 periods)
+STALE_S = 0.05
+#: stale images skipped at most per read: the queue of a V4L2 driver holds a few
+MAX_SKIPPED = 8
+
+
+def newest_image(capture: Any, device: str) -> tuple[bool, Any, int, int]:
+    """The newest image a camera has: (ok, frame, its time on the program's clock, images dropped).
+
+    After a slow cognition frame the driver's queue holds older images; reading them in turn would put
+    cognition ever further behind the world. Stale ones are dropped (never queued) until one is fresh,
+    and the count goes back to the caller, which reports it.
+    """
+    dropped = 0
+    ok, frame = capture.read()
+    taken_ns = image_time_ns(capture, device)
+    while ok and dropped < MAX_SKIPPED and clock.now_ns() - taken_ns > STALE_S * 1e9:
+        newer_ok, newer = capture.read()
+        if not newer_ok:
+            break
+        newer_ns = image_time_ns(capture, device)
+        if newer_ns <= taken_ns:  # no newer image in the queue: this one is the newest there is
+            break
+        ok, frame, taken_ns = newer_ok, newer, newer_ns
+        dropped += 1
+    return ok, frame, taken_ns, dropped
