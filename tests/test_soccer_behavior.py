@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+import copy
 import math
 
 import pytest
+from hypothesis import HealthCheck, example, given, settings
+from hypothesis import strategies as st
 
 from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.soccer_behavior import SoccerBehavior
 from tafel.representations import field as pitch
+from tafel.representations.behavior import ActivationGraph, OptionGraph
 from tafel.representations.game import GamePhase, GameState, Penalty, RobotInfo, SetPlay, State, TeamInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType
@@ -223,3 +227,149 @@ def test_it_walks_around_a_robot_in_its_way_and_straight_when_the_way_is_free() 
             assert math.hypot(t * out.target_x - o.x, t * out.target_y - o.y) >= o.radius + ROBOT_RADIUS
         if not obstacles.obstacles:
             assert (out.target_x, out.target_y) == pytest.approx((2000.0, 0.0))
+
+
+# ------------------------------------------------------------------------------ the options, watched
+def active(harness: ModuleHarness) -> list[tuple[str, str]]:
+    return [(o.name, o.state) for o in harness[ActivationGraph].options]
+
+
+def test_the_activation_graph_shows_the_kick_off_wait_and_its_end_after_10_s() -> None:
+    pose = RobotPose(valid=True, x=-1000.0, y=200.0)
+    harness = ModuleHarness(SoccerBehavior, game(State.set, kicking_team=2), PlayerRole(role=Role.striker), pose,
+                            BallModel(valid=True, seen=True, x=1000.0, y=-200.0), TeamMates(), MotionInfo())
+    harness.advance(1.0)
+    assert active(harness) == [("PlaySoccer", "set")]
+    harness.set(game(State.playing, kicking_team=2))
+    harness.advance(9.5)
+    assert active(harness) == [("PlaySoccer", "opponents_kick_off"), ("Play", "play"), ("Striker", "wait_outside"), ("GoTo", "walk")]
+    root = harness[ActivationGraph].options[0]
+    assert root.time_in_state == pytest.approx(9.5, abs=0.05) and root.time_in_option == pytest.approx(harness.time_s)
+    assert harness[ActivationGraph].options[1].parameters == "role=striker"
+    harness.advance(0.6)
+    assert active(harness) == [("PlaySoccer", "playing"), ("Play", "play"), ("Striker", "kick")]
+    assert harness[OptionGraph].root == "PlaySoccer" and "Striker" in [o.name for o in harness[OptionGraph].options]
+
+
+def test_the_opponents_free_kick_is_over_after_30_s_whatever_the_game_controller_says() -> None:
+    pose = RobotPose(valid=True, x=-1000.0, y=0.0)
+    harness = ModuleHarness(SoccerBehavior, set_play_game(State.playing, SetPlay.kick_in, 2), PlayerRole(role=Role.striker), pose,
+                            BallModel(valid=True, seen=True, x=500.0, y=0.0), TeamMates(), MotionInfo())
+    harness.advance(29.0)
+    assert active(harness)[1] == ("Play", "opponents_set_play") and harness[MotionRequest].motion is not MotionType.kick
+    harness.advance(1.5)
+    assert active(harness)[1:3] == [("Play", "set_play_over"), ("Striker", "kick")]
+    harness.set(set_play_game(State.playing, SetPlay.none, 2))
+    harness.execute()
+    assert active(harness)[1] == ("Play", "play")
+
+
+def test_while_a_kick_plays_the_options_go_on_and_the_request_stays() -> None:
+    harness = ModuleHarness(SoccerBehavior, game(State.playing), PlayerRole(role=Role.striker), RobotPose(valid=True, x=-3000.0),
+                            BallModel(valid=True, x=190.0, y=-50.0), TeamMates(), MotionInfo())
+    assert harness.execute()[MotionRequest].motion is MotionType.kick
+    harness.set(MotionInfo(busy=True), BallModel())
+    harness.advance(1.0)
+    assert harness[MotionRequest].motion is MotionType.kick and active(harness)[-1] == ("Striker", "search")
+
+
+# A situation the robot may be in: the game, its role, what it knows, and for how long. Places and
+# times lean towards where the rules and roles decide something (the own penalty area, the centre, a
+# ball at the foot; the rules' 10 s and 30 s).
+PLACES = st.sampled_from([(-4200.0, 0.0, 0.0), (-1000.0, 200.0, 0.0), (-300.0, 0.0, 0.0), (2900.0, 0.0, 0.0), (3000.0, 1500.0, 3.0)])
+BALLS = st.sampled_from([(190.0, 50.0), (600.0, 0.0), (1000.0, -200.0), (2500.0, 0.0)])
+SITUATIONS = st.fixed_dictionaries({
+    "state": st.sampled_from([State.initial, State.standby, State.ready, State.set, State.playing, State.playing, State.finished]),
+    "set_play": st.sampled_from(list(SetPlay)),
+    "kicking_team": st.sampled_from([1, 2]),
+    "shoot_out": st.sampled_from([False, False, False, True]),
+    "penalized": st.sampled_from([False, False, False, True]),
+    "role": st.sampled_from(list(Role)),
+    "ball": st.none() | BALLS | st.tuples(st.floats(-4000.0, 4000.0), st.floats(-3000.0, 3000.0)),
+    "pose": st.none() | PLACES | st.tuples(st.floats(-4500.0, 4500.0), st.floats(-3000.0, 3000.0), st.floats(-3.1, 3.1)),
+    "mate_ball": st.none() | st.tuples(st.floats(-4500.0, 4500.0), st.floats(-3000.0, 3000.0)),
+    "seconds": st.sampled_from([0.2, 1.0, 4.0, 11.0, 31.0]),
+})
+
+
+def case(state: State = State.playing, set_play: SetPlay = SetPlay.none, kicking_team: int = 2, role: Role = Role.striker,
+         ball: tuple[float, float] | None = (600.0, 0.0), pose: tuple[float, float, float] | None = (-4200.0, 0.0, 0.0),
+         seconds: float = 1.0) -> dict[str, object]:
+    """One situation written out, for the examples every run tries."""
+    return {"state": state, "set_play": set_play, "kicking_team": kicking_team, "shoot_out": False, "penalized": False, "role": role,
+            "ball": ball, "pose": pose, "mate_ball": None, "seconds": seconds}
+
+
+def situation(s: dict[str, object]) -> tuple[object, ...]:
+    phase = GamePhase.penalty_shoot if s["shoot_out"] else GamePhase.normal
+    out = set_play_game(s["state"], s["set_play"], s["kicking_team"], phase)
+    if s["penalized"]:
+        out.teams[0].players[1].penalty = Penalty.player_pushing
+    pose = RobotPose(valid=True, x=s["pose"][0], y=s["pose"][1], rotation=s["pose"][2]) if s["pose"] else RobotPose()
+    ball = BallModel(valid=True, seen=True, x=s["ball"][0], y=s["ball"][1]) if s["ball"] else BallModel()
+    said = [TeamMate(TeamMessage(team=1, player=3, pose_valid=True, ball_seen=True, ball_x=s["mate_ball"][0], ball_y=s["mate_ball"][1]),
+                     age=0.2)] if s["mate_ball"] else []
+    return out, PlayerRole(role=s["role"]), pose, ball, TeamMates(mates=said)
+
+
+def arrive(pose: RobotPose, ball: BallModel, target: dict[str, str]) -> tuple[RobotPose, BallModel]:
+    """The robot at ``target`` (field x, y, rotation), the ball where it was on the field."""
+    there = RobotPose(valid=True, **{name: float(value) for name, value in target.items()})
+    if not (ball.valid and pose.valid):
+        return there, ball
+    x, y = there.to_robot(*pose.to_field(ball.x, ball.y))
+    return there, BallModel(valid=True, seen=True, x=x, y=y)
+
+
+def ways_out(harness: ModuleHarness) -> list[tuple[float, tuple[object, ...]]]:
+    """What may change next, and how long to wait for a state to be left: time alone, the robot arriving
+    where it walks to, the ball, the pose, the set play, the kicking team, the GameController's state."""
+    def changed(**fields: object) -> GameState:
+        out = copy.deepcopy(game_now)
+        out.__dict__.update(fields)
+        return out
+    keeper_area = (RobotPose(valid=True, x=-4200.0, y=0.0), BallModel(valid=True, seen=True, x=600.0, y=0.0))
+    game_now = harness[GameState]
+    walking = [dict(item.split("=") for item in o.parameters.split()) for o in harness[ActivationGraph].options if o.name == "GoTo"]
+    arrived = [(0.5, arrive(harness[RobotPose], harness[BallModel], target)) for target in walking]
+    return [*arrived,
+        (31.0, ()), (0.5, (BallModel(), TeamMates())), (0.5, (BallModel(valid=True, seen=True, x=190.0, y=50.0),)),
+        (0.5, (BallModel(valid=True, seen=True, x=2500.0, y=0.0),)), (0.5, keeper_area), (0.5, (RobotPose(),)),
+        (0.5, (RobotPose(valid=True, x=1000.0, y=-2000.0, rotation=2.0),)), (0.5, (changed(set_play=SetPlay.none),)),
+        (0.5, (changed(set_play=SetPlay.kick_in, kicking_team=2),)), (0.5, (changed(set_play=SetPlay.penalty_kick),)),
+        (0.5, (changed(kicking_team=3 - game_now.kicking_team),)),
+        *((0.5, (changed(state=state, teams=game(state).teams),)) for state in (State.ready, State.playing, State.finished)),
+    ]
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(SITUATIONS, min_size=1, max_size=3))
+@example([case(set_play=SetPlay.kick_in, seconds=31.0)])  # past the opponents' set play
+@example([case(role=Role.goalkeeper)])  # the keeper clears
+@example([case(State.set), case(ball=(1000.0, -200.0), pose=(-1000.0, 200.0, 0.0), seconds=4.0)])  # the opponents' kick-off
+@example([case(set_play=SetPlay.corner_kick, kicking_team=1, ball=(190.0, 50.0), pose=(4200.0, 2900.0, 0.0))])  # own free kick
+def test_every_reachable_state_has_a_way_out_or_is_meant_to_be_final(situations: list[dict[str, object]]) -> None:
+    """Whatever happened before, an active state that is not final is left when time passes or
+    something changes while its caller goes on calling it (an option of one state has nothing to leave)."""
+    harness = ModuleHarness(SoccerBehavior, *situation(situations[0]), MotionInfo(), rate_hz=5)
+    harness._history.clear()  # no copies of every frame's outputs: each trial below copies the harness
+    for s in situations:
+        harness.set(*situation(s))
+        harness.advance(s["seconds"])
+    graph = {o.name: o for o in harness[OptionGraph].options}
+    final = {(o.name, s.name) for o in graph.values() for s in o.states if s.final}
+    stuck = {(o.name, o.state): harness.time_s - o.time_in_state for o in harness[ActivationGraph].options
+             if len(graph[o.name].states) > 1 and (o.name, o.state) not in final}
+    for seconds, change in ways_out(harness):
+        if not stuck:
+            break
+        trial = copy.deepcopy(harness)
+        trial.set(*change)
+        for _ in range(max(1, round(seconds * 5))):
+            trial.execute()
+            now = {o.name: (o.state, trial.time_s - o.time_in_state) for o in trial[ActivationGraph].options}
+            # left: the option, still called, is in another state or entered this one anew (an option
+            # its caller stops calling has not found a way out of its state)
+            stuck = {(name, state): entered for (name, state), entered in stuck.items()
+                     if name not in now or (now[name][0] == state and now[name][1] == pytest.approx(entered, abs=1e-6))}
+    assert not stuck, f"no way out of {sorted(stuck)} after {situations}"

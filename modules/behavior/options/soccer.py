@@ -1,0 +1,396 @@
+"""The soccer behaviour's options, root first: ``PlaySoccer`` follows the GameController, ``Play`` the
+rules' set plays, then each role's option and ``GoTo``. Each state's method checks its transitions,
+then acts; ``b`` is the ``SoccerBehavior`` module (its blackboard, parameters and helpers).
+
+The set plays restrict the roles through ``b.keep_out`` (field discs nobody of the team may enter now)
+and ``b.indirect`` (an own free kick: never straight at the goal), which the states of ``PlaySoccer``
+and ``Play`` set before they call the role.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from tafel.modules.behavior.kicking import approach_and_kick, goal_direction
+from tafel.modules.behavior.options.framework import Next, Option, common, state
+from tafel.modules.behavior.paths import outside, waypoint
+from tafel.representations import field as pitch
+from tafel.representations.game import GamePhase, SetPlay, State
+from tafel.representations.motion_control import MotionType
+from tafel.representations.team import Role
+
+if TYPE_CHECKING:
+    from tafel.modules.behavior.soccer_behavior import SoccerBehavior
+
+OWN_GOAL_X = -pitch.LENGTH / 2
+#: the rules' set plays with a free kick: the other team keeps FREE_KICK_DISTANCE from the ball
+FREE_KICKS = (SetPlay.goal_kick, SetPlay.pushing_free_kick, SetPlay.corner_kick, SetPlay.kick_in)
+FREE_KICK_DISTANCE = 750.0  # mm, the rules
+FREE_KICK_S = 30.0  # s: then the set play is over, touched or not (the GameController says so too)
+KICK_OFF_S = 10.0  # s of PLAYING the defending team stays out of the centre circle, unless the ball moved
+BALL_MOVED = 200.0  # mm from the centre spot: the kick-off ball has moved
+LOST_TURN = 0.3  # rad/s: turning (the head looks around) while the robot does not know where it is
+
+
+class GoTo(Option["SoccerBehavior"]):
+    """Walk to a field pose, out of the areas the rules close and around the robots in the way."""
+
+    @dataclass
+    class Args:
+        x: float
+        """field mm"""
+        y: float
+        """field mm"""
+        rotation: float
+        """field rad"""
+
+    args: Args
+
+    @common(to=("lost", "walk", "there"))
+    def where_am_i(self, b: SoccerBehavior) -> Next:
+        if not b.robot_pose.valid:
+            return "lost"
+        x, y, rotation = self.target(b)
+        target_x, target_y = b.robot_pose.to_robot(x, y)
+        turn = math.remainder(rotation - b.robot_pose.rotation, math.tau)
+        return "there" if math.hypot(target_x, target_y) < b.parameters.arrived and abs(turn) < 0.15 else "walk"
+
+    @state(initial=True)
+    def walk(self, b: SoccerBehavior) -> Next:
+        """Walk to the pose; round a robot or a closed area in the way, facing the way meanwhile."""
+        x, y, rotation = self.target(b)
+        pose = b.robot_pose
+        target_x, target_y = pose.to_robot(x, y)
+        turn = math.remainder(rotation - pose.rotation, math.tau)
+        zones = [(*pose.to_robot(cx, cy), radius) for cx, cy, radius in b.keep_out]
+        way_x, way_y = waypoint(target_x, target_y, [*zones, *b.robot_discs()], b.parameters.obstacle_margin)
+        if (way_x, way_y) != (target_x, target_y):  # a detour: face the way while walking round
+            turn = math.atan2(way_y, way_x)
+        b.walk_to(way_x, way_y, turn)
+
+    @state(final=True)
+    def there(self, b: SoccerBehavior) -> Next:
+        """Stand: the pose is reached."""
+        self.target(b)
+        b.stand()
+
+    @state
+    def lost(self, b: SoccerBehavior) -> Next:
+        """Turn on the spot while the robot does not know where it is (the head looks around)."""
+        b.turn(LOST_TURN)
+
+    def target(self, b: SoccerBehavior) -> tuple[float, float, float]:
+        """The pose moved out of the closed areas (and drawn, on request)."""
+        x, y = outside(self.args.x, self.args.y, b.keep_out)
+        b.draw_target(x, y, self.args.rotation)
+        return x, y, self.args.rotation
+
+
+class Striker(Option["SoccerBehavior"]):
+    """Get the ball to the opponent goal: kick it there (an own free kick: ahead and towards the middle),
+    go by a teammate's ball without an own sighting, search by turning without any."""
+
+    calls = (GoTo,)
+
+    @common(to=("wait_outside", "kick", "to_teammates_ball", "search"))
+    def what_is_known(self, b: SoccerBehavior) -> Next:
+        ball = b.ball_on_field()
+        if b.keep_out and ball is not None:
+            return "wait_outside"
+        if b.ball_model.valid:
+            return "kick"
+        if ball is not None and b.robot_pose.valid:
+            return "to_teammates_ball"
+        return "search"
+
+    @state(initial=True)
+    def search(self, b: SoccerBehavior) -> Next:
+        """Nobody knows where the ball is: turn on the spot (the head searches)."""
+        b.turn(b.parameters.search_turn)
+
+    @state
+    def kick(self, b: SoccerBehavior) -> Next:
+        """Walk behind the ball on the kick's line and kick (``kicking.approach_and_kick``)."""
+        ball, p, out = b.ball_model, b.parameters, b.motion_request
+        direction = b.indirect_direction() if b.indirect else goal_direction(ball, b.robot_pose, b.odometry)
+        approach_and_kick(ball, direction, p, out)
+        if out.motion is MotionType.walk_to and math.hypot(ball.x, ball.y) > p.near_ball:  # near it a duel is no push
+            out.target_x, out.target_y = waypoint(out.target_x, out.target_y, b.robot_discs(), p.obstacle_margin)
+
+    @state
+    def to_teammates_ball(self, b: SoccerBehavior) -> Next:
+        """Walk to where a teammate sees the ball, facing the opponent goal."""
+        bx, by = b.ball_on_field() or (0.0, 0.0)
+        self.call(GoTo, x=bx, y=by, rotation=math.atan2(-by, pitch.LENGTH / 2 - bx))
+
+    @state
+    def wait_outside(self, b: SoccerBehavior) -> Next:
+        """The rules keep the team away from the ball: stand between it and the own goal, just outside."""
+        bx, by = b.ball_on_field() or (0.0, 0.0)
+        dx, dy = OWN_GOAL_X - bx, -by
+        distance = max(math.hypot(dx, dy), 1.0)
+        reach = max((radius for cx, cy, radius in b.keep_out if math.hypot(bx - cx, by - cy) < radius), default=0.0)
+        reach = max(reach, FREE_KICK_DISTANCE + b.parameters.keep_out_margin)
+        x, y = bx + dx / distance * reach, by + dy / distance * reach
+        self.call(GoTo, x=x, y=y, rotation=math.atan2(by - y, bx - x))
+
+
+class Goalkeeper(Option["SoccerBehavior"]):
+    """Stand between the ball and the goal's centre; clear a ball that comes near in the penalty area."""
+
+    calls = (GoTo, Striker)
+
+    @state(initial=True, to=("clear",))
+    def guard(self, b: SoccerBehavior) -> Next:
+        """On the goal line's front, shifted towards the ball's side."""
+        if b.ball_model.valid and b.keeper_clears():
+            return "clear"
+        _, by = b.ball_on_field() or (0.0, 0.0)
+        x, y = OWN_GOAL_X + 300.0, max(-500.0, min(500.0, 0.3 * by))
+        self.call(GoTo, x=x, y=y, rotation=b.facing_ball(x, y))
+
+    @state(to=("guard",))
+    def clear(self, b: SoccerBehavior) -> Next:
+        """The ball is near, in the own penalty area: play it away as the striker does."""
+        if not (b.ball_model.valid and b.keeper_clears()):
+            return "guard"
+        self.call(Striker)
+
+
+class Supporter(Option["SoccerBehavior"]):
+    """Wait behind and beside the ball (beside: towards the field's long axis)."""
+
+    calls = (GoTo,)
+
+    @state(initial=True)
+    def support(self, b: SoccerBehavior) -> Next:
+        """``supporter_offset`` behind and beside the ball, at least a metre in front of the own goal."""
+        bx, by = b.ball_on_field() or (0.0, 0.0)
+        back, beside = b.parameters.supporter_offset
+        x, y = max(OWN_GOAL_X + 1000.0, bx + back), by - math.copysign(beside, by) if abs(by) > 100.0 else by + beside
+        self.call(GoTo, x=x, y=y, rotation=b.facing_ball(x, y))
+
+
+class Defender(Option["SoccerBehavior"]):
+    """Stand between the ball and the own goal (also a robot that has no role yet)."""
+
+    calls = (GoTo,)
+
+    @state(initial=True)
+    def defend(self, b: SoccerBehavior) -> Next:
+        """A third of the way from the own goal to the ball."""
+        bx, by = b.ball_on_field() or (0.0, 0.0)
+        x, y = OWN_GOAL_X + 0.35 * (bx - OWN_GOAL_X), 0.35 * by
+        self.call(GoTo, x=x, y=y, rotation=b.facing_ball(x, y))
+
+
+ROLES: dict[Role, type[Option[SoccerBehavior]]] = {Role.striker: Striker, Role.goalkeeper: Goalkeeper, Role.supporter: Supporter,
+                                                   Role.defender: Defender, Role.none: Defender}
+
+
+class Play(Option["SoccerBehavior"]):
+    """PLAYING: the role's play, within the rules of the set play going on."""
+
+    @dataclass
+    class Args:
+        role: Role
+
+    args: Args
+    calls = (Striker, Goalkeeper, Supporter, Defender)
+
+    @state(initial=True, to=("opponents_set_play", "own_free_kick"))
+    def play(self, b: SoccerBehavior) -> Next:
+        """No set play: the role plays freely."""
+        if b.opponents_set_play():
+            return "opponents_set_play"
+        if b.own_free_kick():
+            return "own_free_kick"
+        self.call(ROLES[self.args.role])
+
+    @state(to=("play", "set_play_over"))
+    def opponents_set_play(self, b: SoccerBehavior) -> Next:
+        """The opponents' free kick or penalty kick: keep 0.75 m (and ``keep_out_margin``) from the ball."""
+        if not b.opponents_set_play():
+            return "play"
+        if self.time_in_state >= FREE_KICK_S:
+            return "set_play_over"
+        ball = b.ball_on_field()
+        if ball is not None:
+            b.keep_out.append((*ball, FREE_KICK_DISTANCE + b.parameters.keep_out_margin))
+        self.call(ROLES[self.args.role])
+
+    @state(to=("play",))
+    def set_play_over(self, b: SoccerBehavior) -> Next:
+        """30 s of the opponents' set play passed: it is over whatever the GameController still says."""
+        if not b.opponents_set_play():
+            return "play"
+        self.call(ROLES[self.args.role])
+
+    @state(to=("play",))
+    def own_free_kick(self, b: SoccerBehavior) -> Next:
+        """The own free kick is indirect: the ball is played ahead and towards the middle."""
+        if not b.own_free_kick():
+            return "play"
+        b.indirect = True
+        self.call(ROLES[self.args.role])
+
+
+class ReadyPosition(Option["SoccerBehavior"]):
+    """READY: walk to the role's kick-off position (``ready_*``), or the penalty kick's."""
+
+    calls = (GoTo,)
+
+    @common(to=("kick_off", "penalty_kick"))
+    def which_set_play(self, b: SoccerBehavior) -> Next:
+        return "penalty_kick" if b.game_state.set_play is SetPlay.penalty_kick else "kick_off"
+
+    @state(initial=True)
+    def kick_off(self, b: SoccerBehavior) -> Next:
+        """The role's place in the own half; the striker nearer the centre when its team kicks off."""
+        game, role, p = b.game_state, b.player_role.role, b.parameters
+        kicking_off = role is Role.striker and game.kicking_team == game.team_number
+        name = "striker_kicking_off" if kicking_off else role.name if role is not Role.none else "defender"
+        self.go(getattr(p, f"ready_{name}"))
+
+    @state
+    def penalty_kick(self, b: SoccerBehavior) -> Next:
+        """The kicker behind the penalty mark; the defending keeper on its goal line, the others out of the
+        penalty area."""
+        game, role, p = b.game_state, b.player_role.role, b.parameters
+        ours = game.kicking_team == game.team_number
+        if ours and role is Role.striker:
+            self.go(p.ready_penalty_kicker)
+        elif not ours and role is Role.goalkeeper:
+            self.go(p.ready_penalty_keeper)
+        else:
+            x, y, rotation = getattr(p, f"ready_{role.name if role is not Role.none else 'defender'}")
+            if not ours:  # outside the own penalty area
+                x = max(x, OWN_GOAL_X + pitch.PENALTY_AREA_LENGTH + p.keep_out_margin)
+            self.go([x, y, rotation])
+
+    def go(self, pose: list[float]) -> None:
+        self.call(GoTo, x=pose[0], y=pose[1], rotation=pose[2])
+
+
+class ShootOut(Option["SoccerBehavior"]):
+    """A penalty shoot-out in PLAYING: the kicking team's robot kicks at a goal corner, the other keeps
+    its goal line."""
+
+    calls = (GoTo,)
+
+    @common(to=("search", "shoot", "keep_line"))
+    def whose_kick(self, b: SoccerBehavior) -> Next:
+        game = b.game_state
+        if game.kicking_team != game.team_number:
+            return "keep_line"
+        return "shoot" if b.ball_model.valid else "search"
+
+    @state(initial=True)
+    def search(self, b: SoccerBehavior) -> Next:
+        """The kicker without a ball: turn on the spot."""
+        b.turn(b.parameters.search_turn)
+
+    @state
+    def shoot(self, b: SoccerBehavior) -> Next:
+        """Kick at the goal's corner on the side away from the keeper's (``shootout_aim`` mm beside the centre)."""
+        ball, pose, p = b.ball_model, b.robot_pose, b.parameters
+        if pose.valid:
+            gx, gy = pose.to_robot(pitch.LENGTH / 2, p.shootout_aim if pose.y <= 0 else -p.shootout_aim)
+            direction = math.atan2(gy - ball.y, gx - ball.x)
+        else:
+            direction = goal_direction(ball, pose, b.odometry)
+        approach_and_kick(ball, direction, p, b.motion_request)
+
+    @state
+    def keep_line(self, b: SoccerBehavior) -> Next:
+        """On the goal line, across from the ball."""
+        ball = b.ball_on_field()
+        ball_y = ball[1] if ball is not None else 0.0
+        x, _, rotation = b.parameters.ready_penalty_keeper
+        self.call(GoTo, x=x, y=max(-pitch.GOAL_INNER_WIDTH / 2 + 200.0, min(pitch.GOAL_INNER_WIDTH / 2 - 200.0, ball_y)), rotation=rotation)
+
+
+GAME_STATES = ("initial", "standby", "ready", "set", "playing", "opponents_kick_off", "penalized", "finished", "shoot_out_wait",
+               "shoot_out")
+
+
+class PlaySoccer(Option["SoccerBehavior"]):
+    """The root: what the GameController's state asks for."""
+
+    calls = (ReadyPosition, Play, ShootOut)
+
+    @common(to=GAME_STATES)
+    def follow_the_game_controller(self, b: SoccerBehavior) -> Next:
+        game = b.game_state
+        if game.state is State.finished:
+            return "finished"
+        if game.penalized:
+            return "penalized"
+        if game.state in (State.initial, State.standby, State.set):
+            return game.state.name
+        if game.game_phase is GamePhase.penalty_shoot:
+            return "shoot_out" if game.state is State.playing else "shoot_out_wait"
+        if game.state is State.ready:
+            return "ready"
+        if self.state == "set" and game.set_play is SetPlay.none and game.kicking_team not in (game.team_number, 255):
+            return "opponents_kick_off"  # PLAYING after SET: the opponents kick off
+        return "opponents_kick_off" if self.state == "opponents_kick_off" else "playing"
+
+    @state(initial=True)
+    def initial(self, b: SoccerBehavior) -> Next:
+        """INITIAL: stand (the head looks around)."""
+        b.stand()
+
+    @state
+    def standby(self, b: SoccerBehavior) -> Next:
+        """STANDBY: stand."""
+        b.stand()
+
+    @state
+    def ready(self, b: SoccerBehavior) -> Next:
+        """READY: walk to the kick-off position."""
+        self.call(ReadyPosition)
+
+    @state
+    def set(self, b: SoccerBehavior) -> Next:
+        """SET: stand."""
+        b.stand()
+
+    @state
+    def playing(self, b: SoccerBehavior) -> Next:
+        """PLAYING: the role's play."""
+        self.call(Play, role=b.player_role.role)
+
+    @state(to=("playing",))
+    def opponents_kick_off(self, b: SoccerBehavior) -> Next:
+        """PLAYING after the opponents' kick-off: out of the centre circle until the ball moved or 10 s passed."""
+        ball = b.ball_on_field()
+        if self.time_in_state >= KICK_OFF_S or (ball is not None and math.hypot(*ball) > BALL_MOVED):
+            return "playing"
+        b.keep_out.append((0.0, 0.0, pitch.CENTER_CIRCLE_DIAMETER / 2 + b.parameters.keep_out_margin))
+        self.call(Play, role=b.player_role.role)
+
+    @state
+    def penalized(self, b: SoccerBehavior) -> Next:
+        """Penalized: stand still (the head too) until the GameController unpenalizes."""
+        b.stand()
+
+    @state
+    def finished(self, b: SoccerBehavior) -> Next:
+        """FINISHED: sit."""
+        b.sit()
+
+    @state
+    def shoot_out_wait(self, b: SoccerBehavior) -> Next:
+        """A penalty shoot-out before PLAYING: stand."""
+        b.stand()
+
+    @state
+    def shoot_out(self, b: SoccerBehavior) -> Next:
+        """A penalty shoot-out in PLAYING."""
+        self.call(ShootOut)
+
+
+__all__ = ["Defender", "Goalkeeper", "GoTo", "Play", "PlaySoccer", "ReadyPosition", "ShootOut", "Striker", "Supporter"]
