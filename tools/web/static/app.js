@@ -1,6 +1,7 @@
 // RobotControl in the browser: panels the user arranges (kept in this browser's storage), each a view
 // that talks to the program through the debug protocol (connection.js).
 
+import { behaviorView } from "./behavior.js";
 import { Connection } from "./connection.js";
 import { fieldView } from "./field.js";
 import { modulesView } from "./modules.js";
@@ -22,6 +23,7 @@ const VIEWS = [
   { id: "requests", title: "Debug requests", make: debugRequestsView, x: 0, y: 32, w: 4, h: 6 },
   { id: "modify", title: "Modify", make: modifyView, x: 4, y: 32, w: 4, h: 6 },
   { id: "parameters", title: "Parameters", make: parametersView, x: 8, y: 32, w: 4, h: 6 },
+  { id: "behavior", title: "Behaviour", make: behaviorView, x: 0, y: 38, w: 12, h: 10 },
 ];
 const LAYOUT_KEY = "tafel-layout";
 const HIDDEN_KEY = "tafel-hidden";
