@@ -223,6 +223,7 @@ def test_each_json_channel_has_a_schema_its_messages_fit_field_by_field() -> Non
     import jsonschema
 
     from tafel.debug.concepts import ModuleTimes
+    from tafel.representations.behavior import ActivationGraph, ActiveOption
     from tafel.representations.infrastructure import FrameInfo
     from tafel.representations.motion import FsrData, InertialSensorData, JointCommand, JointSensorData
     from tafel.tools.foxglove_channels import JSON_SCHEMAS, FoxgloveTranslator
@@ -239,14 +240,17 @@ def test_each_json_channel_has_a_schema_its_messages_fit_field_by_field() -> Non
                                ("motion", FsrData(pressure=rng.uniform(0, 2, 8))),
                                ("motion", ModuleTimes(names=["WalkingEngine", "StandMotion"], milliseconds=[0.4, 0.1])),
                                ("cognition", ModuleTimes(names=["BallDetector"], milliseconds=[2.5])),
-                               ("motion", FrameInfo(frame_number=frame, time_ns=t)), ("cognition", FrameInfo(frame_number=frame, time_ns=t))):
+                               ("motion", FrameInfo(frame_number=frame, time_ns=t)), ("cognition", FrameInfo(frame_number=frame, time_ns=t)),
+                               ("cognition", ActivationGraph(options=[ActiveOption(name="PlaySoccer", state="playing", time_in_option=0.1 * frame),
+                                                                      ActiveOption(name="GoTo", state="walk", depth=1, parameters="x=1 y=2")]))):
             messages += translator.feed(context, value, t)
     by_topic: dict[str, list[dict[str, Any]]] = defaultdict(list)
     for out in messages:
         if isinstance(out.message, dict):
             by_topic[out.topic].append(out.message)
             assert out.encoded().schema_data == JSON_SCHEMAS[out.topic]
-    assert set(by_topic) == set(JSON_SCHEMAS) == {"/joints", "/imu", "/fsr", "/timing", "/rates"}
+    assert set(by_topic) == set(JSON_SCHEMAS) == {"/joints", "/imu", "/fsr", "/timing", "/rates", "/behavior"}
+    assert by_topic["/behavior"][-1]["path"] == "PlaySoccer/playing > GoTo/walk" and by_topic["/behavior"][-1]["options"][1]["depth"] == 1
     for topic, sent in by_topic.items():
         schema = json.loads(JSON_SCHEMAS[topic])
         jsonschema.Draft202012Validator.check_schema(schema)

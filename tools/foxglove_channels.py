@@ -10,6 +10,7 @@ The same topics in recordings and live (metres and seconds, as Foxglove wants th
 | ``/scene`` | ``foxglove.SceneUpdate`` | the field (once), robot, ``BallModel``, ``BallPercept``, ``field`` and ``robot`` drawings |
 | ``/tf`` | ``foxglove.FrameTransforms`` | field -> robot (``RobotPose`` while valid, else ``Odometry``), robot -> torso (``TorsoPose``), torso -> cameras |
 | ``/joints``, ``/imu``, ``/fsr``, ``/timing``, ``/rates`` | JSON by name, for the Plot panel | joints, IMU, foot pressure, ``ModuleTimes``, frame times |
+| ``/behavior`` | JSON, for the Raw Messages panel | ``ActivationGraph``: the active options, root first, and the path on one line |
 | ``/log`` | ``foxglove.Log`` | the program's log lines |
 
 A ``FoxgloveTranslator`` is fed every representation as it is recorded (in the writer thread, or in the
@@ -37,6 +38,7 @@ from tafel.core.logfile import ExtraMessage
 from tafel.core.serialization import deserialize
 from tafel.debug.concepts import DebugDrawings, ModuleTimes
 from tafel.representations import field
+from tafel.representations.behavior import ActivationGraph
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion import (
@@ -59,7 +61,7 @@ FSR_NAMES = tuple(f"{foot}_{where}" for foot in ("left", "right") for where in (
 CAMERA_MATRICES = {CameraMatrixTop: "top", CameraMatrixBottom: "bottom"}
 #: every topic, for a client that subscribes to everything and for the layouts
 TOPICS = ("/camera/top", "/camera/bottom", "/camera/top/calibration", "/camera/bottom/calibration", "/camera/top/annotations",
-          "/camera/bottom/annotations", "/scene", "/tf", "/joints", "/imu", "/fsr", "/timing", "/rates", "/log")
+          "/camera/bottom/annotations", "/scene", "/tf", "/joints", "/imu", "/fsr", "/timing", "/rates", "/behavior", "/log")
 #: which representations each topic is made of: what the live bridge asks the loops for
 NEEDS: dict[str, tuple[type, ...]] = {
     "/camera/top": (CameraImageTop,), "/camera/bottom": (CameraImageBottom,),
@@ -67,7 +69,7 @@ NEEDS: dict[str, tuple[type, ...]] = {
     "/camera/top/annotations": (CameraImageTop, DebugDrawings), "/camera/bottom/annotations": (CameraImageBottom, DebugDrawings),
     "/scene": (BallModel, BallPercept, DebugDrawings, FrameInfo), "/tf": (Odometry, TorsoPose, CameraMatrixTop, CameraMatrixBottom),
     "/joints": (JointSensorData, JointCommand), "/imu": (InertialSensorData,), "/fsr": (FsrData,), "/timing": (ModuleTimes,),
-    "/rates": (FrameInfo,), "/log": (),
+    "/rates": (FrameInfo,), "/behavior": (ActivationGraph,), "/log": (),
 }
 #: every representation some topic is made of; the others are not even decoded
 USED = frozenset(rep for reps in NEEDS.values() for rep in reps) | frozenset(CAMERA_MATRICES) | {RobotPose}
@@ -97,6 +99,14 @@ JSON_SCHEMAS: dict[str, bytes] = {topic: json.dumps({"title": title, **schema}).
     ("/fsr", "Foot pressure sensors by name (kg)", {**_numbers(FSR_NAMES), "required": list(FSR_NAMES)}),
     ("/timing", "Module times (ms) by context and module", _per_context({"type": "object", "additionalProperties": {"type": "number"}})),
     ("/rates", "Frames per second by context", _per_context({"type": "number"})),
+    ("/behavior", "The behaviour's active options, root first: name, state, s in option and in state, depth, parameters",
+     {"type": "object", "properties": {
+         "path": {"type": "string"},
+         "options": {"type": "array", "items": {"type": "object", "properties": {
+             "name": {"type": "string"}, "state": {"type": "string"}, "time_in_option": {"type": "number"},
+             "time_in_state": {"type": "number"}, "depth": {"type": "integer"}, "parameters": {"type": "string"}},
+             "required": ["name", "state", "time_in_option", "time_in_state", "depth", "parameters"], "additionalProperties": False}}},
+      "required": ["path", "options"], "additionalProperties": False}),
 )}
 
 
@@ -363,6 +373,10 @@ class FoxgloveTranslator:
             yield Outgoing("/timing", {context: dict(zip(value.names, value.milliseconds))}, time_ns, wall)
         elif kind is FrameInfo:
             yield from self._rates(context, time_ns, wall)
+        elif kind is ActivationGraph and self.wanted("/behavior"):
+            yield Outgoing("/behavior", {"path": value.status_text(), "options": [
+                {"name": o.name, "state": o.state, "time_in_option": float(o.time_in_option), "time_in_state": float(o.time_in_state),
+                 "depth": int(o.depth), "parameters": o.parameters} for o in value.options]}, time_ns, wall)
 
     def _image(self, camera: str, value: Any, time_ns: int, wall: int) -> Iterator[Outgoing]:
         image = np.asarray(value.image)
