@@ -242,24 +242,32 @@ class DebugDrawingPrimitive:
     text: str = ""
 
 
-@representation
+@representation(state=False)
 class DebugDrawings:
-    """The drawings of one frame of a context (recordable like any representation)."""
+    """The drawings of one frame of a context (recordable like any representation).
+
+    Debug output, not the robot's state: only there while a debug client can look, so fingerprints and
+    ``tafel log compare`` leave it out."""
 
     primitives: list[DebugDrawingPrimitive] = field(default_factory=list)
 
 
-@representation
+@representation(state=False)
 class DebugPlots:
-    """The plot values of one frame of a context: ``names[i]`` took ``values[i]``."""
+    """The plot values of one frame of a context: ``names[i]`` took ``values[i]``.
+
+    Debug output, not the robot's state: only there while a debug client can look, so fingerprints and
+    ``tafel log compare`` leave it out."""
 
     names: list[str] = field(default_factory=list)
     values: list[float] = field(default_factory=list)
 
 
-@representation
+@representation(state=False)
 class ModuleTimes:
-    """How long each module of a context ran in one frame: ``names[i]`` took ``milliseconds[i]``."""
+    """How long each module of a context ran in one frame: ``names[i]`` took ``milliseconds[i]``.
+
+    Timing, not state: fingerprints and ``tafel log compare`` leave it out."""
 
     names: list[str] = field(default_factory=list)
     milliseconds: list[float] = field(default_factory=list)
