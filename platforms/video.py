@@ -116,6 +116,8 @@ class VideoPlatform(Platform):
         """``video``, then ``video_spl`` (it picks the SPL ball detector) when the SPL ball is looked for."""
         return [self.name, *(["video_spl"] if self.ball_color == "spl" else [])]
 
+    config_sections = ("video",)  # [video] camera_pose
+
     def configure(self, config: Mapping[str, Any]) -> None:
         """``[video] camera_pose`` from the configuration, where the command line gives none."""
         pose = (config.get("video") or {}).get("camera_pose")
