@@ -2,10 +2,14 @@
 
 For each engine: walking speed at the largest request (forward, sideways, turning, 10 s each), falls
 and odometry error over simulated minutes of random walk requests (a new one every 2 s, within the
-walk's limits), the mean kick distance of 10 kicks, get-up successes from the front and the back
-(10 tries each), and the real-time factor while walking with both cameras rendered.
+walk's limits), ``push_survived_n``: walking forward at 150 mm/s, 0.1 s pushes on the torso from the
+front, back, left and right at increasing force (20 N up, 2 to 2.6 s apart) until the robot falls, the
+median over 5 seeds of the largest survived; the mean kick distance of 10 kicks, get-up successes from
+the front and the back (10 tries each) with the median seconds from being laid down to standing, and the
+real-time factor while walking with both cameras rendered.
 
-    python benchmarks/walking.py [--minutes 10] [--kicks 10] [--getups 10] [--engines mujoco,pybullet]
+    python benchmarks/walking.py [--minutes 10] [--kicks 10] [--getups 10] [--push-seeds 5]
+                                 [--engines mujoco,pybullet] [--parts speeds,random_walk,pushes,...]
 
 Prints one JSON line. Targets (MuJoCo, this 2-core machine): forward >= 200 mm/s, sideways >= 100 mm/s,
 turning >= 0.8 rad/s, 0 falls in 10 minutes, odometry error <= 10 %, kick >= 3 m, get-up >= 9/10 each,
@@ -29,37 +33,7 @@ sys.path.insert(0, str(REPO))
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 from tafel.representations.motion_control import FallState, Foot, MotionRequest, MotionType, Odometry  # noqa: E402
-from tests.support.simulation import Simulation  # noqa: E402
-
-
-class Driven:
-    """A simulation whose motion context gets ``request`` every frame (as ``motion:*`` would set it)."""
-
-    def __init__(self, engine: str, cameras: bool = False, seed: int = 0) -> None:
-        self.sim = Simulation(engine, cameras="on" if cameras else "off", ball="4000,2800", seed=str(seed))
-        self.request = MotionRequest(motion=MotionType.stand)
-        self.motion = self.sim.blackboard("motion")
-        self.sim.runtime.runners["motion"].manager.before_frame.append(lambda: self.motion.set(self.request))
-        self.turned = 0.0
-        self.last_heading = self.sim.platform.robot_pose()[2]
-        self.lying = False
-        self.falls = 0
-        self.sim.run(2.0, self.watch)
-
-    def watch(self, sim: Simulation) -> None:
-        heading = sim.platform.robot_pose()[2]
-        self.turned += math.remainder(heading - self.last_heading, math.tau)
-        self.last_heading = heading
-        lying = sim.platform.posture() != "upright"
-        if lying and not self.lying:
-            self.falls += 1
-        self.lying = lying
-
-    def run(self, seconds: float) -> None:
-        self.sim.run(seconds, self.watch)
-
-    def close(self) -> None:
-        self.sim.close()
+from tests.support.driven import PUSH_FROM, Driven  # noqa: E402
 
 
 def speeds(engine: str) -> dict[str, float]:
@@ -137,25 +111,56 @@ def kicks(engine: str, count: int) -> dict[str, float]:
             "kick_falls": falls}
 
 
-def getups(engine: str, tries: int) -> dict[str, str]:
-    result = {}
+def getups(engine: str, tries: int) -> dict[str, object]:
+    """Successes within 15 s from lying on the front and on the back, and the median time (s, of the
+    successes) from being laid down to standing: upright at standing height (ground truth) and upright
+    by the FallDetector too."""
+    result: dict[str, object] = {}
     for side in ("front", "back"):
-        success = 0
+        times = []
         for attempt in range(tries):
             driven = Driven(engine, seed=attempt)
             x, y, heading = driven.sim.platform.robot_pose()
             driven.sim.platform.move_robot(x, y, heading, side)
-            up = False
-            for _ in range(15):
-                driven.run(1.0)
+            for step in range(1, 151):
+                driven.run(0.1)
                 if driven.sim.platform.posture() == "upright" and driven.sim.platform.torso_height() > 280 \
                         and driven.motion[FallState].upright:
-                    up = True
+                    times.append(step * 0.1)
                     break
-            success += up
             driven.close()
-        result[f"getup_{side}"] = f"{success}/{tries}"
+        result[f"getup_{side}"] = f"{len(times)}/{tries}"
+        result[f"getup_{side}_s"] = round(float(np.median(times)), 1) if times else None
     return result
+
+
+PUSH_FORCES = (20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0, 100.0, 120.0)  # N, each for 0.1 s
+
+
+def largest_push_survived(engine: str, side: str, seed: int, forces: tuple[float, ...] = PUSH_FORCES) -> float:
+    """Walking forward at 150 mm/s, pushed from ``side`` for 0.1 s at each force in turn (2 to 2.6 s apart,
+    seeded, so that the pushes meet the step at different phases) until the robot falls (ground truth):
+    the largest force survived (0 when the first one throws it over)."""
+    rng = np.random.default_rng(seed)
+    driven = Driven(engine, seed=seed, start="-3500,0,0")
+    driven.request = MotionRequest(motion=MotionType.walk, walk_x=150.0)
+    driven.run(2.0)
+    survived = 0.0
+    for force in forces:
+        driven.run(float(rng.uniform(0.0, 0.6)))
+        driven.push_from(side, force)
+        driven.run(2.0)
+        if driven.falls:
+            break
+        survived = force
+    driven.close()
+    return survived
+
+
+def pushes(engine: str, seeds: int) -> dict[str, dict[str, float]]:
+    """``push_survived_n``: for each side, the median over ``seeds`` seeds of the largest push survived."""
+    return {"push_survived_n": {side: float(np.median([largest_push_survived(engine, side, seed) for seed in range(seeds)]))
+                                for side in PUSH_FROM}}
 
 
 def realtime_with_cameras(engine: str, seconds: float = 10.0) -> float:
@@ -168,22 +173,38 @@ def realtime_with_cameras(engine: str, seconds: float = 10.0) -> float:
     return round(seconds / wall, 2)
 
 
+PARTS = ("speeds", "random_walk", "pushes", "kicks", "getups", "realtime")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--minutes", type=float, default=10.0, help="simulated minutes of random walking per engine")
     parser.add_argument("--kicks", type=int, default=10)
     parser.add_argument("--getups", type=int, default=10, help="tries from the front and from the back")
+    parser.add_argument("--push-seeds", type=int, default=5, help="seeds of the pushes from each side")
     parser.add_argument("--engines", default="mujoco,pybullet")
+    parser.add_argument("--parts", default=",".join(PARTS), help=f"which measurements, of {','.join(PARTS)}")
     args = parser.parse_args()
+    parts = args.parts.split(",")
+    unknown = sorted(set(parts) - set(PARTS))
+    if unknown:
+        parser.error(f"--parts: unknown {', '.join(unknown)}; choose from {','.join(PARTS)}")
     report: dict[str, object] = {"benchmark": "walking"}
     for engine in args.engines.split(","):
         started = time.perf_counter()
         figures: dict[str, object] = {}
-        figures.update(speeds(engine))
-        figures.update(random_walk(engine, args.minutes))
-        figures.update(kicks(engine, args.kicks))
-        figures.update(getups(engine, args.getups))
-        figures["realtime_factor_walking_with_cameras"] = realtime_with_cameras(engine)
+        if "speeds" in parts:
+            figures.update(speeds(engine))
+        if "random_walk" in parts:
+            figures.update(random_walk(engine, args.minutes))
+        if "pushes" in parts:
+            figures.update(pushes(engine, args.push_seeds))
+        if "kicks" in parts:
+            figures.update(kicks(engine, args.kicks))
+        if "getups" in parts:
+            figures.update(getups(engine, args.getups))
+        if "realtime" in parts:
+            figures["realtime_factor_walking_with_cameras"] = realtime_with_cameras(engine)
         figures["benchmark_wall_s"] = round(time.perf_counter() - started, 1)
         report[engine] = figures
     report["targets_mujoco"] = {"forward_mm_s": 200, "sideways_mm_s": 100, "turn_rad_s": 0.8, "falls": 0,

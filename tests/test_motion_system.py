@@ -167,9 +167,9 @@ def selector(*inputs: object) -> ModuleHarness:
 
 
 def test_a_fall_overrides_every_request_at_once_and_lying_leads_to_getting_up() -> None:
-    harness = selector(MotionRequest(motion=MotionType.walk), WalkingEngineOutput(standing=False))
+    harness = selector(MotionRequest(motion=MotionType.stand))  # a walk gets catch_time first (test below)
     harness.execute()
-    assert harness[MotionSelection].active is MotionType.walk
+    assert harness[MotionSelection].active is MotionType.stand
     harness.set(FallState(phase=FallPhase.falling, direction=FallDirection.front))
     harness.execute()
     selection = harness[MotionSelection]
@@ -203,6 +203,65 @@ def test_a_kick_waits_for_the_walk_to_stop_and_runs_once_per_request() -> None:
     assert harness[MotionSelection].active is MotionType.kick  # a new request, a new kick
 
 
+def test_a_stagger_while_walking_gets_catch_time_for_the_steps_before_the_protective_motion() -> None:
+    harness = selector(MotionRequest(motion=MotionType.walk), WalkingEngineOutput(standing=False))
+    harness.execute()
+    harness.set(FallState(phase=FallPhase.falling, direction=FallDirection.back))
+    harness.execute(frames=5)  # 0.05 s: the walk's step adjustment may still catch it
+    assert harness[MotionSelection].active is MotionType.walk
+    assert harness.module.waiting_for == "the walk tries to catch the stagger first"
+    harness.execute(frames=10)  # still falling after catch_time (0.12 s): protect the robot
+    assert harness[MotionSelection].active is MotionType.fall
+
+
+def test_a_pushed_torso_makes_the_swing_foot_land_further_that_way() -> None:
+    def landing(pitch: float, pitch_rate: float) -> float:
+        harness = ModuleHarness(WalkingEngine, MotionRequest(motion=MotionType.walk, walk_x=100.0),
+                                MotionSelection(active=MotionType.walk), context="motion")
+        harness.execute(frames=30)  # walking undisturbed
+        harness.set(InertialSensorData(angles=np.array([0.0, pitch]), gyroscope=np.array([0.0, pitch_rate, 0.0])))
+        harness.execute(frames=5)
+        engine = harness.module
+        swing = Foot.right if engine.support is Foot.left else Foot.left
+        return float(engine.goal(swing)[0])
+    undisturbed = landing(0.0, 0.0)
+    assert landing(0.2, 1.5) > undisturbed + 30.0  # pushed from behind: a longer step
+    assert landing(-0.2, -1.5) < undisturbed - 30.0  # pushed from the front: a step back
+
+
+def test_leaving_sit_stands_up_from_the_crouch_before_the_walk_starts() -> None:
+    harness = selector(MotionRequest(motion=MotionType.sit))
+    harness.execute(frames=5)
+    assert harness[MotionSelection].active is MotionType.sit
+    harness.set(MotionRequest(motion=MotionType.walk_to, target_x=1000.0))  # READY after FINISHED
+    harness.execute()
+    selection = harness[MotionSelection]
+    assert selection.active is MotionType.getup and selection.waiting_for == "standing up from sitting first"
+    harness.set(KeyframeOutput(done=False))
+    harness.execute(frames=20)
+    assert harness[MotionSelection].active is MotionType.getup  # stands up to the end
+    harness.set(KeyframeOutput(done=True))
+    harness.execute()
+    assert harness[MotionSelection].active is MotionType.walk_to
+
+
+def test_a_get_up_that_starts_on_the_feet_stands_up_into_the_stand_pose() -> None:
+    crouch = stand_pose()
+    crouch[JOINT_INDEX["LKneePitch"]] = crouch[JOINT_INDEX["RKneePitch"]] = 2.0
+    harness = ModuleHarness(KeyframePlayer, MotionSelection(active=MotionType.getup), FallState(phase=FallPhase.upright),
+                            JointSensorData(position=crouch), context="motion")
+    harness.execute()
+    assert harness[KeyframeOutput].motion == "stand_up"
+    harness.set(FallState(phase=FallPhase.getting_up))  # what the FallDetector says while it plays
+    harness.advance(1.0)
+    assert harness[KeyframeOutput].motion == "stand_up"  # goes on as it began
+    harness.advance(1.5)
+    out = harness[KeyframeOutput]
+    assert out.done
+    legs = [JOINT_INDEX[side + joint] for side in "LR" for joint in LEG]
+    assert_close(out.position[legs], stand_pose()[legs], abs=1e-9)
+
+
 @given(st.lists(strategy_for(MotionRequest), min_size=1, max_size=30), st.lists(strategy_for(FallState), min_size=1, max_size=30))
 def test_the_shares_of_the_motions_always_add_up_to_one(requests: list[MotionRequest], falls: list[FallState]) -> None:
     harness = selector()
@@ -231,7 +290,7 @@ def test_the_combinator_blends_without_a_jump_and_keeps_the_head_to_the_head_mot
 
 # --------------------------------------------------------------------------------- keyframe motions
 def test_every_shipped_motion_file_loads_and_mirrors() -> None:
-    for name in ("kick_left", "kick_right", "getup_front", "getup_back", "getup_sitting", "sit", "fall_front", "fall_back"):
+    for name in ("kick_left", "kick_right", "getup_front", "getup_back", "getup_sitting", "sit", "stand_up", "fall_front", "fall_back"):
         motion = load_motion(name)
         assert motion.duration > 0 and motion.keyframes
     shared_end = load_motion("getup_sitting").keyframes

@@ -12,6 +12,8 @@ from pathlib import Path
 
 import pytest
 
+from tafel.representations.motion_control import MotionRequest, MotionType
+from tests.support.driven import Driven
 from tests.test_debug_server import Program
 
 ENGINES = ["mujoco", "pybullet"]
@@ -148,3 +150,28 @@ def test_a_push_that_topples_the_robot_is_detected_as_a_fall_and_it_gets_up(robo
     wait_until_standing(robot, 15.0)
 
 
+
+
+# ------------------------------------------------------------ in-process, several seeds, ground truth
+SEEDS = range(3)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+def test_after_sitting_limp_the_robot_stands_up_and_walks_off_without_falling(engine: str) -> None:
+    """Half-time: FINISHED sits (crouch, then limp), READY walks to a place; the robot must not fall."""
+    for seed in SEEDS:
+        driven = Driven(engine, seed=seed)
+        try:
+            driven.request = MotionRequest(motion=MotionType.sit)
+            driven.run(4.0)
+            driven.falls = 0  # sitting down is not the question; what follows is
+            x0, _, _ = driven.sim.platform.robot_pose()
+            driven.request = MotionRequest(motion=MotionType.walk_to, target_x=800.0)
+            driven.run(8.0)
+            x1, _, _ = driven.sim.platform.robot_pose()
+            assert driven.falls == 0, f"seed {seed}: fell after sitting"
+            assert driven.sim.platform.torso_height() > 280, f"seed {seed}: not standing"
+            assert x1 - x0 > 300, f"seed {seed}: walked only {x1 - x0:.0f} mm"
+        finally:
+            driven.close()

@@ -32,7 +32,7 @@ class KeyframePlayer(Module):
     """Plays the motion file that fits what motion selected, from where the joints are when it starts.
 
     Which file: ``kick_left``/``kick_right`` by the request's foot, ``getup_front``/``getup_back`` by how
-    the robot lies, ``sit``, and ``fall_front``/``fall_back`` by the fall's direction. Files are read
+    the robot lies (``stand_up`` when a get-up starts with the robot on its feet: out of ``sit``), ``sit``, and ``fall_front``/``fall_back`` by the fall's direction. Files are read
     once and kept; a file that cannot be played is logged and the robot keeps still instead. A keyframe
     with ``abort_if_tilted`` that begins with the torso tilted more than that stops the motion where
     it is (``aborted``); a get-up then starts again once the robot lies still.
@@ -56,9 +56,11 @@ class KeyframePlayer(Module):
     def execute(self) -> None:
         out, active = self.keyframe_output, self.motion_selection.active
         now = self.frame_info.time_ns
-        name = self.motion_for(active) if active in (MotionType.kick, MotionType.getup, MotionType.sit, MotionType.fall) else ""
         current = self.playing.name if self.playing else ""
         retry = active is MotionType.getup and out.done and self.fall_state.lying  # still lying after getting up: again
+        name = self.motion_for(active) if active in (MotionType.kick, MotionType.getup, MotionType.sit, MotionType.fall) else ""
+        if active is MotionType.getup and self.selected is MotionType.getup and self.playing is not None and not retry:
+            name = current  # a get-up goes on as it began (the fall state says getting_up meanwhile)
         if active is not self.selected or name != current or retry:
             self.selected = active
             self.playing = self.load(name) if name else None
@@ -94,6 +96,8 @@ class KeyframePlayer(Module):
         if active is MotionType.kick:
             return "kick_left" if self.motion_request.kick_foot is Foot.left else "kick_right"
         if active is MotionType.getup:
+            if self.fall_state.upright:
+                return "stand_up"  # on its feet, crouched: standing up from sitting
             lying_back = self.fall_state.phase is FallPhase.lying_back or self.fall_state.direction is FallDirection.back
             return "getup_back" if lying_back else "getup_front"
         if active is MotionType.fall:

@@ -27,9 +27,11 @@ WALKING = (MotionType.walk, MotionType.walk_to)
 class MotionSelector(Module):
     """Follows the request, but never cuts a motion off where that would throw the robot over.
 
-    - A fall overrides everything at once (the protective motion); lying is followed by getting up,
-      and nothing else runs until the robot stands again.
-    - A kick or get-up plays to its end. A walk stops with its feet together before anything else
+    - A fall overrides everything at once (the protective motion), except that a walk first has
+      ``catch_time`` to catch the stagger with its steps; lying is followed by getting up, and nothing
+      else runs until the robot stands again.
+    - A kick or get-up plays to its end. Leaving ``sit`` is a get-up (standing up from the crouch) before
+      anything else. A walk stops with its feet together before anything else
       starts. A kick runs once per request: the request must change before the next.
     - The joint commands blend from the old motion into the new one over ``blend_time``.
     """
@@ -40,6 +42,9 @@ class MotionSelector(Module):
         """s over which one motion blends into the next"""
         startup: float = bounded(0.0, 10.0, 1.6)
         """s of standing at the start, while the stand motion brings the joints from where they are"""
+        catch_time: float = bounded(0.0, 0.5, 0.12)
+        """s a fall must go on while walking before the protective motion takes over: the walk's step
+        adjustment catches a push in that time, a real fall still meets the protective motion before the ground"""
 
     def __init__(self) -> None:
         self.kicked = False
@@ -47,6 +52,7 @@ class MotionSelector(Module):
         self.waiting_for = ""
         self.last_ns: int | None = None
         self.first_ns: int | None = None
+        self.falling_since: int | None = None  # ns: when the FallDetector began to say falling
 
     def execute(self) -> None:
         selection = self.motion_selection
@@ -78,12 +84,23 @@ class MotionSelector(Module):
         if current is MotionType.getup and (not keyframe.done or fall.lying or (keyframe.aborted and not fall.upright)):
             self.waiting_for = "getting up first"
             return MotionType.getup  # an aborted get-up holds still until the robot lies, then starts again
+        now = self.frame_info.time_ns
+        if fall.phase is not FallPhase.falling:
+            self.falling_since = None
+        elif self.falling_since is None:
+            self.falling_since = now
         if fall.phase is FallPhase.falling and current is not MotionType.getup:
+            if current in WALKING and (now - (self.falling_since or now)) * 1e-9 < self.parameters.catch_time:
+                self.waiting_for = "the walk tries to catch the stagger first"
+                return current
             self.waiting_for = "falling"
             return MotionType.fall
         if fall.lying:
             self.waiting_for = "getting up first"
             return MotionType.getup
+        if current is MotionType.sit and request.motion is not MotionType.sit:
+            self.waiting_for = "standing up from sitting first"
+            return MotionType.getup  # the KeyframePlayer's stand_up: out of the limp crouch, never straight into a walk
         if current is MotionType.kick and not keyframe.done:
             self.waiting_for = "the kick plays to its end"
             return MotionType.kick

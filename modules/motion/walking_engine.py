@@ -52,9 +52,9 @@ class WalkingEngine(Module):
         """mm/s"""
         max_backward: float = bounded(0.0, 400.0, 150.0)
         """mm/s"""
-        max_sideways: float = bounded(0.0, 300.0, 140.0)
+        max_sideways: float = bounded(0.0, 300.0, 220.0)
         """mm/s"""
-        max_turn: float = bounded(0.0, 3.0, 1.2)
+        max_turn: float = bounded(0.0, 3.0, 2.0)
         """rad/s"""
         max_acceleration: float = bounded(10.0, 2000.0, 400.0)
         """mm/s^2 by which the walking speed may change"""
@@ -79,6 +79,24 @@ class WalkingEngine(Module):
         """1/s: walk_to speed per mm (and rad) still to go"""
         target_tolerance: float = bounded(5.0, 300.0, 40.0)
         """mm (and tolerance / 400 rad) within which walk_to has arrived"""
+        com_height: float = bounded(100.0, 500.0, 280.0)
+        """mm of the centre of mass above the ground: turns the torso's tilt and its rate into where the body goes"""
+        balance_x_gain: float = bounded(0.0, 3.0, 1.0)
+        """share of the forward (or backward) capture-point error the swing foot steps further"""
+        balance_y_gain: float = bounded(0.0, 3.0, 1.0)
+        """share of the sideways capture-point error the swing foot steps further"""
+        balance_deadband: float = bounded(0.0, 100.0, 60.0)
+        """mm of capture-point error the walk's own rocking makes: no step adjustment within it"""
+        max_adjust_x: float = bounded(0.0, 200.0, 80.0)
+        """mm the swing foot may step further forward or back than planned"""
+        max_adjust_y: float = bounded(0.0, 200.0, 60.0)
+        """mm the swing foot may step further sideways than planned (never across the other foot)"""
+        adjust_until: float = bounded(0.1, 1.0, 0.6)
+        """share of a step after which its landing place stays as it is"""
+        hurry: float = bounded(0.0, 0.05, 0.01)
+        """per mm of capture-point error beyond the deadband, how much faster the step goes (it lands sooner)"""
+        max_hurry: float = bounded(1.0, 3.0, 1.6)
+        """the fastest a step may go, as a multiple of its duration's speed"""
 
     def __init__(self) -> None:
         self.support = Foot.left  # the first swing foot is the right one
@@ -94,6 +112,9 @@ class WalkingEngine(Module):
         self.last_target = np.full(3, np.nan)
         self.last_ns: int | None = None
         self.tuned = self.parameters  # this frame's parameters, with the modify values pinned by a debug client
+        self.adjust = np.zeros(2)  # mm forward, left the swing foot steps beyond the plan, to catch the body
+        self.reference = np.zeros(2)  # the torso's roll and pitch (rad) while walking undisturbed, a slow mean
+        self.rates = np.zeros(2)  # roll and pitch rate (rad/s), lightly filtered
 
     def execute(self) -> None:
         self.tuned = modify_fields("WalkingEngine", self.parameters, TUNED)
@@ -125,7 +146,8 @@ class WalkingEngine(Module):
                 return
             self.begin_step(velocity)
             swing = Foot.right if self.support is Foot.left else Foot.left
-        self.phase_s += dt
+        beyond = self.balance(dt, phase)
+        self.phase_s += dt * min(p.max_hurry, 1.0 + p.hurry * float(np.hypot(*beyond)))  # pushed: land sooner
         phase = min(1.0, self.phase_s / p.step_duration)  # this frame's: the last frame of a step reaches 1
         support_before = self.now[self.support].copy()
         smooth = 0.5 - 0.5 * math.cos(math.pi * phase)
@@ -137,6 +159,41 @@ class WalkingEngine(Module):
         self.set_joints(swing, lift, sway, phase)
         out.support_foot, out.step_phase = self.support, phase
         out.standing = False
+
+    def capture_error(self, dt: float) -> np.ndarray:
+        """Where the body is going (mm forward, left) beyond where the walk's own rocking takes it: the
+        capture point of a linear inverted pendulum of ``com_height``, from the torso's tilt and its rate
+        (the IMU), relative to the tilt the walk has when nobody pushes."""
+        p, imu = self.tuned, self.inertial_sensor_data
+        angles = np.asarray(imu.angles[:2], dtype=float)
+        self.rates = 0.5 * self.rates + 0.5 * np.asarray(imu.gyroscope[:2], dtype=float)
+        self.reference += (angles - self.reference) * min(1.0, dt / 2.0)  # 2 s: a push does not move it
+        tilt = angles - self.reference
+        settle = math.sqrt(p.com_height / 9810.0)  # s: the pendulum's time constant
+        roll, pitch = tilt + settle * self.rates  # the tilt turns the stiff leg, and the landing place with it
+        return np.array([p.com_height * pitch, -p.com_height * roll])  # leaning right: the body goes right
+
+    def balance(self, dt: float, phase: float) -> np.ndarray:
+        """Step adjustment: the swing foot lands further in the direction the body is pushed, as far as
+        the capture-point error beyond the deadband and the limits allow (never across the other foot),
+        until ``adjust_until`` of the step. Returns the error beyond the deadband (mm forward, left)."""
+        p = self.tuned
+        error = self.capture_error(dt)
+        beyond = np.sign(error) * np.maximum(np.abs(error) - p.balance_deadband, 0.0)
+        if phase < p.adjust_until:
+            swing = Foot.right if self.support is Foot.left else Foot.left
+            side = 1.0 if swing is Foot.left else -1.0
+            limit = np.array([p.max_adjust_x, p.max_adjust_y])
+            wanted = np.clip(beyond * np.array([p.balance_x_gain, p.balance_y_gain]), -limit, limit)
+            planned_y = float(self.step[1]) * 0.5
+            support_y = -planned_y
+            inward = (support_y - planned_y) * side - 10.0  # mm it may go towards the support foot (<= 0: none)
+            wanted[1] = max(wanted[1] * side, min(inward, 0.0)) * side
+            self.adjust += np.clip(wanted - self.adjust, -800.0 * dt, 800.0 * dt)  # mm/s the landing place moves
+        if DRAW_STEPS:
+            plot("WalkingEngine:capture_x", float(error[0]))
+            plot("WalkingEngine:capture_y", float(error[1]))
+        return beyond
 
     def requested_velocity(self) -> tuple[np.ndarray, bool]:
         """(forward mm/s, left mm/s, turn rad/s) within the limits, and whether a walk_to target is reached."""
@@ -183,6 +240,7 @@ class WalkingEngine(Module):
             self.support = Foot.right if self.support is Foot.left else Foot.left
         self.started = True
         self.phase_s = 0.0
+        self.adjust = np.zeros(2)  # the foot that now swings starts with its own plan
         self.start = {foot: offset.copy() for foot, offset in self.now.items()}
         swing = Foot.right if self.support is Foot.left else Foot.left
         limit = np.array([p.max_acceleration, p.max_acceleration, p.max_turn_acceleration]) * p.step_duration
@@ -205,7 +263,10 @@ class WalkingEngine(Module):
         """Where a foot ends this step (x, y mm, yaw rad, relative to its place beside the torso)."""
         swing = self.support is not foot
         sign = 0.5 if swing else -0.5
-        return self.step * sign
+        goal = self.step * sign
+        if swing:
+            goal[:2] += self.adjust
+        return goal
 
     def set_joints(self, swing: Foot, lift: float, sway: float, phase: float) -> None:
         p, out = self.tuned, self.walking_engine_output
@@ -245,5 +306,6 @@ class WalkingEngine(Module):
         self.velocity = np.zeros(3)
         self.phase_s = 0.0
         self.started = False
+        self.adjust = np.zeros(2)
         self.set_joints(Foot.right, 0.0, 0.0, 0.0)
         out.standing, out.step_phase = True, 0.0
