@@ -14,8 +14,8 @@ import statistics
 import time
 
 from tafel.core import Module, ModuleManager, provides, representation, requires
-from tafel.core.manager import make_module
-from tafel.core.naming import snake_case
+from tafel.core.framework.manager import make_module
+from tafel.core.framework.naming import snake_case
 
 CHAIN = 100
 FRAMES = 2000

@@ -28,11 +28,11 @@ from pathlib import Path
 
 import numpy as np
 
-from tafel.core.config import load_config
-from tafel.core.program import plan_program
-from tafel.core.recording import Recorder, select
+from tafel.core.framework.config import load_config
+from tafel.core.logs.recording import Recorder, select
+from tafel.core.logs.serialization import codec, serialize
 from tafel.core.runtime import Limits, LockstepRuntime
-from tafel.core.serialization import codec, serialize
+from tafel.core.runtime.program import plan_program
 from tafel.platforms.dummy import DummyPlatform
 from tafel.platforms.log import LogPlatform
 from tafel.representations.infrastructure import FrameInfo

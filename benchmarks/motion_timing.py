@@ -19,12 +19,12 @@ import tempfile
 import threading
 from pathlib import Path
 
-from tafel.core.blackbox import BlackBox
-from tafel.core.config import load_config
-from tafel.core.handover import LocalChannel
-from tafel.core.program import plan_program
-from tafel.core.recording import select
+from tafel.core.framework.config import load_config
+from tafel.core.logs.blackbox import BlackBox
+from tafel.core.logs.recording import select
 from tafel.core.runtime import ConcurrentRuntime, ContextRunner, Limits, StopFlag, cognition_watcher, run_context_loop, try_realtime
+from tafel.core.runtime.handover import LocalChannel
+from tafel.core.runtime.program import plan_program
 from tafel.platforms.dummy import DummyPlatform
 from tafel.tools.cli import DEFAULT_CONFIG, discover_modules
 

@@ -1,10 +1,14 @@
 """Tafel core: representations, blackboard, modules and the module manager.
 
-Depends on nothing else in the project; everything else depends on it.
+Depends on nothing else in the project; everything else depends on it. Its wings: ``framework``
+(representations, modules, the manager, parameters, configuration), ``runtime`` (the runtimes,
+platforms, clock, hand-overs), ``logs`` (serialization, MCAP logs, recording, the black box) and
+``testing`` (the module harness and the pytest plugin). Names a module author needs are here.
 """
 
-from tafel.core.access import ReadOnlyArray
-from tafel.core.errors import (
+from tafel.core import _moved  # noqa: F401 - first: old import paths (tafel.core.manager, ...) keep working
+from tafel.core.framework.access import ReadOnlyArray
+from tafel.core.framework.errors import (
     ConflictingProvidersError,
     DependencyCycleError,
     MissingProviderError,
@@ -15,11 +19,11 @@ from tafel.core.errors import (
     TafelError,
     UnknownModuleError,
 )
-from tafel.core.graph import prune_unsatisfiable
-from tafel.core.manager import Blackboard, ModuleManager, ModuleTiming
-from tafel.core.module import Module, Requirements, provides, requires, uses
-from tafel.core.naming import snake_case
-from tafel.core.representation import (
+from tafel.core.framework.graph import prune_unsatisfiable
+from tafel.core.framework.manager import Blackboard, ModuleManager, ModuleTiming
+from tafel.core.framework.module import Module, Requirements, provides, requires, uses
+from tafel.core.framework.naming import snake_case
+from tafel.core.framework.representation import (
     array,
     bounded,
     fields_of,
@@ -30,7 +34,7 @@ from tafel.core.representation import (
     representation,
     values_equal,
 )
-from tafel.core.serialization import SerializationError, deserialize, schema_of, serialize
+from tafel.core.logs.serialization import SerializationError, deserialize, schema_of, serialize
 
 __all__ = [
     "Blackboard",

@@ -23,14 +23,14 @@ from typing import Any
 
 import numpy as np
 
-from tafel.core.errors import TafelError
-from tafel.core.manager import ModuleManager
-from tafel.core.naming import did_you_mean
-from tafel.core.parameters import ParameterError, make_parameters, parameter_values, set_parameter
-from tafel.core.reload import ModuleReloader
-from tafel.core.representation import FieldInfo, fields_of
-from tafel.core.serialization import SerializationError, deserialize, serialize
-from tafel.core.validation import MAX_MAGNITUDE, ValueCheckError, check_field, check_instance, check_number
+from tafel.core.framework.errors import TafelError
+from tafel.core.framework.manager import ModuleManager
+from tafel.core.framework.naming import did_you_mean
+from tafel.core.framework.parameters import ParameterError, make_parameters, parameter_values, set_parameter
+from tafel.core.framework.reload import ModuleReloader
+from tafel.core.framework.representation import FieldInfo, fields_of
+from tafel.core.framework.validation import MAX_MAGNITUDE, ValueCheckError, check_field, check_instance, check_number
+from tafel.core.logs.serialization import SerializationError, deserialize, serialize
 from tafel.debug.concepts import CANVASES, STATE, DebugState
 from tafel.debug.protocol import Command
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tafel.core import representation
-from tafel.core.representation import RANGE_META
+from tafel.core.framework.representation import RANGE_META
 from tafel.core.testing import RESET_HOOKS
 
 HISTORY = 300  # values kept per plot and per stopwatch

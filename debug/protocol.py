@@ -20,7 +20,7 @@ import binascii
 import re
 from dataclasses import dataclass, field
 
-from tafel.core.errors import TafelError
+from tafel.core.framework.errors import TafelError
 
 MAX_LINE = 64 * 1024
 EMPTY_VALUE = '""'  # an empty ArgValue must be quoted

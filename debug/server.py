@@ -29,7 +29,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from tafel.core.naming import did_you_mean
+from tafel.core.framework.naming import did_you_mean
 from tafel.core.runtime import name_os_thread
 from tafel.debug.commands import SPECS, CommandError, merge_answers
 from tafel.debug.protocol import Command, ParseError, TelnetDecoder, answer_bytes, parse

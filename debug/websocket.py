@@ -35,7 +35,7 @@ from websockets.datastructures import Headers
 from websockets.exceptions import ConnectionClosed
 from websockets.http11 import Request, Response
 
-from tafel.core.naming import did_you_mean
+from tafel.core.framework.naming import did_you_mean
 from tafel.debug.commands import CommandError
 from tafel.debug.protocol import Command
 from tafel.debug.server import DebugServer, Session

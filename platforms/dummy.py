@@ -14,8 +14,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from tafel.core.manager import Blackboard
-from tafel.core.platform import Platform, seed_number
+from tafel.core.framework.manager import Blackboard
+from tafel.core.runtime.platform import Platform, seed_number
 from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS, NetworkedPlatform
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import RobotPose

@@ -28,8 +28,8 @@ from typing import Any
 
 import numpy as np
 
-from tafel.core.manager import Blackboard
-from tafel.core.platform import EndOfData, PlatformError, PlatformOptionError
+from tafel.core.framework.manager import Blackboard
+from tafel.core.runtime.platform import EndOfData, PlatformError, PlatformOptionError
 from tafel.platforms.match_world import Side, Snapshot
 from tafel.platforms.mujoco_sim import GL_BACKEND, MujocoRobot, close_renderers, mujoco
 from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from tafel.core.platform import PlatformError
+from tafel.core.runtime.platform import PlatformError
 from tafel.platforms.robot_model import SERVO_GAIN, VIEWER_ONLY_GROUP, fsr_sites, joint_motor, mjcf, mjcf_assets, torque_range
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.field import BALL_RADIUS

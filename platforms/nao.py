@@ -27,9 +27,9 @@ import cv2
 import msgpack
 import numpy as np
 
-from tafel.core import clock
-from tafel.core.manager import Blackboard
-from tafel.core.platform import Platform, PlatformError
+from tafel.core.framework.manager import Blackboard
+from tafel.core.runtime import clock
+from tafel.core.runtime.platform import Platform, PlatformError
 from tafel.platforms.actuators import ActuatorGuard
 from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS, NetworkedPlatform
 from tafel.platforms.v4l2 import newest_image

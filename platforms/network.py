@@ -26,8 +26,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from tafel.core.config import ConfigError
-from tafel.core.manager import Blackboard
+from tafel.core.framework.config import ConfigError
+from tafel.core.framework.manager import Blackboard
 from tafel.representations.game import GAME_CONTROLLER_PORT, RETURN_PORT, Datagram, GameControllerPackets, GameControllerReturn
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.team import MAX_MESSAGE_BYTES, TEAM_PORT_BASE, IncomingTeamMessages, OutgoingTeamMessage

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from tafel.core.platform import PlatformError
+from tafel.core.runtime.platform import PlatformError
 from tafel.platforms.field_world import NET_FRICTION, FieldPart, ball_mesh, ball_texture_png, cylinder_mesh, field_parts
 from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, fsr_sites, joint_motor, urdf
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform

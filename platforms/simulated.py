@@ -17,8 +17,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from tafel.core.manager import Blackboard
-from tafel.core.platform import Platform, PlatformOptionError, seed_number
+from tafel.core.framework.manager import Blackboard
+from tafel.core.runtime.platform import Platform, PlatformOptionError, seed_number
 from tafel.platforms.actuators import ActuatorGuard
 from tafel.platforms.field_world import BALL_COLORS
 from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS, NetworkedPlatform

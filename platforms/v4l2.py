@@ -7,7 +7,7 @@ from typing import Any
 
 import cv2
 
-from tafel.core import clock
+from tafel.core.runtime import clock
 
 log = logging.getLogger("tafel.platform.camera")
 #: a buffer timestamp further than this from the time of the read is not on the monotonic clock

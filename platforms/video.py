@@ -26,9 +26,9 @@ from typing import Any, ClassVar
 import cv2
 import numpy as np
 
-from tafel.core import clock
-from tafel.core.manager import Blackboard
-from tafel.core.platform import EndOfData, Platform, PlatformError, PlatformOptionError
+from tafel.core.framework.manager import Blackboard
+from tafel.core.runtime import clock
+from tafel.core.runtime.platform import EndOfData, Platform, PlatformError, PlatformOptionError
 from tafel.platforms.images import IMAGE_SUFFIXES, RAW_SUFFIXES, ImageSourceError, PosedImage, image_files, options_pose, posed_image
 from tafel.platforms.v4l2 import image_time_ns
 from tafel.representations.infrastructure import FrameInfo

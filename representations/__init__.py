@@ -68,7 +68,7 @@ def __getattr__(name: str) -> Any:
     index = _index()
     if name in index:
         return getattr(importlib.import_module(f"{__name__}.{index[name]}"), name)
-    from tafel.core.naming import did_you_mean
+    from tafel.core.framework.naming import did_you_mean
 
     raise AttributeError(f"tafel.representations has no representation {name!r}; {did_you_mean(name, index)}")
 

@@ -19,8 +19,8 @@ import struct
 from dataclasses import dataclass, field
 
 from tafel.core import representation
-from tafel.core.errors import TafelError
-from tafel.core.representation import counter
+from tafel.core.framework.errors import TafelError
+from tafel.core.framework.representation import counter
 
 NO_TEAM = 255  # ``kicking_team`` when no team kicks
 

@@ -19,6 +19,6 @@ class FrameInfo:
 
 
 # Provided by the runtime to motion; defined in core because the runtime fills it.
-from tafel.core.status import CognitionStatus  # noqa: E402
+from tafel.core.runtime.status import CognitionStatus  # noqa: E402
 
 __all__ = ["CognitionStatus", "FrameInfo"]

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tafel.core import array, bounded, representation
-from tafel.core.representation import counter
+from tafel.core.framework.representation import counter
 
 #: what the elements of a rotation matrix take: -1 to 1, with room for rounding (1 + 2e-16 after a product)
 ROTATION_ELEMENT = (-1.0 - 1e-9, 1.0 + 1e-9)

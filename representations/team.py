@@ -30,8 +30,8 @@ import struct
 from dataclasses import dataclass, field
 
 from tafel.core import representation
-from tafel.core.errors import TafelError
-from tafel.core.representation import counter
+from tafel.core.framework.errors import TafelError
+from tafel.core.framework.representation import counter
 from tafel.representations.game import Datagram
 
 MAX_MESSAGE_BYTES = 128  # the rules' limit

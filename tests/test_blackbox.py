@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from tafel.core.blackbox import BlackBox, Condition, conditions_from_config
-from tafel.core.config import ConfigError
-from tafel.core.logfile import read_log
-from tafel.core.serialization import serialize
+from tafel.core.framework.config import ConfigError
+from tafel.core.logs.blackbox import BlackBox, Condition, conditions_from_config
+from tafel.core.logs.logfile import read_log
+from tafel.core.logs.serialization import serialize
 from tafel.representations.game import GameState, Penalty
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import ChestButton

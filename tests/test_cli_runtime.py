@@ -356,7 +356,7 @@ def test_status_line_rates_are_over_the_last_interval_and_shown_from_configurati
 
 
 def test_the_tools_package_knows_no_representation_by_name() -> None:
-    from tafel.core.representation import registered_representations
+    from tafel.core.framework.representation import registered_representations
     from tafel.tools.cli import discover_modules
 
     discover_modules()

@@ -11,8 +11,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tafel.core import clock
-from tafel.core.logfile import read_log
+from tafel.core.logs.logfile import read_log
+from tafel.core.runtime import clock
 from tafel.core.testing import ModuleHarness
 from tafel.modules.motion.camera_matrix_buffer_provider import CameraMatrixBufferProvider
 from tafel.representations.infrastructure import FrameInfo
@@ -125,11 +125,11 @@ def test_camera_latency_option_is_checked() -> None:
 @pytest.mark.slow
 def test_every_process_of_a_concurrent_program_shares_one_origin(tmp_path: Path) -> None:
     """Processes adopt the supervisor's origin: with it set 1000 s back, every frame time is past 1000 s."""
-    from tafel.core.config import load_config
-    from tafel.core.platform import load_platform
-    from tafel.core.program import plan_program
-    from tafel.core.recording import Recorder, select
+    from tafel.core.framework.config import load_config
+    from tafel.core.logs.recording import Recorder, select
     from tafel.core.runtime import ConcurrentRuntime, Limits
+    from tafel.core.runtime.platform import load_platform
+    from tafel.core.runtime.program import plan_program
     from tafel.tools.cli import DEFAULT_CONFIG, discover_modules
 
     discover_modules()

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tafel.core.config import (
+from tafel.core.framework.config import (
     ConfigError,
     apply_overrides,
     context_section,

@@ -19,8 +19,8 @@ from pathlib import Path
 
 import pytest
 
-from tafel.core.logfile import read_log
-from tafel.core.serialization import deserialize
+from tafel.core.logs.logfile import read_log
+from tafel.core.logs.serialization import deserialize
 from tafel.debug.client import DebugClient
 from tafel.debug.server import DebugRouter, DebugServer
 from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler

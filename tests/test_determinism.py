@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from tafel.core.config import ConfigError
-from tafel.core.manager import Blackboard
+from tafel.core.framework.config import ConfigError
+from tafel.core.framework.manager import Blackboard
 from tafel.platforms.network import GameNetwork, NetworkSettings
 from tafel.representations.game import GameControllerPackets, GameControllerReturn
 from tafel.representations.infrastructure import FrameInfo

@@ -192,7 +192,7 @@ def test_every_panel_of_the_layout_is_placed() -> None:
 
 
 def test_the_programs_log_lines_are_recorded_as_foxglove_logs(tmp_path: Path) -> None:
-    from tafel.core.recording import Recorder
+    from tafel.core.logs.recording import Recorder
     from tafel.tools.cli import foxglove_recording
 
     recorder = Recorder([])

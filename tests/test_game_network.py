@@ -11,7 +11,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from tafel.core.manager import Blackboard
+from tafel.core.framework.manager import Blackboard
 from tafel.platforms.network import GameNetwork, NetworkSettings
 from tafel.representations.game import GameControllerReturn
 from tafel.representations.infrastructure import FrameInfo
@@ -157,7 +157,7 @@ def test_the_network_refuses_what_the_rules_forbid_and_survives_a_taken_port(por
 
 
 def test_bad_game_settings_are_clear_errors() -> None:
-    from tafel.core.config import ConfigError
+    from tafel.core.framework.config import ConfigError
 
     with pytest.raises(ConfigError, match="game.team_number takes 1 to 254"):
         NetworkSettings.from_config({"team_number": 0})

@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tafel.core import Module, ModuleManager, provides, representation
-from tafel.core.handover import HandoverError, LocalChannel, SharedChannel, apply_bundle, make_bundle, snapshot
+from tafel.core.runtime.handover import HandoverError, LocalChannel, SharedChannel, apply_bundle, make_bundle, snapshot
 
 
 @representation
@@ -104,7 +104,7 @@ def test_local_channel_between_threads_never_shows_a_torn_value(sequence: list[i
 
     thread = threading.Thread(target=publish)
     thread.start()
-    from tafel.core.manager import Blackboard
+    from tafel.core.framework.manager import Blackboard
 
     board = Blackboard()
     board.ensure(HoConsistent)

@@ -13,10 +13,10 @@ from pathlib import Path
 
 import pytest
 
-from tafel.core.manager import ModuleManager
-from tafel.core.module import _KNOWN
-from tafel.core.reload import ModuleReloader, ReloadError
-from tafel.core.representation import _REGISTRY
+from tafel.core.framework.manager import ModuleManager
+from tafel.core.framework.module import _KNOWN
+from tafel.core.framework.reload import ModuleReloader, ReloadError
+from tafel.core.framework.representation import _REGISTRY
 from tafel.representations.infrastructure import FrameInfo
 from tests.test_debug_server import Program
 

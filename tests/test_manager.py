@@ -24,7 +24,7 @@ from tafel.core import (
     requires,
     uses,
 )
-from tafel.core.parameters import ParameterError
+from tafel.core.framework.parameters import ParameterError
 
 
 @representation
@@ -409,7 +409,7 @@ class MgrAlwaysFails(Module):
 
 
 def test_a_module_failing_every_frame_logs_its_traceback_once_then_a_line_a_second(caplog, monkeypatch) -> None:
-    import tafel.core.manager as manager_module
+    import tafel.core.framework.manager as manager_module
 
     now = [1000.0]
     monkeypatch.setattr(manager_module.time, "monotonic", lambda: now[0])

@@ -22,7 +22,7 @@ from tafel.core import (
     snake_case,
     uses,
 )
-from tafel.core.access import ArrayFieldError
+from tafel.core.framework.access import ArrayFieldError
 
 
 @dataclasses.dataclass
@@ -207,7 +207,7 @@ def test_read_only_arrays_compute_into_plain_arrays() -> None:
 
 def test_read_only_array_slices_stay_read_only() -> None:
     base = np.arange(6.0)
-    from tafel.core.access import read_only_array
+    from tafel.core.framework.access import read_only_array
 
     view = read_only_array(base, "M", "R", ".f")
     part = view[2:4]

@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tafel.core import Module, bounded, provides, representation, requires, uses
-from tafel.core.representation import fields_of
+from tafel.core.framework.representation import fields_of
 from tafel.core.testing import ModuleHarness, assert_close, differences, replay_module, strategy_for
 from tafel.debug.concepts import STATE, modify, request
 from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tafel.core.status import CognitionStatus
+from tafel.core.runtime.status import CognitionStatus
 from tafel.core.testing import ModuleHarness, assert_close, replay_module, strategy_for
 from tafel.modules.behavior.look_at_ball_behavior import LookAtBallBehavior
 from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler

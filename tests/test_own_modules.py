@@ -81,7 +81,7 @@ def test_the_shipped_representations_import_from_the_package() -> None:
 
 def test_every_registered_representation_is_reachable_from_the_package() -> None:
     import tafel.representations as representations
-    from tafel.core.representation import registered_representations
+    from tafel.core.framework.representation import registered_representations
 
     representations.load_all()
     shipped = {name: cls for name, cls in registered_representations().items() if cls.__module__.startswith("tafel.representations.")}

@@ -7,10 +7,10 @@ from typing import ClassVar
 import pytest
 
 from tafel.core import ConflictingProvidersError, MissingProviderError, Module, UnknownModuleError, provides, requires
-from tafel.core.config import ConfigError
-from tafel.core.platform import Platform
-from tafel.core.program import plan_program
+from tafel.core.framework.config import ConfigError
 from tafel.core.runtime import Limits, LockstepRuntime
+from tafel.core.runtime.platform import Platform
+from tafel.core.runtime.program import plan_program
 from tafel.representations.behavior import HeadMotionRequest
 from tafel.representations.infrastructure import CognitionStatus, FrameInfo
 from tafel.representations.motion import BodyJointTargets, HeadJointTargets, JointCommand, JointSensorData
@@ -128,7 +128,7 @@ def test_lockstep_hands_over_the_newest_complete_value() -> None:
         def execute(self) -> None:
             seen.append((self.head_motion_request.yaw, self.head_motion_request.pitch))
 
-    from tafel.core.program import ContextPlan
+    from tafel.core.runtime.program import ContextPlan
 
     plans = {
         "cognition": ContextPlan("cognition", 30.0, [StampRequest], {}, [], {}, [FrameInfo], [], handover_out=[HeadMotionRequest]),

@@ -18,7 +18,7 @@ from tafel.core import (
     representation,
     values_equal,
 )
-from tafel.core.representation import copy_into, reset
+from tafel.core.framework.representation import copy_into, reset
 
 
 class Color(enum.Enum):

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tafel.core.manager import Blackboard
+from tafel.core.framework.manager import Blackboard
 from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.look_at_ball_behavior import LookAtBallBehavior
 from tafel.modules.communication.game_state_provider import GameStateProvider

@@ -20,9 +20,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tafel.core.config import ConfigError, store_private
-from tafel.core.manager import Blackboard, ModuleManager
-from tafel.core.platform import load_platform
+from tafel.core.framework.config import ConfigError, store_private
+from tafel.core.framework.manager import Blackboard, ModuleManager
+from tafel.core.runtime.platform import load_platform
 from tafel.debug.client import DebugClient
 from tafel.debug.commands import CommandError, ContextDebug
 from tafel.modules.motion.head_motion import HeadMotion
@@ -527,7 +527,7 @@ def test_a_broken_private_configuration_is_an_error_not_a_traceback(tmp_path: Pa
 
 # ------------------------------------------------------------------------------ clients never destroy recordings
 def test_log_start_never_replaces_a_file_but_records_under_the_next_free_name(tmp_path: Path) -> None:
-    from tafel.core.logfile import read_log
+    from tafel.core.logs.logfile import read_log
 
     logs = tmp_path / "logs"
     logs.mkdir()

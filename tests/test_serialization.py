@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tafel.core import array, registered_representations, representation, values_equal
-from tafel.core.serialization import (
+from tafel.core.logs.serialization import (
     SerializationError,
     check_compatible,
     deserialize,

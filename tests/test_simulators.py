@@ -15,7 +15,7 @@ import sys
 import numpy as np
 import pytest
 
-from tafel.core.platform import PlatformOptionError
+from tafel.core.runtime.platform import PlatformOptionError
 from tafel.core.testing import ModuleHarness
 from tafel.modules.motion.camera_matrix_provider import CameraMatrixProvider
 from tafel.modules.perception.ball_detector import BallDetector
@@ -271,7 +271,7 @@ def test_a_ball_can_start_rolling_and_the_sensor_noise_can_be_scaled(engine: str
     ("sensor_noise", "-1", "--sensor-noise takes a factor from 0 to 100"),
 ])
 def test_bad_ball_velocities_and_noise_factors_say_what_would_be_right(option: str, value: str, message: str) -> None:
-    from tafel.core.platform import PlatformOptionError, load_platform
+    from tafel.core.runtime.platform import PlatformOptionError, load_platform
 
     with pytest.raises(PlatformOptionError) as error:
         load_platform("mujoco")({option: value})
@@ -289,7 +289,7 @@ class World:
 
             self.world = MatchWorld([(-1500.0, 0.0)])
         else:
-            from tafel.core.platform import load_platform
+            from tafel.core.runtime.platform import load_platform
 
             self.world = load_platform(engine)({"cameras": "off", "start": "-1500,0,0"})
             self.world.start(frozenset({"motion"}))

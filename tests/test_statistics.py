@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tafel.core.runtime import ContextStats
-from tafel.core.statistics import PeriodStatistics
+from tafel.core.runtime.statistics import PeriodStatistics
 
 
 def test_a_million_samples_take_no_more_room_than_a_thousand() -> None:

@@ -20,12 +20,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from tafel.core.manager import ModuleManager
-from tafel.core.module import Module
-from tafel.core.parameters import ParameterError, make_parameters, parameters_class, set_parameter
-from tafel.core.representation import fields_of, registered_representations
+from tafel.core.framework.manager import ModuleManager
+from tafel.core.framework.module import Module
+from tafel.core.framework.parameters import ParameterError, make_parameters, parameters_class, set_parameter
+from tafel.core.framework.representation import fields_of, registered_representations
+from tafel.core.framework.validation import MAX_MAGNITUDE, ValueCheckError, check_field, check_number
 from tafel.core.testing import ModuleHarness
-from tafel.core.validation import MAX_MAGNITUDE, ValueCheckError, check_field, check_number
 from tafel.debug.commands import CommandError, ContextDebug
 from tafel.debug.protocol import parse
 from tafel.modules.communication.game_state_provider import GameStateProvider

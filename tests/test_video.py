@@ -8,8 +8,8 @@ import cv2
 import numpy as np
 import pytest
 
-from tafel.core.logfile import read_log
-from tafel.core.serialization import deserialize
+from tafel.core.logs.logfile import read_log
+from tafel.core.logs.serialization import deserialize
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.perception import BallImagePercept
 from tests.test_cli_runtime import tafel

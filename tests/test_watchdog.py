@@ -10,7 +10,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from tafel.core.watchdog import ContextStuck, Watchdog
+from tafel.core.runtime.watchdog import ContextStuck, Watchdog
 from tests.test_cli_runtime import dummy, frames
 
 STUCK = "tests.support.runtime_faults:StuckAfter"

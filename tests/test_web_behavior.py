@@ -12,8 +12,8 @@ from typing import Any
 
 import pytest
 
-from tafel.core.logfile import read_log
-from tafel.core.serialization import deserialize
+from tafel.core.logs.logfile import read_log
+from tafel.core.logs.serialization import deserialize
 from tafel.representations.behavior import ActivationGraph
 from tests.support.browser import WebProgram, launch, missing_browser, open_page, wait_for
 from tests.test_web_view import screenshot_dir

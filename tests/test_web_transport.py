@@ -19,8 +19,8 @@ from hypothesis import strategies as st
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
-from tafel.core.manager import ModuleManager
-from tafel.core.representation import registered_representations
+from tafel.core.framework.manager import ModuleManager
+from tafel.core.framework.representation import registered_representations
 from tafel.core.testing import strategy_for
 from tafel.debug.commands import ContextDebug, json_value, merge_answers
 from tafel.debug.protocol import parse

@@ -77,7 +77,7 @@ def parse_teams(text: str) -> tuple[int, int]:
 
 
 def add_match_command(commands: Any) -> None:
-    from tafel.core.platform import seed_number
+    from tafel.core.runtime.platform import seed_number
 
     match = commands.add_parser("match", help="play a simulated game: several robots in MuJoCo, refereed by a simulated GameController")
     match.add_argument("--teams", type=parse_teams, default=(1, 1), metavar="NvM", help="robots per team, 1v1 to 5v5 or e.g. 1v0 (default 1v1)")

@@ -19,26 +19,26 @@ from importlib.metadata import version
 from pathlib import Path
 from typing import Any, NoReturn
 
-from tafel.core import clock
-from tafel.core.blackbox import MAX_MB, SECONDS, BlackBox, conditions_from_config
-from tafel.core.config import check_config, edit_modules, load_config
-from tafel.core.dot import contexts_dot
-from tafel.core.errors import TafelError
-from tafel.core.extensions import load_modules
-from tafel.core.platform import Platform, PlatformError, PlatformOptionError, available_platforms, load_platform
-from tafel.core.program import ContextPlan, plan_program
-from tafel.core.recording import Recorder, select
-from tafel.core.representation import registered_representations
+from tafel.core.framework.config import check_config, edit_modules, load_config
+from tafel.core.framework.dot import contexts_dot
+from tafel.core.framework.errors import TafelError
+from tafel.core.framework.extensions import load_modules
+from tafel.core.framework.representation import registered_representations
+from tafel.core.logs.blackbox import MAX_MB, SECONDS, BlackBox, conditions_from_config
+from tafel.core.logs.recording import Recorder, select
 from tafel.core.runtime import (
     ConcurrentRuntime,
     ContextStats,
     Limits,
     LockstepRuntime,
+    clock,
     install_signal_handlers,
     program_fingerprint,
     recorder_hook,
 )
-from tafel.core.watchdog import STUCK_TIMEOUT_S
+from tafel.core.runtime.platform import Platform, PlatformError, PlatformOptionError, available_platforms, load_platform
+from tafel.core.runtime.program import ContextPlan, plan_program
+from tafel.core.runtime.watchdog import STUCK_TIMEOUT_S
 from tafel.debug.commands import frame_number
 from tafel.tools.arguments import (
     add_console_command,

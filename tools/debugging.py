@@ -18,14 +18,14 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from tafel.core.config import store_private
-from tafel.core.dot import contexts_dot
-from tafel.core.errors import TafelError
-from tafel.core.logfile import LogExistsError
-from tafel.core.manager import ModuleManager
-from tafel.core.program import ContextPlan
-from tafel.core.recording import Recorder
+from tafel.core.framework.config import store_private
+from tafel.core.framework.dot import contexts_dot
+from tafel.core.framework.errors import TafelError
+from tafel.core.framework.manager import ModuleManager
+from tafel.core.logs.logfile import LogExistsError
+from tafel.core.logs.recording import Recorder
 from tafel.core.runtime import ContextRunner
+from tafel.core.runtime.program import ContextPlan
 from tafel.debug.commands import CommandError, ContextDebug, argument
 from tafel.debug.concepts import STATE, DebugDrawings, DebugPlots, ModuleTimes, frame_debug_data
 from tafel.debug.protocol import Command, parse

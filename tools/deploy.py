@@ -34,7 +34,6 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, fields
 from importlib import metadata
 from pathlib import Path
-from typing import Any
 
 #: the shipped configuration (the repository's config/ folder)
 DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "config"
@@ -236,7 +235,7 @@ def copy(robot: Robot, ssh_config: Path | None, staging: Path, dry_run: bool) ->
 def command_deploy(args: argparse.Namespace) -> int:
     robots = load_robots([DEFAULT_CONFIG, *([args.config] if args.config else [])])
     if args.robot not in robots:
-        from tafel.core.naming import did_you_mean
+        from tafel.core.framework.naming import did_you_mean
 
         known = ", ".join(robots) or "none (add [[robots]] tables to robots.toml in your --config folder)"
         print(f"tafel deploy: error: no robot named {args.robot!r}; {did_you_mean(args.robot, robots)}; robots: {known}", file=sys.stderr)

@@ -129,7 +129,7 @@ def worker_feed_setup(runner: Any, args: dict[str, Any]) -> None:
     """Runs in a context process: after each frame, hand over what the viewer's flags ask for.
 
     ``args`` holds ``names`` (the feed's representations by name, in its order), ``flags`` and ``queue``."""
-    from tafel.core.representation import get_representation
+    from tafel.core.framework.representation import get_representation
     from tafel.debug.commands import frame_number
 
     reps = [get_representation(name) for name in args["names"]]

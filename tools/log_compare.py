@@ -19,8 +19,8 @@ from typing import Any
 
 import numpy as np
 
-from tafel.core.logfile import LogError, LogMessage, LogReader
-from tafel.core.naming import did_you_mean
+from tafel.core.framework.naming import did_you_mean
+from tafel.core.logs.logfile import LogError, LogMessage, LogReader
 from tafel.tools.log_tools import message_class, to_python
 
 
@@ -154,7 +154,8 @@ def run_compare(args: argparse.Namespace) -> int:
     try:
         with LogReader(args.first) as first, LogReader(args.second) as second:
             result = compare_logs(first, second, reps, timing=args.timing)
-            skipped = sorted(t for t in set(first.channels) | set(second.channels) if t not in result)
+            skipped = [] if reps else sorted(t for t in set(first.channels) | set(second.channels)
+                                             if t not in result and (is_timing(first, t) or is_timing(second, t)))
             problems = first.problems + second.problems
     except LogError as exc:
         print(f"tafel log compare: error: {exc}", file=sys.stderr)

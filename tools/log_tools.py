@@ -18,8 +18,8 @@ from typing import Any
 import numpy as np
 from google.protobuf import descriptor_pool, message_factory
 
-from tafel.core.logfile import LogError, LogReader, write_slice
-from tafel.core.naming import did_you_mean
+from tafel.core.framework.naming import did_you_mean
+from tafel.core.logs.logfile import LogError, LogReader, write_slice
 
 
 def run_log_command(args: argparse.Namespace) -> int:

@@ -40,7 +40,6 @@ from dataclasses import dataclass, field
 
 from tafel.platforms.match_world import MatchWorld, Side
 from tafel.platforms.network import listening_socket
-from tafel.representations.team import MAX_MESSAGE_BYTES
 from tafel.representations import field as pitch
 from tafel.representations.game import (
     MAX_PLAYERS,
@@ -55,6 +54,7 @@ from tafel.representations.game import (
     decode_return,
     encode_game_state,
 )
+from tafel.representations.team import MAX_MESSAGE_BYTES
 
 PACKET_INTERVAL_S = 0.5
 MESSAGE_BUDGET = 1200  # the rules: team messages per game

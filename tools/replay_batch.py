@@ -24,8 +24,8 @@ from functools import partial
 from pathlib import Path
 from typing import Any
 
-from tafel.core.logfile import LogError, LogReader
-from tafel.core.naming import did_you_mean
+from tafel.core.framework.naming import did_you_mean
+from tafel.core.logs.logfile import LogError, LogReader
 from tafel.tools.batch import BatchError, BatchInfo, run_jobs
 from tafel.tools.log_compare import compare_logs
 from tafel.tools.log_tools import decoded_messages
@@ -80,7 +80,7 @@ def metric_means(path: Path, metrics: Sequence[str]) -> dict[str, float | None]:
 
 def check_metrics(metrics: Sequence[str], logs: Sequence[Path]) -> None:
     """Every ``REP.FIELD`` names a representation some log holds and a field it has; ``ValueError`` otherwise."""
-    from tafel.core.representation import fields_of, get_representation
+    from tafel.core.framework.representation import fields_of, get_representation
     from tafel.tools.cli import discover_modules
 
     if not metrics:

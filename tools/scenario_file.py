@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from tafel.core.config import ConfigError, apply_overrides, check_config
-from tafel.core.naming import did_you_mean
-from tafel.core.representation import fields_of, get_representation
+from tafel.core.framework.config import ConfigError, apply_overrides, check_config
+from tafel.core.framework.naming import did_you_mean
+from tafel.core.framework.representation import fields_of, get_representation
 from tafel.representations.field import BORDER_STRIP, LENGTH, WIDTH
 from tafel.tools.scenario_predicates import PREDICATES, REQUIRED, TIMING, Parameter
 

@@ -209,7 +209,7 @@ def _failure_log(job: Job, row: dict[str, Any]) -> dict[str, Any]:
 
 def warm_up(platforms: Sequence[str] = ("mujoco",)) -> None:
     """Imports, module discovery and the simulators' libraries, once per worker, before the clock starts."""
-    from tafel.core.platform import load_platform
+    from tafel.core.runtime.platform import load_platform
     from tafel.tools.cli import discover_modules
 
     discover_modules()

@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tafel.core.manager import Blackboard, ModuleManager
-from tafel.core.platform import load_platform
+from tafel.core.framework.manager import Blackboard, ModuleManager
+from tafel.core.runtime.platform import load_platform
 from tafel.modules.motion.kinematics import CAMERA_LINKS, angles_by_name, camera_pose_in_torso, link_poses, robot_frame_from_torso
 from tafel.modules.motion.stand_motion import stand_pose
 from tafel.modules.perception.ball_detector import BallDetector

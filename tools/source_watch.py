@@ -3,7 +3,7 @@
 A thread looks at the modification times of the files that define the program's modules twice a
 second; a changed file sends ``module:reload`` for each module it defines through the debug server,
 which routes it to the context that runs the module (in the concurrent runtime: to its process). The
-reload happens at that context's next frame boundary (``tafel.core.reload``), and its answer (or why
+reload happens at that context's next frame boundary (``tafel.core.framework.reload``), and its answer (or why
 it was refused) is printed like a status line.
 """
 

@@ -12,10 +12,10 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from tafel.core.config import edit_modules, load_config
-from tafel.core.platform import load_platform
-from tafel.core.program import plan_program
+from tafel.core.framework.config import edit_modules, load_config
 from tafel.core.runtime import Limits, LockstepRuntime
+from tafel.core.runtime.platform import load_platform
+from tafel.core.runtime.program import plan_program
 from tafel.tools.cli import DEFAULT_CONFIG, discover_modules, program_recorder
 
 

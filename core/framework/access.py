@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from tafel.core.errors import ReadOnlyRepresentationError, TafelError
-from tafel.core.representation import ArraySpec, fields_of
+from tafel.core.framework.errors import ReadOnlyRepresentationError, TafelError
+from tafel.core.framework.representation import ArraySpec, fields_of
 
 
 class ArrayFieldError(TafelError, ValueError):

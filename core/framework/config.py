@@ -36,8 +36,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from tafel.core.errors import TafelError
-from tafel.core.naming import did_you_mean
+from tafel.core.framework.errors import TafelError
+from tafel.core.framework.naming import did_you_mean
 
 CONTEXTS = ("cognition", "motion")
 PRIVATE_FILE = "private/private.toml"

@@ -23,7 +23,7 @@ import traceback
 from collections.abc import Iterable
 from pathlib import Path
 
-from tafel.core.errors import TafelError
+from tafel.core.framework.errors import TafelError
 
 ENTRY_POINT_GROUP = "tafel.modules"
 log = logging.getLogger("tafel.modules")

@@ -10,16 +10,16 @@ import heapq
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
-from tafel.core.errors import (
+from tafel.core.framework.errors import (
     ConflictingProvidersError,
     DependencyCycleError,
     MissingProviderError,
     ModuleDefinitionError,
     UnknownModuleError,
 )
-from tafel.core.module import Module
-from tafel.core.naming import did_you_mean
-from tafel.core.representation import is_representation
+from tafel.core.framework.module import Module
+from tafel.core.framework.naming import did_you_mean
+from tafel.core.framework.representation import is_representation
 
 
 @dataclass

@@ -9,13 +9,13 @@ from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
-from tafel.core.access import AccessMark, read_view, undo_writes, writer_view
-from tafel.core.errors import ModuleDefinitionError, UnknownModuleError
-from tafel.core.graph import Plan, build_plan, module_names, resolve_module
-from tafel.core.module import Module
-from tafel.core.naming import did_you_mean, snake_case
-from tafel.core.parameters import make_parameters
-from tafel.core.representation import reset
+from tafel.core.framework.access import AccessMark, read_view, undo_writes, writer_view
+from tafel.core.framework.errors import ModuleDefinitionError, UnknownModuleError
+from tafel.core.framework.graph import Plan, build_plan, module_names, resolve_module
+from tafel.core.framework.module import Module
+from tafel.core.framework.naming import did_you_mean, snake_case
+from tafel.core.framework.parameters import make_parameters
+from tafel.core.framework.representation import reset
 
 R = TypeVar("R")
 
@@ -350,7 +350,7 @@ class ModuleManager:
 
     def to_dot(self) -> str:
         """Graphviz DOT text of the graph: modules as boxes, representations as ellipses."""
-        from tafel.core.dot import manager_dot
+        from tafel.core.framework.dot import manager_dot
 
         return manager_dot(self.graph())
 

@@ -19,9 +19,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
-from tafel.core.errors import ModuleDefinitionError
-from tafel.core.naming import snake_case
-from tafel.core.representation import is_representation
+from tafel.core.framework.errors import ModuleDefinitionError
+from tafel.core.framework.naming import snake_case
+from tafel.core.framework.representation import is_representation
 
 M = TypeVar("M", bound=type)
 
@@ -121,8 +121,8 @@ def find_module(name: str) -> type:
     name wins); ``tools`` imports the ``modules`` package so that all of them are known. A name of the
     form ``package.module:ClassName`` is imported on demand.
     """
-    from tafel.core.errors import UnknownModuleError
-    from tafel.core.naming import did_you_mean
+    from tafel.core.framework.errors import UnknownModuleError
+    from tafel.core.framework.naming import did_you_mean
 
     if ":" in name:
         import importlib

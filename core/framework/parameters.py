@@ -5,7 +5,7 @@ Values from configuration are checked against the field types, so a typo or a st
 belongs fails at start-up with the field's name instead of misbehaving later.
 
 Every number has a range: the one its field declares (``bounded``), else its type's natural one
-(``tafel.core.validation.natural_range``). A string parameter may declare what it names:
+(``tafel.core.framework.validation.natural_range``). A string parameter may declare what it names:
 
 - ``choice_of(options)``: one of a few words (``GameStateProvider.start_state``), checked like an enum
   wherever a value comes from, so a stored value always loads again;
@@ -24,9 +24,9 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from tafel.core.errors import TafelError
-from tafel.core.naming import did_you_mean
-from tafel.core.validation import ValueCheckError, check_number, declared_range
+from tafel.core.framework.errors import TafelError
+from tafel.core.framework.naming import did_you_mean
+from tafel.core.framework.validation import ValueCheckError, check_number, declared_range
 
 
 class ParameterError(TafelError, ValueError):

@@ -27,9 +27,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from tafel.core.errors import TafelError
-from tafel.core.module import _KNOWN, Module
-from tafel.core.representation import _REGISTRY, fields_of, is_representation
+from tafel.core.framework.errors import TafelError
+from tafel.core.framework.module import _KNOWN, Module
+from tafel.core.framework.representation import _REGISTRY, fields_of, is_representation
 
 log = logging.getLogger("tafel.reload")
 

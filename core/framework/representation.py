@@ -20,7 +20,7 @@ from typing import Any, TypeVar, overload
 
 import numpy as np
 
-from tafel.core.errors import RepresentationDefinitionError
+from tafel.core.framework.errors import RepresentationDefinitionError
 
 T = TypeVar("T")
 
@@ -190,7 +190,7 @@ def get_representation(name: str) -> type:
     try:
         return _REGISTRY[name]
     except KeyError:
-        from tafel.core.naming import did_you_mean
+        from tafel.core.framework.naming import did_you_mean
 
         raise KeyError(f"no representation named {name!r}; {did_you_mean(name, _REGISTRY)}") from None
 

@@ -22,9 +22,9 @@ from typing import Any
 
 import numpy as np
 
-from tafel.core.access import ArrayFieldError, check_array
-from tafel.core.errors import TafelError
-from tafel.core.representation import RANGE_META, FieldInfo, fields_of
+from tafel.core.framework.access import ArrayFieldError, check_array
+from tafel.core.framework.errors import TafelError
+from tafel.core.framework.representation import RANGE_META, FieldInfo, fields_of
 
 __all__ = ["INT_RANGE", "MAX_MAGNITUDE", "ValueCheckError", "check_field", "check_instance", "check_number", "declared_range",
            "natural_range"]
@@ -91,7 +91,7 @@ def check_field(owner: type, name: str, value: Any, where: str = "") -> Any:
     """``value`` converted to field ``name`` of the dataclass ``owner``, checked; raises ``ValueCheckError``."""
     infos = {info.name: info for info in fields_of(owner)}
     if name not in infos:
-        from tafel.core.naming import did_you_mean
+        from tafel.core.framework.naming import did_you_mean
 
         raise ValueCheckError(f"{owner.__name__} has no field {name!r}; {did_you_mean(name, infos)}")
     return _check(infos[name], value, where or f"{owner.__name__}.{name}")

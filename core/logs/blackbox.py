@@ -27,9 +27,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from tafel.core.config import ConfigError
-from tafel.core.logfile import LogWriter
-from tafel.core.serialization import deserialize
+from tafel.core.framework.config import ConfigError
+from tafel.core.logs.logfile import LogWriter
+from tafel.core.logs.serialization import deserialize
 
 log = logging.getLogger("tafel.blackbox")
 

@@ -40,8 +40,8 @@ from mcap.opcode import Opcode
 from mcap.records import Channel, ChunkIndex, Header, Metadata, MetadataIndex, Schema, Statistics
 from mcap.writer import CompressionType, Writer
 
-from tafel.core.errors import TafelError
-from tafel.core.serialization import file_descriptor_set, message_name
+from tafel.core.framework.errors import TafelError
+from tafel.core.logs.serialization import file_descriptor_set, message_name
 
 PROFILE = "tafel"
 MAGIC = b"\x89MCAP0\r\n"
@@ -817,13 +817,13 @@ def write_slice(source: str | Path, target: str | Path, *, representations: Iter
     from before wall-clock log times gets them: its frame times moved to end when the file was last
     written. Returns messages per topic. Raises ``LogError`` when nothing would be copied.
     """
-    from tafel.core.representation import get_representation
+    from tafel.core.framework.representation import get_representation
 
     wanted = set(representations) if representations else None
     with LogReader(source) as reader:
         topics = [t for t, c in reader.channels.items() if wanted is None or c.representation in wanted]
         if wanted is not None and (unknown := wanted - {reader.channels[t].representation for t in topics}):
-            from tafel.core.naming import did_you_mean
+            from tafel.core.framework.naming import did_you_mean
 
             names = sorted({c.representation for c in reader.channels.values()})
             name = sorted(unknown)[0]

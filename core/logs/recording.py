@@ -13,15 +13,17 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
-from tafel.core.errors import UnknownModuleError
-from tafel.core.logfile import LogWriter, Translate
-from tafel.core.manager import Blackboard
-from tafel.core.naming import did_you_mean
-from tafel.core.program import ContextPlan
-from tafel.core.representation import is_state
-from tafel.core.serialization import SerializationError, serialize
+from tafel.core.framework.errors import UnknownModuleError
+from tafel.core.framework.manager import Blackboard
+from tafel.core.framework.naming import did_you_mean
+from tafel.core.framework.representation import is_state
+from tafel.core.logs.logfile import LogWriter, Translate
+from tafel.core.logs.serialization import SerializationError, serialize
+
+if TYPE_CHECKING:  # plans only for their type: logs sit below the runtime
+    from tafel.core.runtime.program import ContextPlan
 
 #: the name that selects every representation of the program
 ALL = "all"

@@ -29,8 +29,8 @@ import numpy as np
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
 from google.protobuf.unknown_fields import UnknownFieldSet
 
-from tafel.core.errors import TafelError
-from tafel.core.representation import FieldInfo, fields_of
+from tafel.core.framework.errors import TafelError
+from tafel.core.framework.representation import FieldInfo, fields_of
 
 PACKAGE = "tafel"
 MAX_FIELD_NUMBER = 536_870_911

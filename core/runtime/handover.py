@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from tafel.core.errors import TafelError
-from tafel.core.manager import Blackboard
+from tafel.core.framework.errors import TafelError
+from tafel.core.framework.manager import Blackboard
 
 log = logging.getLogger("tafel.handover")
 

@@ -22,9 +22,9 @@ from collections.abc import Mapping
 from importlib.metadata import entry_points
 from typing import Any, ClassVar
 
-from tafel.core.errors import TafelError, UnknownModuleError
-from tafel.core.manager import Blackboard
-from tafel.core.naming import did_you_mean
+from tafel.core.framework.errors import TafelError, UnknownModuleError
+from tafel.core.framework.manager import Blackboard
+from tafel.core.framework.naming import did_you_mean
 
 ENTRY_POINT_GROUP = "tafel.platforms"
 

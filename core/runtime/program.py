@@ -13,13 +13,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from tafel.core.config import CONTEXTS, ConfigError, context_section
-from tafel.core.errors import ConflictingProvidersError, MissingProviderError
-from tafel.core.graph import build_plan
-from tafel.core.manager import ModuleManager
-from tafel.core.module import find_module
-from tafel.core.platform import Platform
-from tafel.core.status import CognitionStatus
+from tafel.core.framework.config import CONTEXTS, ConfigError, context_section
+from tafel.core.framework.errors import ConflictingProvidersError, MissingProviderError
+from tafel.core.framework.graph import build_plan
+from tafel.core.framework.manager import ModuleManager
+from tafel.core.framework.module import find_module
+from tafel.core.runtime.platform import Platform
+from tafel.core.runtime.status import CognitionStatus
 
 DEFAULT_RATES = {"cognition": 30.0, "motion": 100.0}
 
@@ -176,7 +176,7 @@ def _check_missing_providers(plans: Mapping[str, ContextPlan], platform: type[Pl
 
 def _provided_by_any_platform(current: type[Platform] | Platform) -> set[str]:
     """Names of the representations that some registered platform provides (platforms load lazily)."""
-    from tafel.core.platform import available_platforms
+    from tafel.core.runtime.platform import available_platforms
 
     names = {r.__name__ for reps in current.provides.values() for r in reps}
     for entry in available_platforms().values():

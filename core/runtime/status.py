@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from tafel.core.representation import representation
+from tafel.core.framework.representation import representation
 
 
 @representation

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from tafel.core import Module, bounded, provides, requires, uses
-from tafel.core.parameters import choice_of
+from tafel.core.framework.parameters import choice_of
 from tafel.representations.game import (
     MAX_PLAYERS,
     GameControllerPackets,

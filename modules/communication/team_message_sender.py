@@ -62,7 +62,7 @@ class TeamMessageSender(Module):
 
     def execute(self) -> None:
         game, out, now = self.game_state, self.outgoing_team_message, self.frame_info.time_s
-        p, ball = self.parameters, self.ball_model
+        ball = self.ball_model
         if ball.valid:
             self.ball_seen_s = now - ball.time_since_seen
         out.data = b""

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tafel.core import Module, provides, requires
-from tafel.core.parameters import folder_within
+from tafel.core.framework.parameters import folder_within
 from tafel.modules.motion.keyframes import SHIPPED_MOTIONS, KeyframeMotion, MotionFileError, load_motion
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import InertialSensorData, JointSensorData

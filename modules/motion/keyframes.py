@@ -130,7 +130,7 @@ def _keyframe(path: Path, index: int, frame: object) -> Keyframe:
     targets = {}
     for name, angle in joints.items():
         if name not in JOINT_INDEX:
-            from tafel.core.naming import did_you_mean
+            from tafel.core.framework.naming import did_you_mean
 
             raise MotionFileError(f"{where}: unknown joint {name!r}; {did_you_mean(name, JOINT_NAMES)}")
         if isinstance(angle, bool) or not isinstance(angle, (int, float)) or not math.isfinite(angle):

@@ -62,7 +62,7 @@ def is_image(value: Any) -> bool:
 
 
 def image_canvas(topic: str) -> str:
-    """The drawing canvas of a camera image topic: ``CameraImageTop`` -> ``image:top``."""
+    """The drawing canvas of a camera image topic: the top camera's image -> ``image:top``."""
     return "image:" + topic.removeprefix("CameraImage").lower()
 
 
