@@ -14,10 +14,10 @@ from tafel.core import ModuleManager
 from tafel.core.testing import ModuleHarness
 from tafel.debug.commands import ContextDebug, pretty
 from tafel.debug.concepts import STATE, frame_debug_data
+from tafel.debug.executors import RateMeter, instrument
 from tafel.debug.protocol import parse
 from tafel.representations.infrastructure import FrameInfo
 from tafel.tools.console import Completer
-from tafel.tools.debugging import RateMeter, instrument
 from tests.support.debug_user import DRAW, DebugUser, DebugUserOutput
 from tests.test_debug_server import Program
 

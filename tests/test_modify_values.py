@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from tafel.core.testing import ModuleHarness
 from tafel.debug.commands import ContextDebug
+from tafel.debug.executors import RateMeter, instrument
 from tafel.debug.protocol import parse
 from tafel.modules.behavior.striker import Striker
 from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler
@@ -12,7 +13,6 @@ from tafel.modules.motion.walking_engine import WalkingEngine
 from tafel.representations.modeling import BallModel
 from tafel.representations.motion_control import MotionRequest, MotionSelection, MotionType, Odometry, WalkingEngineOutput
 from tafel.representations.perception import BallPercept
-from tafel.tools.debugging import RateMeter, instrument
 
 
 def client(harness: ModuleHarness, context: str) -> ContextDebug:

@@ -23,6 +23,7 @@ from tafel.core.framework.manager import ModuleManager
 from tafel.core.framework.representation import registered_representations
 from tafel.core.testing import strategy_for
 from tafel.debug.commands import ContextDebug, json_value, merge_answers
+from tafel.debug.executors import LocalExecutor
 from tafel.debug.protocol import parse
 from tafel.debug.server import DebugRouter, DebugServer
 from tafel.debug.websocket import WebServer, WebSocketSession, host_allowed
@@ -32,7 +33,6 @@ from tafel.representations import load_all
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel
 from tafel.representations.perception import BallPercept, CameraImageTop
-from tafel.tools.debugging import LocalExecutor
 from tafel.tools.live_feed import LiveFeed
 
 load_all()

@@ -40,6 +40,15 @@ from tafel.core.runtime.platform import Platform, PlatformError, PlatformOptionE
 from tafel.core.runtime.program import ContextPlan, plan_program
 from tafel.core.runtime.watchdog import STUCK_TIMEOUT_S
 from tafel.debug.commands import frame_number
+from tafel.debug.executors import (
+    DEBUG_REPRESENTATIONS,
+    LocalExecutor,
+    RemoteExecutor,
+    concurrent_pipes,
+    context_debug,
+    worker_debug_setup,
+    worker_setups,
+)
 from tafel.tools.arguments import (
     add_console_command,
     add_deploy_commands,
@@ -52,17 +61,7 @@ from tafel.tools.arguments import (
     port_number,
     positive,
 )
-from tafel.tools.debugging import (
-    DEBUG_REPRESENTATIONS,
-    LocalExecutor,
-    ProgramDebug,
-    RemoteExecutor,
-    concurrent_pipes,
-    context_debug,
-    handovers_of,
-    worker_debug_setup,
-    worker_setups,
-)
+from tafel.tools.debugging import ProgramDebug, handovers_of
 from tafel.tools.live_feed import forward
 
 #: the default configuration, shipped inside the package (the repository's config/ folder)
