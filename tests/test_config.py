@@ -166,3 +166,18 @@ def test_wrong_module_edits_are_errors_that_say_what_would_be_right(layered: Pat
     write(layered / "robot" / "nao1.toml", text)
     with pytest.raises(ConfigError, match=message):
         load_config(layered, "sim", "nao1")
+
+
+def test_store_private_keeps_the_users_comments_and_layout(tmp_path: Path) -> None:
+    """The private layer is the user's file: a stored value changes that value and nothing else."""
+    private = tmp_path / "private" / "private.toml"
+    text = ('# my robot at home: the carpet is slippery\n[parameters.WalkingEngine]\nodometry_scale = 0.9  # measured 2026-11-20\n\n'
+            '[cognition]\ndisabled = ["GoalPostDetector"]   # no goals in the lab\n')
+    write(private, text)
+    store_private(tmp_path, ["parameters", "HeadMotion", "max_speed"], 2.5)
+    store_private(tmp_path, ["parameters", "WalkingEngine", "odometry_scale"], 0.92)
+    after = private.read_text()
+    for kept in ("# my robot at home: the carpet is slippery", "# measured 2026-11-20", "# no goals in the lab"):
+        assert kept in after
+    assert tomllib.loads(after) == {"parameters": {"WalkingEngine": {"odometry_scale": 0.92}, "HeadMotion": {"max_speed": 2.5}},
+                                    "cognition": {"disabled": ["GoalPostDetector"]}}

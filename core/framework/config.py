@@ -36,6 +36,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+import tomlkit
+
 from tafel.core.framework.errors import TafelError
 from tafel.core.framework.naming import did_you_mean
 
@@ -334,23 +336,36 @@ def context_section(config: Mapping[str, Any], context: str) -> dict[str, Any]:
 
 
 def store_private(config_dir: Path, path: list[str], value: Any) -> Path:
-    """Write one value into the private layer (``config/private/private.toml``), keeping the rest."""
+    """Write one value into the private layer (``config/private/private.toml``), keeping the rest of the
+    file as the user wrote it: comments, order and layout stay (tomlkit edits the document in place)."""
     target = config_dir / PRIVATE_FILE
-    data = read_toml(target) if target.is_file() else {}
-    node = data
+    before = target.read_text(encoding="utf-8") if target.is_file() else ""
+    read_toml(target) if target.is_file() else None  # a broken file is reported as any layer is
+    document = tomlkit.parse(before)
+    node: Any = document
     for part in path[:-1]:
-        node = node.setdefault(part, {})
-    node[path[-1]] = value
-    text = dump_toml(data)
+        if part not in node or not isinstance(node[part], Mapping):
+            node[part] = tomlkit.table()
+        node = node[part]
+    if _has_nan(value):
+        raise ConfigError(f"cannot store {'.'.join(path)} = {value!r}: TOML configuration holds finite numbers only")
+    try:
+        node[path[-1]] = value
+    except (TypeError, ValueError) as exc:
+        raise ConfigError(f"cannot store {'.'.join(path)} = {value!r} in TOML ({exc})") from None
+    text = tomlkit.dumps(document)
     try:  # never write what would not load again: the next start would fail on it
         loaded = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"cannot store {'.'.join(path)} = {value!r}: it would not read back as TOML ({exc})") from None
-    if loaded != data or _has_nan(loaded):
+    stored: Any = loaded
+    for part in path:
+        stored = stored[part]
+    if stored != (list(value) if isinstance(value, tuple) else value):
         raise ConfigError(f"cannot store {'.'.join(path)} = {value!r}: it would not read back as the same value")
     target.parent.mkdir(parents=True, exist_ok=True)
     temporary = target.with_name(target.name + ".tmp")
-    temporary.write_text(text)
+    temporary.write_text(text, encoding="utf-8")
     temporary.replace(target)  # whole or not at all, also when the disk is full or the program dies
     return target
 
@@ -365,45 +380,6 @@ def _has_nan(value: Any) -> bool:
     return False
 
 
-def dump_toml(data: Mapping[str, Any], prefix: str = "") -> str:
-    """Minimal TOML writer for configuration data (tables, strings, numbers, booleans, lists)."""
-    lines: list[str] = []
-    tables = []
-    for key, value in data.items():
-        if isinstance(value, Mapping):
-            tables.append((key, value))
-        else:
-            lines.append(f"{_key(key)} = {_value(value)}")
-    text = "\n".join(lines) + ("\n" if lines else "")
-    for key, value in tables:
-        name = f"{prefix}.{_key(key)}" if prefix else _key(key)
-        body = dump_toml(value, name)
-        text += f"\n[{name}]\n{body}" if any(not isinstance(v, Mapping) for v in value.values()) or not value else body
-    return text
-
-
-_ESCAPES = {'"': '\\"', "\\": "\\\\", "\b": "\\b", "\t": "\\t", "\n": "\\n", "\f": "\\f", "\r": "\\r"}
-
-
-def _escape(ch: str) -> str:
-    if ch in _ESCAPES:
-        return _ESCAPES[ch]
-    if ord(ch) < 0x20 or ord(ch) == 0x7F:
-        return f"\\u{ord(ch):04x}"
-    return ch
-
-
-def _key(key: str) -> str:
-    return key if key.replace("_", "").replace("-", "").isalnum() else _value(key)
-
-
-def _value(value: Any) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, (int, float)):
-        return repr(value)
-    if isinstance(value, str):
-        return '"' + "".join(_escape(ch) for ch in value) + '"'
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(_value(v) for v in value) + "]"
-    raise ConfigError(f"cannot store {value!r} in TOML")
+def dump_toml(data: Mapping[str, Any]) -> str:
+    """Configuration data as TOML text (tomlkit)."""
+    return tomlkit.dumps(data)
