@@ -1,7 +1,8 @@
 """Loop rates of the default simulation (MuJoCo, both cameras, speed 1) without and during the attack.
 
 The attack is the security issues': 20 clients pipelining commands, one streaming 50 MB without
-newlines, 40 connections over the limit of 32, an HTTP POST, and one with a request line over 64 KiB. Rates are the program's own, from its
+newlines, 40 connections over the limit of 32, an HTTP POST, one with a request line over 64 KiB, a page
+of another site and a DNS-rebinding host at the Foxglove server, and two log bombs read beside it. Rates are the program's own, from its
 status line (one a second); the baseline is measured in the same run, just before the attack.
 
     python benchmarks/debug_attack.py [--seconds 10]
@@ -27,6 +28,8 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
 from tests.support.attack import Attack, status_rates  # noqa: E402
+from tests.support.mcap_files import cpu_bomb, memory_bomb  # noqa: E402
+from tests.support.ssh_server import free_port  # noqa: E402
 
 
 def main() -> None:
@@ -36,8 +39,11 @@ def main() -> None:
     folder = Path(tempfile.mkdtemp(prefix="tafel-attack-"))
     victim = folder / "victim.txt"
     victim.write_text("precious\n")
+    bombs = Path(tempfile.mkdtemp(prefix="tafel-bombs-"))
+    foxglove_port = free_port()
     process = subprocess.Popen(
-        [sys.executable, "-m", "tafel.tools.cli", "run", "--platform", "mujoco", "--debug-port", "0", "--status-interval", "1"],
+        [sys.executable, "-m", "tafel.tools.cli", "run", "--platform", "mujoco", "--debug-port", "0", "--status-interval", "1",
+         "--foxglove", f"127.0.0.1:{foxglove_port}"],
         cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(REPO)})
     port = int(re.search(r":(\d+)", process.stdout.readline()).group(1))
     lines: list[str] = []
@@ -48,7 +54,8 @@ def main() -> None:
         start = len(lines)
         time.sleep(args.seconds)
         without = status_rates(lines[start + 1:])
-        attack = Attack("127.0.0.1", port, http_victim=str(victim))
+        attack = Attack("127.0.0.1", port, http_victim=str(victim), foxglove_port=foxglove_port,
+                        bombs=[memory_bomb(bombs / "memory.mcap"), cpu_bomb(bombs / "cpu.mcap")])
         started = time.perf_counter()
         attack.start()
         start = len(lines)
@@ -71,7 +78,8 @@ def main() -> None:
         "attack": {"pipelined_answers": report.answers, "answers_per_s": round(report.answers / attack_s),
                    "streamed_mb": round(report.streamed_bytes / 2**20, 1), "refused_over_limit": report.refused,
                    "over_limit_left_open": report.over_limit_open, "http_post_answered": report.http_answered,
-                   "long_http_post_answered": report.long_http_answered,
+                   "long_http_post_answered": report.long_http_answered, "foxglove_foreign_pages": report.foxglove,
+                   "log_bombs_exit_and_peak_mb": [[code, round(mb, 1)] for code, mb in report.bombs],
                    "client_errors": report.errors[:3]},
         "victim_unchanged": victim.read_text() == "precious\n",
         "files_in_working_folder": sorted(p.name for p in folder.iterdir()),

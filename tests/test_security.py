@@ -32,6 +32,8 @@ from tafel.representations.behavior import HeadMotionRequest
 from tafel.representations.infrastructure import CognitionStatus, FrameInfo
 from tafel.representations.motion import JOINT_COUNT, JointCommand, JointSensorData, LedRequest
 from tests.support.attack import Attack, rates_during
+from tests.support.mcap_files import cpu_bomb, memory_bomb
+from tests.support.ssh_server import free_port as free_tcp_port
 from tests.test_cli_runtime import REPO, TAFEL, tafel
 from tests.test_debug_server import DEBUG_USER, Program
 
@@ -467,15 +469,20 @@ def test_a_closed_standard_output_does_not_stop_the_program(tmp_path: Path) -> N
 @pytest.mark.slow
 def test_the_default_simulation_holds_its_rates_under_every_attack_at_once(tmp_path: Path) -> None:
     """20 clients pipelining, one streaming 50 MB without newlines, 40 connections over the limit, an
-    HTTP POST and one with a request line over 64 KiB: motion keeps 95 Hz and cognition 28 Hz by the program's own count in every second but
+    HTTP POST and one with a request line over 64 KiB, pages of other sites at the Foxglove server, and
+    two log bombs read beside the program: motion keeps 95 Hz and cognition 28 Hz by the program's own count in every second but
     the slowest one (a lone hiccup of a loaded machine is not the attack's doing; a sustained slowdown
     is), no file changes."""
     victim = tmp_path / "victim.txt"
     victim.write_text("precious\n")
-    running = Program("--platform", "mujoco", "--status-interval", "1", cwd=tmp_path)
+    bombs = tmp_path.parent / f"{tmp_path.name}-bombs"
+    bombs.mkdir()
+    foxglove_port = free_tcp_port()
+    running = Program("--platform", "mujoco", "--status-interval", "1", "--foxglove", f"127.0.0.1:{foxglove_port}", cwd=tmp_path)
     try:
         time.sleep(3.0)  # the robot stands up, the cameras render
-        attack = Attack(running.host, running.port, http_victim=str(victim), limit=32)
+        attack = Attack(running.host, running.port, http_victim=str(victim), limit=32, foxglove_port=foxglove_port,
+                        bombs=[memory_bomb(bombs / "memory.mcap"), cpu_bomb(bombs / "cpu.mcap")])
         attack.start()
         during = rates_during(running.errors, 8.0, forgive=1)  # over 7 seconds, the second slowest
         report = attack.stop()
@@ -488,6 +495,9 @@ def test_the_default_simulation_holds_its_rates_under_every_attack_at_once(tmp_p
     assert report.answers > 1000 and report.streamed_bytes >= 50 << 20, report
     assert report.refused == 40 and report.over_limit_open == 0, report
     assert not report.http_answered and not report.long_http_answered, report
+    assert set(report.foxglove) == {"foreign_origin", "rebinding_host"}, report
+    assert all(answer.startswith("refused 4") for answer in report.foxglove.values()), report  # before the handshake ends
+    assert len(report.bombs) == 2 and all(code == 0 and peak_mb < 200 for code, peak_mb in report.bombs), report
     assert victim.read_text() == "precious\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["victim.txt"]  # nothing was written anywhere else
 

@@ -3,16 +3,22 @@
 All at once against one running program on loopback: clients pipelining commands, one client
 streaming bytes without a newline, connections beyond the limit, an HTTP POST whose body would
 record over a file, and one whose request line is longer than a command line may be (it once arrived
-as "too long" and its body ran). Every loop is bounded in count and time, and everything stops by itself.
+as "too long" and its body ran); with a Foxglove server, a page of another site and a DNS-rebinding
+host asking for its WebSocket; and log bombs read beside the program. Every loop is bounded in count
+and time, and everything stops by itself.
 """
 
 from __future__ import annotations
 
 import re
 import socket
+import subprocess
+import sys
 import threading
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 
 #: commands the pipelining clients send, round and round
 PIPELINED = ("ping", "modules:list", "representation:print FrameInfo", "stopwatch:list", "debug_request:list", "help")
@@ -26,6 +32,11 @@ class AttackReport:
     over_limit_open: int = 0  # connections over the limit that stayed open (should be none)
     http_answered: bool = False  # the POST got anything back (it should not)
     long_http_answered: bool = False  # the POST with a request line over 64 KiB got anything back (it should not)
+    #: a page of another origin and a DNS-rebinding host asking the Foxglove server for a WebSocket: how each
+    #: was answered ("refused 403" and the like; "connected" would be a hole); empty without a Foxglove server
+    foxglove: dict[str, str] = field(default_factory=dict)
+    #: each log bomb read by ``tafel log info`` while the attack ran: exit status and peak memory (MB)
+    bombs: list[tuple[int, float]] = field(default_factory=list)
     errors: list[str] = field(default_factory=list)
 
 
@@ -33,8 +44,11 @@ class Attack:
     """Start with ``start()``, end with ``stop()``, which returns what happened."""
 
     def __init__(self, host: str, port: int, *, pipelining_clients: int = 20, stream_bytes: int = 50 << 20,
-                 extra_connections: int = 40, limit: int = 32, http_victim: str = "/tmp/tafel-attack-victim.txt") -> None:
+                 extra_connections: int = 40, limit: int = 32, http_victim: str = "/tmp/tafel-attack-victim.txt",
+                 foxglove_port: int | None = None, bombs: Sequence[Path] = ()) -> None:
         self.host, self.port = host, port
+        self.foxglove_port = foxglove_port
+        self.bombs = list(bombs)
         self.pipelining_clients = pipelining_clients
         self.stream_bytes = stream_bytes
         self.extra_connections = extra_connections
@@ -58,6 +72,12 @@ class Attack:
         time.sleep(0.5)  # the attack's own clients are in
         self._http_post()
         self._long_http_post()
+        if self.foxglove_port is not None:
+            self._foreign_foxglove_clients()
+        for bomb in self.bombs:
+            thread = threading.Thread(target=self._read_bomb, args=(bomb,), daemon=True)
+            thread.start()
+            self._threads.append(thread)
         self._fill_to_limit(self.limit - self.pipelining_clients - 1)
         self._over_limit()
 
@@ -172,6 +192,37 @@ class Attack:
                     pass  # reset while sending or reading: closed, as it should be
         except OSError as exc:
             self.report.errors.append(f"long http client: {exc}")
+
+
+    def _foreign_foxglove_clients(self) -> None:
+        """A page of another site, and a page that rebinds its DNS name to 127.0.0.1, asking for the Foxglove
+        server's WebSocket (which runs /tafel/command): both must be refused before the handshake ends."""
+        from websockets.exceptions import InvalidStatus
+        from websockets.sync.client import connect
+
+        url = f"ws://{self.host}:{self.foxglove_port}/"
+        for name, headers in (("foreign_origin", {"Origin": "http://evil.example"}),
+                              ("rebinding_host", {"Host": f"evil.example:{self.foxglove_port}", "Origin": f"http://evil.example:{self.foxglove_port}"})):
+            try:
+                with connect(url, subprotocols=["foxglove.sdk.v1"], additional_headers=headers, open_timeout=5):
+                    self.report.foxglove[name] = "connected"
+            except InvalidStatus as exc:
+                self.report.foxglove[name] = f"refused {exc.response.status_code}"
+            except (OSError, TimeoutError) as exc:
+                self.report.foxglove[name] = f"closed ({type(exc).__name__})"
+
+    def _read_bomb(self, bomb: Path) -> None:
+        """``tafel log info`` on a log bomb, beside the program: it must not take the machine's memory."""
+        script = ("import resource, subprocess, sys; r = subprocess.run([sys.executable, '-m', 'tafel.tools.cli', 'log', 'info', "
+                  f"{str(bomb)!r}], capture_output=True); "
+                  "print(r.returncode, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)")
+        try:
+            done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+            code, peak_kb = done.stdout.split()
+            with self._lock:
+                self.report.bombs.append((int(code), int(peak_kb) / 1024))
+        except (subprocess.TimeoutExpired, ValueError) as exc:
+            self.report.errors.append(f"bomb {bomb.name}: {exc}")
 
 
 STATUS_RATE = re.compile(r"(cognition|motion) ([\d.]+) Hz")
