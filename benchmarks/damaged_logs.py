@@ -28,7 +28,7 @@ from typing import Any
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
-from tafel.core.logs.logfile import LogReader  # noqa: E402
+from tafel.core.logs import LogReader  # noqa: E402
 from tests.support.mcap_files import cpu_bomb, flip_offsets, flipped, memory_bomb  # noqa: E402
 
 TAFEL = [sys.executable, "-m", "tafel.tools.cli"]

@@ -24,7 +24,7 @@ from tafel.core.framework.errors import TafelError
 from tafel.core.framework.manager import Blackboard
 from tafel.core.framework.naming import did_you_mean
 from tafel.core.framework.representation import get_representation
-from tafel.core.logs.logfile import LogReader
+from tafel.core.logs import LogReader
 from tafel.core.logs.serialization import SerializationError, check_compatible, codec
 from tafel.core.runtime.platform import EndOfData, Platform, PlatformError, PlatformOptionError
 from tafel.representations import load_all

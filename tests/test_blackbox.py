@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 
 from tafel.core.framework.config import ConfigError
+from tafel.core.logs import read_log
 from tafel.core.logs.blackbox import BlackBox, Condition, conditions_from_config
-from tafel.core.logs.logfile import read_log
 from tafel.core.logs.serialization import serialize
 from tafel.representations.game import GameState, Penalty
 from tafel.representations.infrastructure import FrameInfo

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tafel.core.logs.logfile import read_log
+from tafel.core.logs import read_log
 from tafel.core.runtime import clock
 from tafel.core.testing import ModuleHarness
 from tafel.modules.motion.camera_matrix_buffer_provider import CameraMatrixBufferProvider

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from tafel.core.logs.logfile import read_log
+from tafel.core.logs import read_log
 from tests.test_cli_runtime import REPO, TAFEL, frames
 
 USER_MODULE = textwrap.dedent('''

@@ -171,7 +171,7 @@ def test_console_ctrl_c_clears_the_line_and_ctrl_d_leaves() -> None:
 
 
 def test_debug_data_is_recorded_like_representations(tmp_path) -> None:
-    from tafel.core.logs.logfile import read_log
+    from tafel.core.logs import read_log
     from tafel.core.logs.serialization import deserialize
     from tafel.debug.concepts import DebugPlots
     from tests.test_cli_runtime import tafel

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from tafel.core.logs.logfile import read_log
+from tafel.core.logs import read_log
 from tafel.core.logs.serialization import deserialize
 from tafel.debug.client import DebugClient
 from tafel.debug.server import DebugRouter, DebugServer

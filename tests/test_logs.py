@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from tafel.core import array, representation
-from tafel.core.logs.logfile import LogWriter, read_log
+from tafel.core.logs import LogWriter, read_log
 from tafel.core.logs.serialization import serialize
 from tafel.core.runtime.platform import PlatformError, PlatformOptionError
 from tafel.platforms.log import LogPlatform
@@ -291,7 +291,7 @@ def test_good_magic_and_garbage_after_is_an_error_naming_file_and_byte(tmp_path:
 
 @pytest.mark.slow
 def test_a_damaged_chunk_in_the_middle_is_skipped_and_the_rest_is_read(recorded: Path, tmp_path: Path) -> None:
-    from tafel.core.logs.logfile import LogReader
+    from tafel.core.logs import LogReader
 
     with LogReader(recorded) as reader:
         chunks = list(reader.chunks)
@@ -313,7 +313,7 @@ def test_a_damaged_chunk_in_the_middle_is_skipped_and_the_rest_is_read(recorded:
 
 
 def test_chunks_hold_at_most_one_second_of_log_time_at_any_speed(recorded: Path) -> None:
-    from tafel.core.logs.logfile import CHUNK_SPAN_NS, LogReader
+    from tafel.core.logs import CHUNK_SPAN_NS, LogReader
 
     with LogReader(recorded) as reader:  # recorded at --speed max: 6 s of log time in well under a second
         spans = [c.end_ns - c.start_ns for c in reader.chunks]
@@ -389,7 +389,7 @@ def test_a_chunk_claiming_gigabytes_is_refused_unread_by_every_log_command(recor
 
 def test_a_chunk_of_zero_bytes_is_refused_at_its_first_record_and_the_next_chunk_is_read(tmp_path: Path) -> None:
     """8 MiB of zeros are 900,000 empty records of opcode 0, which the mcap library walks one by one (the CPU bomb)."""
-    from tafel.core.logs.logfile import LogReader
+    from tafel.core.logs import LogReader
 
     path = cpu_bomb(tmp_path / "cpu.mcap", claimed=8 << 20)
     with LogReader(path) as reader:
@@ -399,7 +399,7 @@ def test_a_chunk_of_zero_bytes_is_refused_at_its_first_record_and_the_next_chunk
 
 
 def test_a_chunk_that_claims_more_than_its_compression_can_hold_is_refused(tmp_path: Path) -> None:
-    from tafel.core.logs.logfile import LogReader
+    from tafel.core.logs import LogReader
 
     claimed = 4 << 20
     honest = zstd_rle(claimed)
@@ -413,7 +413,7 @@ def test_a_chunk_that_claims_more_than_its_compression_can_hold_is_refused(tmp_p
 
 def _chunk_extents(path: Path) -> list[tuple[int, int, int]]:
     """(first byte, end, messages) of every chunk record of an intact recording."""
-    from tafel.core.logs.logfile import LogReader
+    from tafel.core.logs import LogReader
 
     data = path.read_bytes()
     with LogReader(path) as reader:
@@ -425,7 +425,7 @@ def _chunk_extents(path: Path) -> list[tuple[int, int, int]]:
 
 
 def _survivors(data: bytes, tmp_path: Path) -> tuple[int, list[str]]:
-    from tafel.core.logs.logfile import LogReader
+    from tafel.core.logs import LogReader
 
     damaged = tmp_path / "flipped.mcap"
     damaged.write_bytes(data)

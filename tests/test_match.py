@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from tafel.core.logs.logfile import LogReader
+from tafel.core.logs import LogReader
 from tafel.tools.log_tools import decoded_messages
 
 REPO = Path(__file__).resolve().parent.parent

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tafel.core.logs.logfile import read_log
+from tafel.core.logs import read_log
 from tafel.core.logs.serialization import deserialize
 from tafel.platforms.nao import CROUCH, LolaProtocolError, battery_data, convert_inertial, crouch_pose, parse_sensors
 from tafel.representations.motion import JOINT_INDEX, BatteryData, FsrData, InertialSensorData, TouchSensorData

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tafel.core.logs.logfile import LogReader
+from tafel.core.logs import LogReader
 from tafel.tools.log_compare import compare_logs, field_differences
 from tests.test_cli_runtime import dummy, tafel
 

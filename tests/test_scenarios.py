@@ -16,7 +16,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tafel.core.logs.logfile import LogReader
+from tafel.core.logs import LogReader
 from tafel.tools.batch import BatchInfo, run_jobs
 from tafel.tools.scenario_file import ScenarioError, load_scenario
 from tafel.tools.scenarios import _Judge, perturbed_start, run_seed, summarize, wilson_interval

@@ -537,7 +537,7 @@ def test_a_broken_private_configuration_is_an_error_not_a_traceback(tmp_path: Pa
 
 # ------------------------------------------------------------------------------ clients never destroy recordings
 def test_log_start_never_replaces_a_file_but_records_under_the_next_free_name(tmp_path: Path) -> None:
-    from tafel.core.logs.logfile import read_log
+    from tafel.core.logs import read_log
 
     logs = tmp_path / "logs"
     logs.mkdir()

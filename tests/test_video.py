@@ -8,7 +8,7 @@ import cv2
 import numpy as np
 import pytest
 
-from tafel.core.logs.logfile import read_log
+from tafel.core.logs import read_log
 from tafel.core.logs.serialization import deserialize
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.perception import BallImagePercept

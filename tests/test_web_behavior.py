@@ -12,7 +12,7 @@ from typing import Any
 
 import pytest
 
-from tafel.core.logs.logfile import read_log
+from tafel.core.logs import read_log
 from tafel.core.logs.serialization import deserialize
 from tafel.representations.behavior import ActivationGraph
 from tests.support.browser import WebProgram, launch, missing_browser, open_page, wait_for

@@ -15,7 +15,7 @@ from typing import Any
 from tafel.core.framework.config import store_private
 from tafel.core.framework.dot import contexts_dot
 from tafel.core.framework.errors import TafelError
-from tafel.core.logs.logfile import LogExistsError
+from tafel.core.logs import LogExistsError
 from tafel.core.logs.recording import Recorder
 from tafel.core.runtime.program import ContextPlan
 from tafel.debug.commands import CommandError, argument

@@ -34,7 +34,7 @@ import cv2
 import numpy as np
 from foxglove import messages as fm
 
-from tafel.core.logs.logfile import ExtraMessage
+from tafel.core.logs import ExtraMessage
 from tafel.core.logs.serialization import deserialize
 from tafel.debug.concepts import DebugDrawings, ModuleTimes
 from tafel.representations import field

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from tafel.core.framework.naming import did_you_mean
-from tafel.core.logs.logfile import LogError, LogMessage, LogReader
+from tafel.core.logs import LogError, LogMessage, LogReader
 from tafel.tools.log_tools import message_class, to_python
 
 

@@ -19,7 +19,7 @@ import numpy as np
 from google.protobuf import descriptor_pool, message_factory
 
 from tafel.core.framework.naming import did_you_mean
-from tafel.core.logs.logfile import LogError, LogReader, write_slice
+from tafel.core.logs import LogError, LogReader, write_slice
 
 
 def run_log_command(args: argparse.Namespace) -> int:

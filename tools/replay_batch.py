@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from tafel.core.framework.naming import did_you_mean
-from tafel.core.logs.logfile import LogError, LogReader
+from tafel.core.logs import LogError, LogReader
 from tafel.tools.batch import BatchError, BatchInfo, run_jobs
 from tafel.tools.log_compare import compare_logs
 from tafel.tools.log_tools import decoded_messages

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from tafel.core.framework.config import ConfigError
-from tafel.core.logs.logfile import LogWriter
+from tafel.core.logs import LogWriter
 from tafel.core.logs.serialization import deserialize
 
 log = logging.getLogger("tafel.blackbox")

@@ -19,7 +19,7 @@ from tafel.core.framework.errors import UnknownModuleError
 from tafel.core.framework.manager import Blackboard
 from tafel.core.framework.naming import did_you_mean
 from tafel.core.framework.representation import is_state
-from tafel.core.logs.logfile import LogWriter, Translate
+from tafel.core.logs import LogWriter, Translate
 from tafel.core.logs.serialization import SerializationError, serialize
 
 if TYPE_CHECKING:  # plans only for their type: logs sit below the runtime

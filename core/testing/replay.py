@@ -58,7 +58,7 @@ def replay_module(module: type, path: str | Path, *, start_s: float = 0.0, secon
     in ``allow_missing`` (they keep their defaults). Returns the module's outputs next to what the
     log recorded of them.
     """
-    from tafel.core.logs.logfile import LogReader
+    from tafel.core.logs import LogReader
     from tafel.core.logs.serialization import deserialize
 
     declared = module.requirements()
