@@ -21,7 +21,7 @@ from tafel.core.runtime import ContextRunner
 from tafel.debug.commands import CommandError, ContextDebug
 from tafel.debug.concepts import STATE, DebugDrawings, DebugPlots, ModuleTimes, frame_debug_data
 from tafel.debug.protocol import Command
-from tafel.debug.server import Executor
+from tafel.debug.router import Executor
 
 DEBUG_REPRESENTATIONS = (DebugDrawings, DebugPlots, ModuleTimes)
 INTERNAL_ERROR = "__error__"  # key of a context's answer to an internal question it could not answer

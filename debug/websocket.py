@@ -38,7 +38,8 @@ from websockets.http11 import Request, Response
 from tafel.core.framework.naming import did_you_mean
 from tafel.debug.commands import CommandError
 from tafel.debug.protocol import Command
-from tafel.debug.server import DebugServer, Session
+from tafel.debug.server import DebugServer
+from tafel.debug.session import Session
 
 log = logging.getLogger("tafel.web")
 WEBSOCKET_PATH = "/ws"

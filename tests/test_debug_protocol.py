@@ -10,7 +10,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tafel.debug.protocol import Command, ParseError, TelnetDecoder, answer_bytes, format_command, parse
-from tafel.debug.server import DebugRouter, DebugServer, looks_like_http
+from tafel.debug.router import DebugRouter
+from tafel.debug.server import DebugServer
+from tafel.debug.session import looks_like_http
 
 
 def test_the_example_from_the_protocol() -> None:

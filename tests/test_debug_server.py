@@ -22,7 +22,8 @@ import pytest
 from tafel.core.logs import read_log
 from tafel.core.logs.serialization import deserialize
 from tafel.debug.client import DebugClient
-from tafel.debug.server import DebugRouter, DebugServer
+from tafel.debug.router import DebugRouter
+from tafel.debug.server import DebugServer
 from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler
 from tafel.representations.modeling import BallModel
 from tests.support.processes import stop_program

@@ -25,7 +25,8 @@ from tafel.core.testing import strategy_for
 from tafel.debug.commands import ContextDebug, json_value, merge_answers
 from tafel.debug.executors import LocalExecutor
 from tafel.debug.protocol import parse
-from tafel.debug.server import DebugRouter, DebugServer
+from tafel.debug.router import DebugRouter
+from tafel.debug.server import DebugServer
 from tafel.debug.websocket import WebServer, WebSocketSession, host_allowed
 from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler
 from tafel.modules.modeling.simple_ball_modeler import SimpleBallModeler

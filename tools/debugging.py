@@ -20,7 +20,9 @@ from tafel.core.logs.recording import Recorder
 from tafel.core.runtime.program import ContextPlan
 from tafel.debug.commands import CommandError, argument
 from tafel.debug.protocol import Command, parse
-from tafel.debug.server import IDLE_TIMEOUT, DebugRouter, DebugServer
+from tafel.debug.router import DebugRouter
+from tafel.debug.server import DebugServer
+from tafel.debug.session import IDLE_TIMEOUT
 
 
 def recording_path(folder: Path, name: str) -> Path:
