@@ -3,12 +3,13 @@ name (``Executor``: in this thread or in another process), and the answers are m
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import json
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from tafel.core.framework.naming import did_you_mean
-from tafel.debug.commands import SPECS, CommandError, merge_answers
+from tafel.debug.commands import SPECS, CommandError
 from tafel.debug.protocol import Command
 
 
@@ -126,3 +127,37 @@ class DebugRouter:
         return [r if r is not None else (True, "no answer") for r in results]
 
 
+def merge_answers(command: Command, answers: Mapping[str, tuple[str, str | bytes]]) -> tuple[bool, str | bytes]:
+    """Combine the contexts' answers to one: (is_error, text or bytes)."""
+    spec = SPECS[command.name]
+    errors = [(ctx, text) for ctx, (status, text) in answers.items() if status == "error"]
+    oks = [(ctx, text) for ctx, (status, text) in answers.items() if status == "ok"]
+    if spec.routing == "lines":
+        if oks:
+            return False, "\n".join(str(text) for _, text in oks if text)
+        if errors:
+            return True, str(errors[0][1])
+    if spec.routing in ("first", "lines"):
+        if oks and all(text == oks[0][1] for _, text in oks):
+            return False, oks[0][1]
+        if oks:  # the name exists in several contexts (a representation on both blackboards): show each
+            if any(isinstance(text, bytes) for _, text in oks):
+                return True, f"{command.name}: the name exists in {' and '.join(c for c, _ in oks)}; add -context NAME"
+            if command.args.get("format") == "json":
+                return False, json.dumps({ctx: json.loads(text) for ctx, text in oks})
+            return False, "\n".join(f"[{ctx}]\n{text}" for ctx, text in oks)
+        if errors:
+            return True, str(errors[0][1])
+        known: set[str] = set()
+        kind, name = "name", ""
+        for status, text in answers.values():
+            if status == "missing":
+                kind, name, names = json.loads(text)
+                known.update(names)
+        return True, f"unknown {kind} {name!r}: {did_you_mean(name, known)}"
+    if errors and not oks:
+        return True, "; ".join(f"{ctx}: {text}" for ctx, text in errors)
+    if command.args.get("format") == "json":  # one JSON object, by context
+        return False, json.dumps({**{ctx: json.loads(text) for ctx, text in oks}, **{ctx: {"error": text} for ctx, text in errors}})
+    parts = [f"[{ctx}]\n{text}" for ctx, text in oks] + [f"[{ctx}] error: {text}" for ctx, text in errors]
+    return False, "\n".join(parts)

@@ -63,7 +63,7 @@ PRECEDED = {"log:stop": "log:start -file stop.mcap", "representation:release": "
 ERROR_HERE = {"image:get", "subscribe", "unsubscribe"}  # and a telnet client cannot stream
 #: answers that change from frame to frame: compared by kind (error or not) only
 VARYING = {"hello", "log:start", "log:status", "log:stop", "modules:list", "plot:get", "representation:get", "representation:print", "stopwatch:list",
-           "drawings:get", "modules:store", "parameter:store", "web:status"}
+           "drawings:get", "modules:store", "parameter:store", "web:status", "module:reload"}  # reload: its time and frame
 
 
 def line(name: str, args: dict[str, str], encoded: str | None = None) -> str:

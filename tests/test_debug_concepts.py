@@ -12,10 +12,11 @@ import pytest
 
 from tafel.core import ModuleManager
 from tafel.core.testing import ModuleHarness
-from tafel.debug.commands import ContextDebug, pretty
+from tafel.debug.commands import ContextDebug
 from tafel.debug.concepts import STATE, frame_debug_data
 from tafel.debug.executors import RateMeter, instrument
 from tafel.debug.protocol import parse
+from tafel.debug.values import pretty
 from tafel.representations.infrastructure import FrameInfo
 from tafel.tools.console import Completer
 from tests.support.debug_user import DRAW, DebugUser, DebugUserOutput

@@ -22,11 +22,12 @@ from websockets.sync.client import connect
 from tafel.core.framework.manager import ModuleManager
 from tafel.core.framework.representation import registered_representations
 from tafel.core.testing import strategy_for
-from tafel.debug.commands import ContextDebug, json_value, merge_answers
+from tafel.debug.commands import ContextDebug
 from tafel.debug.executors import LocalExecutor
 from tafel.debug.protocol import parse
-from tafel.debug.router import DebugRouter
+from tafel.debug.router import DebugRouter, merge_answers
 from tafel.debug.server import DebugServer
+from tafel.debug.values import json_value
 from tafel.debug.websocket import WebServer, WebSocketSession, host_allowed
 from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler
 from tafel.modules.modeling.simple_ball_modeler import SimpleBallModeler

@@ -130,7 +130,7 @@ def worker_feed_setup(runner: Any, args: dict[str, Any]) -> None:
 
     ``args`` holds ``names`` (the feed's representations by name, in its order), ``flags`` and ``queue``."""
     from tafel.core.framework.representation import get_representation
-    from tafel.debug.commands import frame_number
+    from tafel.debug.values import frame_number
 
     reps = [get_representation(name) for name in args["names"]]
     flags, out = args["flags"], args["queue"]
