@@ -93,6 +93,8 @@ class Canvas:
     __slots__ = ("name",)
 
     def __init__(self, name: str) -> None:
+        if name not in CANVASES:  # a typo would draw where no view ever looks
+            raise ValueError(f"no drawing canvas {name!r}; the canvases are {', '.join(CANVASES)}")
         self.name = name
 
     def _add(self, kind: str, points: list[float], color: str, width: float, text: str = "") -> Canvas:
@@ -220,11 +222,14 @@ def plot(name: str, value: float) -> None:
 
 
 #: the canvases every viewer knows: the field (mm, field frame) and both images (px)
-CANVASES = ("field", "image:top", "image:bottom")
+#: where drawings go: the field (mm, field frame), around the robot (mm, robot frame: the view places it at
+#: the robot's pose), each camera's image (px)
+CANVASES = ("field", "robot", "image:top", "image:bottom")
 
 
 def drawing(canvas: str = "field") -> Canvas:
-    """A canvas of the current frame: ``field`` (mm, field frame) or ``image:top`` / ``image:bottom`` (px)."""
+    """A canvas of the current frame: ``field`` (mm, field frame), ``robot`` (mm, robot frame) or
+    ``image:top`` / ``image:bottom`` (px); another name is a ``ValueError`` naming the canvases."""
     return Canvas(canvas)
 
 

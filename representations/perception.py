@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass
 
 import cv2
@@ -99,6 +100,21 @@ class FieldColor:
         return mask > 0
 
 
+class Camera(str, enum.Enum):
+    """The NAO's two cameras. A ``str`` enum, so ``"top"`` works where ``Camera.top`` does; any other name
+    is an error (``"Top"`` once silently meant the bottom camera)."""
+
+    top = "top"
+    bottom = "bottom"
+
+    @classmethod
+    def of(cls, name: Camera | str) -> Camera:
+        try:
+            return cls(name)
+        except ValueError:
+            raise ValueError(f"no camera {name!r}: the cameras are 'top' and 'bottom'") from None
+
+
 @representation
 class SegmentedImage:
     """Both images in HSV with their field-green masks, and the value (V, 0..255) of white in each (the
@@ -111,15 +127,15 @@ class SegmentedImage:
     bottom_green: np.ndarray = array((None, None), np.bool_)
     bottom_white: float = 255.0
 
-    def white(self, camera: str) -> float:
-        return self.top_white if camera == "top" else self.bottom_white
+    def white(self, camera: Camera | str) -> float:
+        return self.top_white if Camera.of(camera) is Camera.top else self.bottom_white
 
     # plain arrays: numpy on a module's read-only view of them would pass through the access checks
-    def hsv(self, camera: str) -> np.ndarray:
-        return np.asarray(self.top_hsv if camera == "top" else self.bottom_hsv)
+    def hsv(self, camera: Camera | str) -> np.ndarray:
+        return np.asarray(self.top_hsv if Camera.of(camera) is Camera.top else self.bottom_hsv)
 
-    def green(self, camera: str) -> np.ndarray:
-        return np.asarray(self.top_green if camera == "top" else self.bottom_green)
+    def green(self, camera: Camera | str) -> np.ndarray:
+        return np.asarray(self.top_green if Camera.of(camera) is Camera.top else self.bottom_green)
 
 
 @representation

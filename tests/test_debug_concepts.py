@@ -187,3 +187,19 @@ def test_debug_data_is_recorded_like_representations(tmp_path) -> None:
     assert len(plots) == 9
     assert [p.values[p.names.index("DebugUser:frame")] for p in plots] == [float(i) for i in range(1, 10)]
     assert contents.channels["cognition/DebugPlots"].metadata == {"source": "debug", "state": "false"}  # debug output, no state
+
+
+def test_a_wrong_canvas_or_camera_name_is_an_error_not_a_silent_fallback() -> None:
+    """``SegmentedImage.hsv("Top")`` once returned the bottom camera's image; a typo in a canvas drew where
+    no view looks."""
+    import numpy as np
+
+    from tafel.debug.concepts import drawing
+    from tafel.representations.perception import Camera, SegmentedImage
+
+    with pytest.raises(ValueError, match="no drawing canvas 'feild'; the canvases are field, robot, image:top, image:bottom"):
+        drawing("feild")
+    image = SegmentedImage(top_hsv=np.ones((2, 2, 3), np.uint8), bottom_hsv=np.zeros((2, 2, 3), np.uint8))
+    with pytest.raises(ValueError, match="no camera 'Top': the cameras are 'top' and 'bottom'"):
+        image.hsv("Top")
+    assert image.hsv("top").max() == 1 and image.hsv(Camera.bottom).max() == 0
