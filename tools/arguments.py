@@ -194,6 +194,37 @@ def add_console_command(commands: Any) -> None:
     console.add_argument("-c", dest="one_command", metavar="COMMAND", help="run one command, print its answer and exit (status 1 on error:)")
 
 
+def team_number(text: str) -> int:
+    """A GameController team number: 1 to 254."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if not 1 <= value <= 254:
+        raise argparse.ArgumentTypeError(f"a team number is a whole number from 1 to 254 (the GameController's), got {text!r}")
+    return value
+
+
+def add_team_command(commands: Any) -> None:
+    """``tafel team``: the code is in ``tafel.tools.team``."""
+    team = commands.add_parser("team", help="TeamControl in the browser: every robot of a team, from its messages on the network",
+                               description="Listens (receive only, within the rules) to a team's messages on UDP 10000 + team "
+                                           "number and to the GameController, and serves the web view's Team panel: every robot "
+                                           "heard with its pose, role, intention, ball, fallen or penalized, the time since its "
+                                           "last message, and the game state. No program needs to run.")
+    team.add_argument("--team", type=team_number, required=True, metavar="N", help="the team number (1 to 254)")
+    team.add_argument("--port", type=port_number, default=0, metavar="P",
+                      help="UDP port of the team's messages (default 10000 + N; tafel match prints its own)")
+    team.add_argument("--game-controller-port", type=port_number, default=3838, metavar="P",
+                      help="UDP port of the GameController's packets (default %(default)s)")
+    team.add_argument("--host", default="127.0.0.1", help="address the page is served on (default %(default)s)")
+    team.add_argument("--web-port", type=port_number, default=5480, metavar="P", help="the page's port (default %(default)s; 0: a free one)")
+    team.add_argument("--debug-port", type=port_number, default=0, metavar="P",
+                      help="the debug server's port, for the console's team:robots (default: a free one)")
+    team.add_argument("--debug-token", metavar="TOKEN", help="the page and the console must give this token")
+    team.add_argument("--seconds", type=positive(float), metavar="S", help="stop after S seconds (default: at Ctrl-C)")
+
+
 def add_deploy_commands(commands: Any) -> None:
     """``tafel robots`` and ``tafel deploy``: the code is in ``tafel.tools.deploy``."""
     robots = commands.add_parser("robots", help="list the robots of robots.toml, whether they answer and which release they run")

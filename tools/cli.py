@@ -57,6 +57,7 @@ from tafel.tools.arguments import (
     add_module_path_argument,
     add_replay_batch_command,
     add_scenario_commands,
+    add_team_command,
     parse_speed,
     port_number,
     positive,
@@ -153,6 +154,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_log_commands(commands)
     add_console_command(commands)
     add_match_command(commands)
+    add_team_command(commands)
     add_scenario_commands(commands)
     add_replay_batch_command(commands)
     add_deploy_commands(commands)
@@ -934,7 +936,7 @@ COMMANDS = {"run": command_run, "view": command_view, "platforms": command_platf
             "log": tool_command("log_tools", "run_log_command"), "console": tool_command("console", "run_console"),
             "match": command_match, "scenarios": tool_command("scenarios", "command_scenarios"),
             "replay-batch": tool_command("replay_batch", "command_replay_batch"),
-            "deploy": tool_command("deploy", "run_command"), "robots": tool_command("deploy", "run_command")}
+            "team": tool_command("team", "run_team"), "deploy": tool_command("deploy", "run_command"), "robots": tool_command("deploy", "run_command")}
 
 
 class PipeSafeStream:

@@ -37,6 +37,7 @@ from foxglove import messages as fm
 from tafel.core.logs import ExtraMessage
 from tafel.core.logs.serialization import deserialize
 from tafel.debug.concepts import DebugDrawings, ModuleTimes
+from tafel.modules.motion.kinematics import angles_by_name, link_poses
 from tafel.representations import field
 from tafel.representations.behavior import ActivationGraph
 from tafel.representations.infrastructure import FrameInfo
@@ -53,6 +54,7 @@ from tafel.representations.motion import (
 )
 from tafel.representations.motion_control import Odometry
 from tafel.representations.perception import BallPercept, CameraImageBottom, CameraImageTop
+from tafel.tools.robot_links import PARENTS
 
 M = 0.001  # mm -> m
 CAMERAS = {CameraImageTop: "top", CameraImageBottom: "bottom"}
@@ -67,7 +69,8 @@ NEEDS: dict[str, tuple[type, ...]] = {
     "/camera/top": (CameraImageTop,), "/camera/bottom": (CameraImageBottom,),
     "/camera/top/calibration": (CameraImageTop,), "/camera/bottom/calibration": (CameraImageBottom,),
     "/camera/top/annotations": (CameraImageTop, DebugDrawings), "/camera/bottom/annotations": (CameraImageBottom, DebugDrawings),
-    "/scene": (BallModel, BallPercept, DebugDrawings, FrameInfo), "/tf": (Odometry, TorsoPose, CameraMatrixTop, CameraMatrixBottom),
+    "/scene": (BallModel, BallPercept, DebugDrawings, FrameInfo),
+    "/tf": (Odometry, TorsoPose, CameraMatrixTop, CameraMatrixBottom, JointSensorData),
     "/joints": (JointSensorData, JointCommand), "/imu": (InertialSensorData,), "/fsr": (FsrData,), "/timing": (ModuleTimes,),
     "/rates": (FrameInfo,), "/behavior": (ActivationGraph,), "/log": (),
 }
@@ -302,6 +305,7 @@ class FoxgloveTranslator:
         self.cameras: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self.frame_times: dict[str, deque[int]] = {}
         self.joints: dict[str, dict[str, float]] = {}
+        self.positions: np.ndarray | None = None  # the last measured joint angles: the links' frames on /tf
         self.pose: Any = None  # the last valid RobotPose
 
     def resend_field(self) -> None:
@@ -360,6 +364,7 @@ class FoxgloveTranslator:
             seen = [(value.x, value.y)] if value.seen else []
             yield Outgoing("/scene", fm.SceneUpdate(entities=[ball_entity(stamp, "ball/percept", seen, color("yellow", 0.6))]), time_ns, wall)
         elif kind is JointSensorData:
+            self.positions = np.asarray(value.position, float)
             self.joints = {"position": named(value.position), "temperature": named(value.temperature)}
         elif kind is JointCommand and self.wanted("/joints"):  # once per motion frame, with the last measurement
             yield Outgoing("/joints", {**self.joints, "command": named(value.position), "stiffness": named(value.stiffness)}, time_ns, wall)
@@ -437,7 +442,22 @@ class FoxgloveTranslator:
                                                 rotation=quaternion(relative_rotation)))
             transforms.append(fm.FrameTransform(timestamp=stamp, parent_frame_id=f"camera_{camera}", child_frame_id=f"camera_{camera}_optical",
                                                 translation=fm.Vector3(x=0, y=0, z=0), rotation=quaternion(OPTICAL)))
+        transforms += self._link_transforms(stamp)
         return fm.FrameTransforms(transforms=transforms)
+
+    def _link_transforms(self, stamp: fm.Timestamp) -> list[fm.FrameTransform]:
+        """Each link's frame in its parent's (``torso`` the root), from the measured joint angles and the
+        program's kinematic model: the robot in Foxglove's 3D panel."""
+        if self.positions is None:
+            return []
+        poses = link_poses(angles_by_name(self.positions))
+        transforms = []
+        for link, parent in PARENTS.items():
+            local = np.linalg.inv(poses[parent]) @ poses[link]
+            transforms.append(fm.FrameTransform(timestamp=stamp, parent_frame_id=parent, child_frame_id=link,
+                                                translation=fm.Vector3(x=local[0, 3] * M, y=local[1, 3] * M, z=local[2, 3] * M),
+                                                rotation=quaternion(local[:3, :3])))
+        return transforms
 
     def _rates(self, context: str, time_ns: int, wall: int) -> Iterator[Outgoing]:
         """Frames per second of each context over the last second of frame time."""

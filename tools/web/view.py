@@ -32,7 +32,9 @@ from tafel.debug.commands import jpeg_bytes, representation_message
 from tafel.debug.concepts import DebugDrawings, DebugPlots, ModuleTimes
 from tafel.debug.server import DebugServer
 from tafel.debug.websocket import WebServer
+from tafel.representations.motion import JointSensorData, TorsoPose
 from tafel.tools.live_feed import Handed, LiveFeed, feed_order
+from tafel.tools.robot_links import links_message
 
 log = logging.getLogger("tafel.web")
 STATIC = Path(__file__).resolve().parent / "static"
@@ -45,6 +47,12 @@ PLOT_NAMES = "PlotNames"
 PLOT_NAMES_EVERY = 1.0
 #: s between two questions for the plot names (plot:get) while a page follows them
 PLOT_NAMES_POLL = 0.5
+#: the topic of the robot's links and cameras in the robot frame, from the measured joints and the torso's pose
+ROBOT_LINKS = "RobotLinks"
+#: what it is computed from (the motion context's)
+ROBOT_LINKS_FROM = (JointSensorData, TorsoPose)
+#: RobotLinks messages a second at most (the joints come 100 times a second)
+ROBOT_LINKS_HZ = 20.0
 #: the contexts whose camera images the page is sent (their drawings travel with them)
 IMAGE_CONTEXTS = ("cognition",)
 #: s an encoded image waits for its frame's drawings when the feed brings nothing else
@@ -96,7 +104,7 @@ class WebView:
         self.by_name = {rep.__name__: rep for rep in self.feed.reps}
         self.jpeg_quality = jpeg_quality
         self.wanted: frozenset[str] = frozenset()
-        self.server = WebServer(debug, STATIC, host=host, port=port, topics=lambda: sorted([*self.by_name, PLOT_NAMES]),
+        self.server = WebServer(debug, STATIC, host=host, port=port, topics=lambda: sorted([*self.by_name, PLOT_NAMES, ROBOT_LINKS]),
                                 on_subscriptions=self._subscribed)
         self.debug = debug
         self.encoded = 0
@@ -104,6 +112,8 @@ class WebView:
         self.waiting: dict[str, list[tuple[Handed, bytes]]] = {}
         self.plot_names: set[str] = set()
         self.plot_names_at = 0.0  # monotonic s of the last list sent
+        self.torso: TorsoPose | None = None  # the last TorsoPose, for RobotLinks
+        self.links_at = 0.0  # monotonic s of the last RobotLinks sent
         self.names_lock = threading.Lock()
         self.stopping = threading.Event()
         self.thread = threading.Thread(target=self._work, name="tafel-web", daemon=True)
@@ -140,6 +150,11 @@ class WebView:
         if any(name.startswith("CameraImage") for name in topics) and DebugDrawings.__name__ not in topics:
             needed.add(DebugDrawings)  # an image travels with its frame's drawings: those of the images' context
             only[DebugDrawings] = IMAGE_CONTEXTS
+        if ROBOT_LINKS in topics:  # computed here from the joints and the torso's pose
+            for rep in ROBOT_LINKS_FROM:
+                if rep in self.feed.index and rep not in needed:  # the motion context's, not a hand-over's copy
+                    needed.add(rep)
+                    only[rep] = ("motion",)
         self.feed.need(needed, only)
 
     def _work(self) -> None:
@@ -167,6 +182,13 @@ class WebView:
             self._release_images(item.context, item.value)
         if topic == DebugPlots.__name__:
             self._note_plot_names(item.value.names)
+        if topic == TorsoPose.__name__:
+            self.torso = item.value
+        if topic == JointSensorData.__name__ and ROBOT_LINKS in self.wanted and time.monotonic() - self.links_at >= 1 / ROBOT_LINKS_HZ:
+            self.links_at = time.monotonic()
+            message = {"topic": ROBOT_LINKS, "context": item.context, "frame": item.frame, "time_ns": item.time_ns,
+                       "value": links_message(item.value.position, self.torso)}
+            self._publish(ROBOT_LINKS, json.dumps(message, allow_nan=False))
         if topic not in self.wanted:  # unsubscribed since it was handed over, or only needed here
             return
         if is_image(item.value):

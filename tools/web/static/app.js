@@ -5,6 +5,8 @@ import { behaviorView } from "./behavior.js";
 import { Connection } from "./connection.js";
 import { fieldView } from "./field.js";
 import { modulesView } from "./modules.js";
+import { teamView } from "./team.js";
+import { view3d } from "./view3d.js";
 import {
   debugRequestsView, imagesView, logPlayerView, modifyView, parametersView, plotsView, remoteView,
   representationsView, statusView, stopwatchesView,
@@ -24,7 +26,11 @@ const VIEWS = [
   { id: "modify", title: "Modify", make: modifyView, x: 4, y: 32, w: 4, h: 6 },
   { id: "parameters", title: "Parameters", make: parametersView, x: 8, y: 32, w: 4, h: 6 },
   { id: "behavior", title: "Behaviour", make: behaviorView, x: 0, y: 38, w: 12, h: 10 },
+  { id: "team", title: "Team", make: teamView, x: 0, y: 48, w: 8, h: 12 },
+  { id: "view3d", title: "3D", make: view3d, x: 8, y: 48, w: 4, h: 12 },
 ];
+// `tafel team` serves only the team view (it has team:robots and no program)
+const TEAM_ONLY = "team:robots";
 const LAYOUT_KEY = "tafel-layout";
 const HIDDEN_KEY = "tafel-hidden";
 
@@ -131,7 +137,14 @@ connection.on("open", async (hello) => {
   tokenForm.hidden = true;
   const help = await connection.ask("help");
   state.commands = new Set(help.split("\n").map((line) => line.split(/\s+/)[0]).filter(Boolean));
+  state.teamOnly = state.commands.has(TEAM_ONLY);
   for (const view of VIEWS) {
+    if (state.teamOnly) { // no program: the team view alone, whatever this browser kept
+      state.panels[view.id].box.disabled = true;
+      show(view.id, view.id === "team", false);
+      if (view.id === "team") gridStack.update(state.panels.team.item, { x: 0, y: 0, w: 12, h: 18 });
+      continue;
+    }
     if (!view.needs) continue;
     // a view shows where its commands are, and not where they make no sense (a log is watched, not driven)
     const can = state.commands.has(view.needs) && !(view.notOn && state.commands.has(view.notOn));

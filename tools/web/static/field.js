@@ -117,7 +117,7 @@ export function fieldView(body, connection, state, panel) {
   }
 }
 
-function fieldPicture(g, width, height, scale) {
+export function fieldPicture(g, width, height, scale) {
   const picture = new OffscreenCanvas(width, height);
   const ctx = picture.getContext("2d");
   const spanX = g.length + 2 * g.border, spanY = g.width + 2 * g.border;
