@@ -2,20 +2,31 @@
 
 The robot is the URDF that ``platforms.robot_model`` generates from ``representations.nao``; the field
 is built from the same ``field_parts``. Cameras render with PyBullet's CPU renderer (no OpenGL at all).
+
+Rendering is most of a simulated second's work (about 15 ms of CPU per 320x240 image, 60 images a
+second), and PyBullet holds the GIL while it renders, so a thread cannot help: with cameras on and more
+than one core, a render worker (``RenderWorker``, a process with a copy of the world that only renders)
+draws the top camera while this process draws the bottom one. Only the poses of what moves (the robot's
+base and joints, the ball) travel to it, a few hundred bytes a frame; its image comes back as raw
+bytes. The images are the same as when one process renders both (``--render-worker off``). PyBullet's
+EGL renderer is no help here: on Mesa's llvmpipe (no GPU) it is slower than the CPU renderer and loses
+the mesh shapes (the ball's texture, the posts).
 """
 
 from __future__ import annotations
 
 import ctypes
 import math
+import multiprocessing
 import os
 import sys
 import tempfile
+from multiprocessing.connection import Connection
 from typing import Any
 
 import numpy as np
 
-from tafel.core.runtime.platform import PlatformError
+from tafel.core.runtime.platform import PlatformError, PlatformOptionError
 from tafel.platforms.field_world import NET_FRICTION, FieldPart, ball_mesh, ball_texture_png, cylinder_mesh, field_parts
 from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, fsr_sites, joint_motor, urdf
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
@@ -61,6 +72,86 @@ def _matrix(quaternion: tuple[float, ...]) -> np.ndarray:
     return np.array(pybullet.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
 
 
+#: s a render worker may take to build its world, and to answer one image, before this process renders alone
+WORKER_START_S = 60.0
+WORKER_IMAGE_S = 10.0
+
+
+def _serve_renders(connection: Connection, options: dict[str, Any]) -> None:
+    """A render worker's life: build the world as the platform does, then for each (state, camera) pose
+    what moves and send the camera's image back as raw bytes, until None or the pipe closes."""
+    platform = PybulletPlatform({**options, "render_worker": "off", "viewer": False})
+    platform.build(frozenset(), viewer=False)
+    connection.send("ready")
+    try:
+        while True:
+            message = connection.recv()
+            if message is None:
+                break
+            state, camera = message
+            platform.set_moving_state(state)
+            connection.send_bytes(memoryview(np.ascontiguousarray(platform.render(camera))).cast("B"))
+    except (EOFError, OSError, KeyboardInterrupt):
+        pass
+    finally:
+        platform.stop()
+
+
+class RenderWorker:
+    """A process with a copy of the world that renders one camera while the simulation renders the other.
+
+    ``request`` hands it the poses of what moves and the camera; ``image`` waits for the picture. Any
+    failure (it died, it is slow to answer) raises ``PlatformError``; the platform then renders alone."""
+
+    def __init__(self, options: dict[str, Any], width: int, height: int) -> None:
+        context = multiprocessing.get_context("spawn")  # a fork would share this process's PyBullet client
+        self.connection, child = context.Pipe()
+        self.process = context.Process(target=_serve_renders, args=(child, options), name="pybullet-render", daemon=True)
+        self.process.start()
+        child.close()
+        self.shape = (height, width, 3)
+        self.buffer = bytearray(height * width * 3)
+        if not self.connection.poll(WORKER_START_S) or self.connection.recv() != "ready":
+            self.close()
+            raise PlatformError("the PyBullet render worker did not start")
+
+    def request(self, state: tuple[Any, ...], camera: str) -> None:
+        try:
+            self.connection.send((state, camera))
+        except (OSError, ValueError) as exc:
+            raise PlatformError(f"the PyBullet render worker is gone ({exc})") from None
+
+    def image(self) -> np.ndarray:
+        try:
+            if not self.connection.poll(WORKER_IMAGE_S):
+                raise PlatformError(f"the PyBullet render worker gave no image within {WORKER_IMAGE_S:g} s")
+            size = self.connection.recv_bytes_into(self.buffer)
+        except (EOFError, OSError) as exc:
+            raise PlatformError(f"the PyBullet render worker is gone ({exc})") from None
+        if size != len(self.buffer):
+            raise PlatformError(f"the PyBullet render worker sent {size} bytes for a {self.shape} image")
+        return np.frombuffer(self.buffer, np.uint8).reshape(self.shape).copy()
+
+    def close(self) -> None:
+        try:
+            self.connection.send(None)
+        except (OSError, ValueError):
+            pass
+        self.process.join(timeout=5.0)
+        if self.process.is_alive():
+            self.process.kill()
+            self.process.join()
+        self.connection.close()
+
+
+def parse_render_worker(value: Any) -> bool | None:
+    """``--render-worker``: on, off, or auto (None: on where cameras render headless on more than one core)."""
+    text = str(value if value is not None else "auto").lower()
+    if text not in ("on", "off", "auto"):
+        raise PlatformOptionError(f"--render-worker takes on, off or auto, got {value!r}")
+    return None if text == "auto" else text == "on"
+
+
 class PybulletPlatform(SimulatedRobotPlatform):
     name = "pybullet"
     engine = "PyBullet"
@@ -70,6 +161,15 @@ class PybulletPlatform(SimulatedRobotPlatform):
         super().__init__(options)
         self.client: int | None = None
         self.viewer = False
+        self.render_worker = parse_render_worker(self.options.get("render_worker"))
+        self.worker: RenderWorker | None = None
+
+    @classmethod
+    def add_arguments(cls, parser: Any) -> None:
+        super().add_arguments(parser)
+        parser.add_argument("--render-worker", choices=["on", "off", "auto"], default="auto",
+                            help="pybullet: render the top camera in a process of its own, in parallel with the bottom one "
+                                 "(auto: with cameras on, no viewer and more than one core)")
 
     # ------------------------------------------------------------------------------- the world
     def build(self, contexts: frozenset[str], viewer: bool) -> None:
@@ -88,6 +188,12 @@ class PybulletPlatform(SimulatedRobotPlatform):
             self.bodies[part.name] = self._field_body(part)
         self._load_robot()
         self.previous_velocity = np.zeros(3)
+        wanted = self.render_worker if self.render_worker is not None else (os.cpu_count() or 1) > 1
+        if wanted and self.cameras and not viewer and "cognition" in contexts:
+            try:
+                self.worker = RenderWorker(dict(self.options), self.width, self.height)
+            except PlatformError as exc:
+                print(f"pybullet: {exc}; rendering both cameras in this process", file=sys.stderr)
 
     def _field_body(self, part: FieldPart) -> int:
         c = self.client
@@ -188,6 +294,7 @@ class PybulletPlatform(SimulatedRobotPlatform):
         self.foot_links = {"L": names["LAnkleRoll"], "R": names["RAnkleRoll"]}
         self.base_inertial = np.array(pybullet.getDynamicsInfo(self.robot, -1, physicsClientId=c)[3])
         all_joints = list(names.values())
+        self.all_joints = all_joints
         pybullet.setJointMotorControlArray(self.robot, all_joints, pybullet.VELOCITY_CONTROL, forces=[0.0] * len(all_joints),
                                            physicsClientId=c)
         for link in [-1, *all_joints]:
@@ -205,6 +312,9 @@ class PybulletPlatform(SimulatedRobotPlatform):
 
     def stop(self) -> None:
         super().stop()
+        if self.worker is not None:
+            self.worker.close()
+            self.worker = None
         if self.client is not None:
             try:
                 pybullet.disconnect(physicsClientId=self.client)
@@ -258,6 +368,39 @@ class PybulletPlatform(SimulatedRobotPlatform):
                 force = contact[9]
                 forces[index * 4 : index * 4 + 4] += force * np.array([u * v, u * (1 - v), (1 - u) * v, (1 - u) * (1 - v)])
         return forces
+
+    def images(self, time_ns: int) -> tuple[int, dict[str, np.ndarray]]:
+        """Both cameras' images: the top one from the render worker while this process renders the bottom
+        one (images shown late, ``--camera-latency-ms``, are rendered here from the saved world)."""
+        if self.worker is None or (self.camera_latency_ns and self.history):
+            return super().images(time_ns)
+        try:
+            self.worker.request(self.moving_state(), "top")
+            bottom = self.render("bottom")
+            return time_ns, {"top": self.worker.image(), "bottom": bottom}
+        except PlatformError as exc:
+            print(f"pybullet: {exc}; rendering both cameras in this process from now on", file=sys.stderr)
+            self.worker.close()
+            self.worker = None
+            return super().images(time_ns)
+
+    def moving_state(self) -> tuple[Any, ...]:
+        """The poses of what moves, all a copy of the world needs to render as this one looks: the robot's
+        base, every joint's angle, the ball."""
+        c = self.client
+        base = pybullet.getBasePositionAndOrientation(self.robot, physicsClientId=c)
+        joints = tuple(state[0] for state in pybullet.getJointStates(self.robot, self.all_joints, physicsClientId=c))
+        ball = pybullet.getBasePositionAndOrientation(self.bodies["ball"], physicsClientId=c)
+        return base, joints, ball
+
+    def set_moving_state(self, state: tuple[Any, ...]) -> None:
+        """Put what moves where ``moving_state`` found it (in a render worker's copy of the world)."""
+        c = self.client
+        (position, orientation), joints, (ball_position, ball_orientation) = state
+        pybullet.resetBasePositionAndOrientation(self.robot, position, orientation, physicsClientId=c)
+        for joint, angle in zip(self.all_joints, joints):
+            pybullet.resetJointState(self.robot, joint, angle, 0.0, physicsClientId=c)
+        pybullet.resetBasePositionAndOrientation(self.bodies["ball"], ball_position, ball_orientation, physicsClientId=c)
 
     def render(self, camera: str) -> np.ndarray:
         rgba, _ = self._camera_image(camera, segmentation=False)

@@ -73,6 +73,9 @@ def test_a_lone_robot_walks_to_its_kickoff_position_in_ready_and_scores_after_pl
     assert math.hypot(at_ready["x"] + 3600.0, at_ready["y"] + 3000.0) < 400.0  # where it entered
     assert all(math.hypot(p["x"] + 300.0, p["y"]) < 350.0 for p in at_set), at_set[0]
     assert result["robots"][0]["returns"] > 0 and result["teams"][0]["team_messages"] > 0
+    # what the match cost, to read its real-time factor against: the cores over the CPU per simulated second
+    per_second = result["cpu_s_per_sim_s_per_robot"] + result["cpu_s_per_sim_s_world"]
+    assert result["cpu_s_per_sim_s_per_robot"] > 0 and result["limit_realtime_factor"] == pytest.approx(result["cpu_count"] / per_second, rel=0.02)
 
 
 #: simulated s of the two-against-two test: three minutes, as issue 19 asks (READY and SET included)

@@ -53,6 +53,18 @@ class Robot:
     """whether it renders its cameras (then it gets the world's positions every tick)"""
 
 
+def cpu_seconds(pid: int | None = None) -> float | None:
+    """CPU seconds (user and system) a process has used so far: this one, or a child by ``pid`` (Linux
+    ``/proc``; None where it cannot be read). What the match's limit on this machine is computed from."""
+    if pid is None:
+        return time.process_time()
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return None
+
+
 def free_udp_port() -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
         probe.bind(("127.0.0.1", 0))
@@ -86,6 +98,25 @@ class Match:
         self.key = secrets.token_hex(16)
         self.listener = Listener(("127.0.0.1", 0), backlog=2 * MAX_PLAYERS_PER_TEAM, authkey=self.key.encode())  # all join at once
         self.robots: list[Robot] = []
+        #: CPU seconds of the world's process and of each robot's at the kickoff and at the final whistle
+        self.cpu_at: dict[str, list[float | None]] = {}
+
+    def take_cpu(self, when: str) -> None:
+        """Note the CPU seconds every process of the match has used by now (``kickoff`` or ``whistle``)."""
+        self.cpu_at[when] = [cpu_seconds(), *(cpu_seconds(robot.process.pid) for robot in self.robots)]
+
+    def cpu_figures(self) -> dict[str, Any]:
+        """CPU seconds per simulated second of play: the world's, each robot's mean, and the real-time factor
+        this machine's cores allow at best (cores / all processes' CPU per simulated second)."""
+        start, end, simulated = self.cpu_at.get("kickoff"), self.cpu_at.get("whistle"), self.world.time_ns * 1e-9
+        if not (start and end and simulated > 0) or any(v is None for v in (*start, *end)):
+            return {}
+        used = [b - a for a, b in zip(start, end)]  # type: ignore[operator]
+        robots = used[1:]
+        per_robot = sum(robots) / len(robots) / simulated if robots else 0.0
+        total = sum(used) / simulated
+        return {"cpu_s_per_sim_s_world": round(used[0] / simulated, 3), "cpu_s_per_sim_s_per_robot": round(per_robot, 3),
+                "cpu_count": os.cpu_count(), "limit_realtime_factor": round((os.cpu_count() or 1) / total, 3) if total > 0 else None}
 
     # ---------------------------------------------------------------------------------- robots
     def start_robots(self) -> None:
@@ -213,6 +244,7 @@ class Match:
             "simulated_s": round(self.world.time_ns * 1e-9, 2),
             "events": [{"time_s": round(e.time_s, 2), "event": e.what} for e in referee.events],
             "bytes_per_team_message": round(referee.message_bytes / sent, 1) if sent else 0,
+            **self.cpu_figures(),
             "robots": [{"team": TEAM_NUMBERS[r.player.team], "player": r.player.number, "debug": r.debug, "returns": r.player.returns,
                         "exit_status": r.process.returncode, **({"log": str(r.log)} if r.log else {})} for r in self.robots],
         }
@@ -232,9 +264,15 @@ def command_match(args: argparse.Namespace, extra: Sequence[str]) -> int:
         for robot in match.robots:
             print(f"[match] team {TEAM_NUMBERS[robot.player.team]} player {robot.player.number}: debug server {robot.debug}"
                   + (f", log {robot.log}" if robot.log else ""), flush=True)
+        for side, team in enumerate(TEAM_NUMBERS):  # what `tafel team` listens to, to watch a team of this match
+            print(f"[match] team {team} talks on UDP {match.team_ports[side]}, the GameController on "
+                  f"{match.ports['game_controller_port']}: tafel team --team {team} --port {match.team_ports[side]} "
+                  f"--game-controller-port {match.ports['game_controller_port']}", flush=True)
         kickoff = time.monotonic()
+        match.take_cpu("kickoff")
         reason = match.play()
         final_whistle = time.monotonic()
+        match.take_cpu("whistle")
     except KeyboardInterrupt:
         reason = "interrupted"
     except RuntimeError as exc:
