@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -61,6 +62,7 @@ def test_a_lone_robot_walks_to_its_kickoff_position_in_ready_and_scores_after_pl
                          "--ready-seconds", "40", "--record-dir", str(tmp_path / "logs"), *LEAN)
     assert done.returncode == 0 and result["ended"] == "the game is over", done.stderr[-3000:]
     assert "team 1 player 1: debug server 127.0.0.1:" in done.stdout
+    assert re.search(r"team 1 talks on UDP \d+, .*: tafel team --team 1 --port \d+ --game-controller-port \d+", done.stdout)
     ready, kickoff = event_time(result, "READY"), event_time(result, "PLAYING")
     goals = [e["time_s"] for e in result["events"] if e["event"] == "GOAL 1"]
     assert goals and goals[0] > kickoff, result["events"]
