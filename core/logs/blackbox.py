@@ -28,8 +28,8 @@ from pathlib import Path
 from typing import Any
 
 from tafel.core.framework.config import ConfigError
-from tafel.core.logs import LogWriter
 from tafel.core.logs.serialization import deserialize
+from tafel.core.logs.writer import LogWriter, PendingMessage
 
 log = logging.getLogger("tafel.blackbox")
 
@@ -40,16 +40,6 @@ HEAVY_BYTES = 64 * 1024
 HEAVY_PERIOD_S = 0.5
 #: s after a save in which further triggers are counted but save nothing (a failure every frame)
 COOLDOWN_S = 10.0
-
-
-@dataclass(frozen=True)
-class Message:
-    topic: str
-    cls: type
-    time_ns: int
-    sequence: int
-    data: bytes
-    metadata: Mapping[str, str]
 
 
 @dataclass(frozen=True)
@@ -122,7 +112,7 @@ class Triggers:
         wanted = {"FallState", "GameState", "ChestButton", *(c.name for c in self.conditions)}
         self.wanted = frozenset(wanted)
 
-    def see(self, message: Message) -> None:
+    def see(self, message: PendingMessage) -> None:
         name = message.topic.split("/", 1)[-1]
         if name not in self.wanted:
             return
@@ -185,7 +175,7 @@ class BlackBox:
         self.heavy_period_ns = int(heavy_period_s * 1e9)
         self.metadata = dict(metadata or {})
         self.cooldown_s = cooldown_s
-        self.ring: collections.deque[Message] = collections.deque()
+        self.ring: collections.deque[PendingMessage] = collections.deque()
         self.bytes = 0
         self.last_heavy: dict[str, int] = {}
         self.lock = threading.Lock()
@@ -203,7 +193,7 @@ class BlackBox:
             if time_ns - self.last_heavy.get(topic, -self.heavy_period_ns) < self.heavy_period_ns:
                 return True
             self.last_heavy[topic] = time_ns
-        message = Message(topic, cls, time_ns, sequence, data, metadata or {})
+        message = PendingMessage(topic, cls, time_ns, sequence, data, metadata or {}, time.time_ns())
         with self.lock:
             self.ring.append(message)
             self.bytes += len(data)
@@ -241,7 +231,7 @@ class BlackBox:
         threading.Thread(target=self._write, args=(path, messages, metadata, trigger), name="tafel-blackbox", daemon=True).start()
         return path
 
-    def _write(self, path: Path, messages: list[Message], metadata: dict[str, str], trigger: str) -> None:
+    def _write(self, path: Path, messages: list[PendingMessage], metadata: dict[str, str], trigger: str) -> None:
         try:
             writer = LogWriter(path, metadata=metadata, exclusive=True)
             writer.blocking = True

@@ -32,7 +32,10 @@ from tafel.core.logs.serialization import file_descriptor_set, message_name
 
 
 @dataclass
-class _Item:
+class PendingMessage:
+    """One message on its way into a log: its channel, class, frame time (ns), frame number, bytes,
+    channel metadata, and the wall-clock time it was taken (ns since the epoch; 0: when written)."""
+
     topic: str
     cls: type
     time_ns: int
@@ -101,7 +104,7 @@ class LogWriter:
         self._writer.start(profile=PROFILE, library="tafel")
         if metadata:
             self._writer.add_metadata("tafel", dict(metadata))
-        self._queue: queue.Queue[_Item | ExtraMessage | None] = queue.Queue(maxsize=queue_size)
+        self._queue: queue.Queue[PendingMessage | ExtraMessage | None] = queue.Queue(maxsize=queue_size)
         self._channels: dict[str, int] = {}
         self._schemas: dict[type, int] = {}
         self._extras = _ExtraChannels(self._writer)
@@ -123,13 +126,13 @@ class LogWriter:
 
         With ``blocking`` set (a run without a beat to keep, ``--speed max``) it waits for room instead.
         """
-        return self._queue_item(_Item(topic, cls, time_ns, sequence, data, metadata or {}, time.time_ns()), self.blocking)
+        return self._queue_item(PendingMessage(topic, cls, time_ns, sequence, data, metadata or {}, time.time_ns()), self.blocking)
 
     def write_extra(self, extra: ExtraMessage) -> bool:
         """Queue one message of a channel that is not a representation (any thread; never blocks)."""
         return self._queue_item(extra, False)
 
-    def _queue_item(self, item: _Item | ExtraMessage, wait: bool) -> bool:
+    def _queue_item(self, item: PendingMessage | ExtraMessage, wait: bool) -> bool:
         if self._closed or self.failed:
             return False
         try:
@@ -179,7 +182,7 @@ class LogWriter:
             try:
                 item = self._queue.get(timeout=self.flush_interval)
             except queue.Empty:
-                item = _Item("", type(None), 0, 0, b"", {})  # nothing came: just flush
+                item = PendingMessage("", type(None), 0, 0, b"", {})  # nothing came: just flush
             if item is None:
                 return
             try:
@@ -218,7 +221,7 @@ class LogWriter:
             except queue.Empty:
                 break
 
-    def _add(self, item: _Item) -> None:
+    def _add(self, item: PendingMessage) -> None:
         channel = self._channels.get(item.topic)
         if channel is None:
             schema = self._schemas.get(item.cls)
