@@ -4,12 +4,13 @@ The robot is the URDF that ``platforms.robot_model`` generates from ``representa
 is built from the same ``field_parts``. Cameras render with PyBullet's CPU renderer (no OpenGL at all).
 
 Rendering is most of a simulated second's work (about 15 ms of CPU per 320x240 image, 60 images a
-second), and PyBullet holds the GIL while it renders, so a thread cannot help: with cameras on and more
-than one core, a render worker (``RenderWorker``, a process with a copy of the world that only renders)
-draws the top camera while this process draws the bottom one. Only the poses of what moves (the robot's
-base and joints, the ball) travel to it, a few hundred bytes a frame; its image comes back as raw
-bytes. The images are the same as when one process renders both (``--render-worker off``). PyBullet's
-EGL renderer is no help here: on Mesa's llvmpipe (no GPU) it is slower than the CPU renderer and loses
+second), and PyBullet holds the GIL while it renders, so a thread cannot help: with cameras on and a
+spare core (more than one, and the last minute's load leaves one idle), a render worker
+(``RenderWorker``, a process with a copy of the world that only renders) draws the top camera while
+this process draws the bottom one. Only the poses of what moves (the robot's base and joints, the
+ball) travel to it, a few hundred bytes a frame; its image comes back as raw bytes. The images are
+the same as when one process renders both (``--render-worker off``). PyBullet's EGL renderer is no
+help here: on Mesa's llvmpipe (no GPU) it is slower than the CPU renderer and loses
 the mesh shapes (the ball's texture, the posts).
 """
 
@@ -144,8 +145,15 @@ class RenderWorker:
         self.connection.close()
 
 
+def spare_core() -> bool:
+    """Whether a core is free for a render worker: there is more than one, and the last minute's load
+    leaves one idle (on a machine already busy, a second process only adds switching)."""
+    cores = os.cpu_count() or 1
+    return cores > 1 and os.getloadavg()[0] <= cores - 1
+
+
 def parse_render_worker(value: Any) -> bool | None:
-    """``--render-worker``: on, off, or auto (None: on where cameras render headless on more than one core)."""
+    """``--render-worker``: on, off, or auto (None: on where cameras render headless and a core is spare)."""
     text = str(value if value is not None else "auto").lower()
     if text not in ("on", "off", "auto"):
         raise PlatformOptionError(f"--render-worker takes on, off or auto, got {value!r}")
@@ -169,7 +177,7 @@ class PybulletPlatform(SimulatedRobotPlatform):
         super().add_arguments(parser)
         parser.add_argument("--render-worker", choices=["on", "off", "auto"], default="auto",
                             help="pybullet: render the top camera in a process of its own, in parallel with the bottom one "
-                                 "(auto: with cameras on, no viewer and more than one core)")
+                                 "(auto: with cameras on, no viewer and a core to spare: more than one, not all busy)")
 
     # ------------------------------------------------------------------------------- the world
     def build(self, contexts: frozenset[str], viewer: bool) -> None:
@@ -188,7 +196,7 @@ class PybulletPlatform(SimulatedRobotPlatform):
             self.bodies[part.name] = self._field_body(part)
         self._load_robot()
         self.previous_velocity = np.zeros(3)
-        wanted = self.render_worker if self.render_worker is not None else (os.cpu_count() or 1) > 1
+        wanted = self.render_worker if self.render_worker is not None else spare_core()
         if wanted and self.cameras and not viewer and "cognition" in contexts:
             try:
                 self.worker = RenderWorker(dict(self.options), self.width, self.height)

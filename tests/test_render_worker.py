@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from tafel.core.runtime.platform import PlatformOptionError
+from tafel.platforms import pybullet_sim
 from tafel.platforms.pybullet_sim import PybulletPlatform
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.perception import CameraImageBottom, CameraImageTop
@@ -75,6 +76,14 @@ def test_render_worker_option_says_what_it_takes() -> None:
     with pytest.raises(PlatformOptionError, match="on, off or auto"):
         PybulletPlatform({"render_worker": "sometimes"})
     assert PybulletPlatform({"render_worker": "off", "cameras": "on"}).render_worker is False
+
+
+@pytest.mark.parametrize(("cores", "load", "spare"), [(2, 0.3, True), (2, 1.0, True), (2, 4.5, False), (1, 0.0, False), (8, 6.5, True)])
+def test_auto_render_worker_only_with_a_spare_core(monkeypatch: pytest.MonkeyPatch, cores: int, load: float, spare: bool) -> None:
+    """On a machine whose cores are all busy, a second process only adds switching: auto renders in one."""
+    monkeypatch.setattr(pybullet_sim.os, "cpu_count", lambda: cores)
+    monkeypatch.setattr(pybullet_sim.os, "getloadavg", lambda: (load, load, load))
+    assert pybullet_sim.spare_core() is spare
 
 
 def test_cpu_seconds_reads_a_process_cpu_time() -> None:
