@@ -1,10 +1,10 @@
 """Cognition's budget: the default cognition per frame over recorded frames, against the floor any perception pays.
 
-    python benchmarks/cognition_budget.py [FOLDER] [--frames N] [--bottom WIDTHxHEIGHT]
+    python benchmarks/cognition_budget.py [FOLDER] [--frames N] [--top WIDTHxHEIGHT] [--bottom WIDTHxHEIGHT]
 
 The frames: the real NAO images of FOLDER (default ``../shared/real-images``, laid out as its README
-says): each frame pairs a top camera image (640x480) with a bottom camera image (shrunk to
-``--bottom``, default the NAO's 320x240), each with its camera's pose as ``tafel.platforms.images``
+says): each frame pairs a top camera image (``--top``, default the NAO's 640x480) with a bottom camera
+image (``--bottom``, default the NAO's 320x240; both shrunk from the recorded 640x480 where smaller), each with its camera's pose as ``tafel.platforms.images``
 reads it. Without that folder, MuJoCo renders of random scenes at 640x480 stand in (``"frames": "renders"``).
 
 The program: the default configuration on the video platform (``tafel run --platform video --source
@@ -63,7 +63,7 @@ def shrink(image: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     return cv2.resize(image, size, interpolation=cv2.INTER_AREA)
 
 
-def real_pairs(folder: Path, bottom_size: tuple[int, int]) -> tuple[list[tuple[Shot, Shot]], Path]:
+def real_pairs(folder: Path, top_size: tuple[int, int], bottom_size: tuple[int, int]) -> tuple[list[tuple[Shot, Shot]], Path]:
     """(top, bottom) pairs from the labelled set: the i-th top image with the i-th bottom one."""
     with open(folder / "labels.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
@@ -76,7 +76,7 @@ def real_pairs(folder: Path, bottom_size: tuple[int, int]) -> tuple[list[tuple[S
         posed = posed_image(folder / row["image"], camera=camera)
         image = posed.image if camera == "top" else shrink(posed.image, bottom_size)
         if camera == "top":
-            image = shrink(image, (640, 480))
+            image = shrink(image, top_size)
             paths.append(folder / row["image"])
         shots[camera].append(Shot(image, posed.matrix, posed.horizontal_fov, posed.vertical_fov))
     count = min(len(shots["top"]), len(shots["bottom"]))
@@ -85,14 +85,14 @@ def real_pairs(folder: Path, bottom_size: tuple[int, int]) -> tuple[list[tuple[S
     return list(zip(shots["top"][:count], shots["bottom"][:count])), paths[0]
 
 
-def rendered_pairs(count: int, bottom_size: tuple[int, int]) -> list[tuple[Shot, Shot]]:
-    """(top, bottom) pairs of MuJoCo renders of random scenes (top 640x480)."""
+def rendered_pairs(count: int, top_size: tuple[int, int], bottom_size: tuple[int, int]) -> list[tuple[Shot, Shot]]:
+    """(top, bottom) pairs of MuJoCo renders of random scenes (rendered at 640x480)."""
     from tafel.tools.scene_frames import SceneRenderer
 
     pairs, pending = [], {}
     with SceneRenderer("mujoco", resolution="640x480") as renderer:
         for frame in renderer.random_frames(2 * count, seed=1):
-            image = frame.image if frame.camera == "top" else shrink(frame.image, bottom_size)
+            image = shrink(frame.image, top_size if frame.camera == "top" else bottom_size)
             pending[frame.camera] = Shot(image, frame.matrix, frame.horizontal_fov, frame.vertical_fov)
             if len(pending) == 2:
                 pairs.append((pending["top"], pending["bottom"]))
@@ -166,14 +166,24 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("folder", nargs="?", type=Path, default=DEFAULT_FOLDER, help="the real-image set (default ../shared/real-images)")
     parser.add_argument("--frames", type=int, default=120, help="cognition frames measured (default 120)")
-    parser.add_argument("--bottom", default="320x240", help="the bottom camera's resolution (default the NAO's 320x240)")
+    parser.add_argument("--top", default="640x480", help="the top camera's resolution (default the NAO's 640x480; at most that)")
+    parser.add_argument("--bottom", default="320x240", help="the bottom camera's resolution (default the NAO's 320x240; at most 640x480)")
     args = parser.parse_args()
-    width, height = (int(v) for v in args.bottom.lower().split("x"))
+    sizes = []
+    for name in ("top", "bottom"):
+        try:
+            width, height = (int(v) for v in getattr(args, name).lower().split("x"))
+        except ValueError:
+            parser.error(f"--{name} takes WIDTHxHEIGHT, e.g. 320x240; got {getattr(args, name)!r}")
+        if not (16 <= width <= 640 and 16 <= height <= 480):
+            parser.error(f"--{name} {width}x{height}: the recorded frames are 640x480, so 16x16 up to 640x480")
+        sizes.append((width, height))
+    (top_w, top_h), (width, height) = sizes
     if (args.folder / "labels.csv").is_file():
-        pairs, source = real_pairs(args.folder, (width, height))
+        pairs, source = real_pairs(args.folder, (top_w, top_h), (width, height))
         kind = f"real ({len(pairs)} pairs from {args.folder.name})"
     else:
-        pairs = rendered_pairs(30, (width, height))
+        pairs = rendered_pairs(30, (top_w, top_h), (width, height))
         source = Path(os.devnull)
         kind = f"renders ({len(pairs)} MuJoCo pairs)"
         cache = Path(os.environ.get("TMPDIR", "/tmp")) / "cognition_budget_top.png"
@@ -187,7 +197,7 @@ def main() -> None:
     ordered = sorted(whole)
     p95 = ordered[int(0.95 * (len(ordered) - 1))] * 1e3
     print(json.dumps({
-        "frames": kind, "top": "640x480", "bottom": f"{width}x{height}", "measured_frames": len(whole),
+        "frames": kind, "top": f"{top_w}x{top_h}", "bottom": f"{width}x{height}", "measured_frames": len(whole),
         "mean_ms": round(mean, 2), "p95_ms": round(p95, 2),
         "per_module_ms": {name: round(statistics.fmean(times), 3) for name, times in sorted(modules.items(), key=lambda kv: -sum(kv[1]))},
         "floor_ms": round(floor, 2), "ratio_to_floor": round(mean / floor, 1),
