@@ -39,7 +39,6 @@ from tafel.core.runtime import (
 from tafel.core.runtime.platform import Platform, PlatformError, PlatformOptionError, available_platforms, load_platform
 from tafel.core.runtime.program import ContextPlan, plan_program
 from tafel.core.runtime.watchdog import STUCK_TIMEOUT_S
-from tafel.debug.commands import frame_number
 from tafel.debug.executors import (
     DEBUG_REPRESENTATIONS,
     LocalExecutor,
@@ -49,6 +48,7 @@ from tafel.debug.executors import (
     worker_debug_setup,
     worker_setups,
 )
+from tafel.debug.values import frame_number
 from tafel.tools.arguments import (
     add_console_command,
     add_deploy_commands,

@@ -28,9 +28,9 @@ from typing import Any
 import numpy as np
 
 from tafel.core.runtime import name_os_thread
-from tafel.debug.commands import jpeg_bytes, representation_message
 from tafel.debug.concepts import DebugDrawings, DebugPlots, ModuleTimes
 from tafel.debug.server import DebugServer
+from tafel.debug.values import jpeg_bytes, representation_message
 from tafel.debug.websocket import WebServer
 from tafel.representations.motion import JointSensorData, TorsoPose
 from tafel.tools.live_feed import Handed, LiveFeed, feed_order
