@@ -8,8 +8,10 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from tafel.core import Module, bounded, provides, requires
+from tafel.core import Module, bounded, provides, requires, uses
 from tafel.debug import plot
+from tafel.modules.perception.image_geometry import camera_views
+from tafel.representations.motion import CameraMatrixBuffer
 from tafel.representations.perception import CameraImageBottom, CameraImageTop, FieldColor, SegmentedImage
 
 #: the most saturation (0..255) a pixel may have and still count as white (lines, posts, the ball)
@@ -17,10 +19,15 @@ WHITE_SATURATION_MAX = 70
 
 
 @requires(CameraImageTop, CameraImageBottom)
+@uses(CameraMatrixBuffer)
 @provides(FieldColor, SegmentedImage)
 class FieldColorProvider(Module):
-    """The most frequent saturated hue among greenish pixels of the bottom image and the top image's
-    lower half (where the field usually is), with a tolerance from its spread, smoothed over frames.
+    """The most frequent saturated hue among greenish pixels where the field must be: the bottom image, and
+    the top image below the horizon (where the camera's pose is known; else its lower half), with a
+    tolerance from its spread, smoothed over frames.
+
+    Sampling below the horizon keeps the hall out: a robot that looks up sees walls, doors and boards in
+    the top image's lower half, and a teal door filling it outvoted the carpet.
 
     Light changes move the estimate within a few frames; a frame with too little green (the robot
     looks at a wall, or is lifted) keeps the last estimate.
@@ -33,6 +40,8 @@ class FieldColorProvider(Module):
         hue_high: int = bounded(0, 180, 95)
         saturation_floor: int = bounded(0, 255, 50)
         """pixels less saturated than this are lines, robots or walls, never field"""
+        horizon_margin: float = bounded(0.0, 0.5, 0.05)
+        """share of the image height below the horizon where sampling starts (the pose is not exact)"""
         min_share: float = bounded(0.0, 1.0, 0.15)
         """share of the sampled pixels that must be green to update the estimate"""
         smoothing: float = bounded(0.0, 1.0, 0.3)
@@ -61,8 +70,13 @@ class FieldColorProvider(Module):
     def estimate(self) -> None:
         """This frame's field colour from samples of both images, blended into the last estimate."""
         p, out, segmented = self.parameters, self.field_color, self.segmented_image
-        samples = [hsv[int(hsv.shape[0] * start) :: p.step, :: p.step].reshape(-1, 3)
-                   for hsv, start in ((segmented.bottom_hsv, 0.0), (segmented.top_hsv, 0.5)) if hsv.size]
+        top_start = 0.5 * segmented.top_hsv.shape[0]
+        for camera, _, projection in camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer):
+            if camera == "top" and (projection.height, projection.width) == segmented.top_hsv.shape[:2]:
+                horizon = max(projection.horizon(0.0), projection.horizon(projection.width - 1.0))  # its lower end
+                top_start = float(np.clip(horizon + p.horizon_margin * projection.height, 0.0, 0.9 * projection.height))
+        samples = [hsv[int(start) :: p.step, :: p.step].reshape(-1, 3)
+                   for hsv, start in ((segmented.bottom_hsv, 0.0), (segmented.top_hsv, top_start)) if hsv.size]
         if not samples:
             return
         hsv = np.concatenate(samples)

@@ -37,7 +37,9 @@ class GoalPostDetector(Module):
     """Posts stand on the field and rise over its boundary: columns that are white just above the
     boundary are grouped, and each group is followed down to where it meets the field (its foot).
     The goal line meets the foot, so the foot is where the white widens into the line. A group is a
-    post if its width fits a 100 mm post at the distance of its foot and it rises well above it."""
+    post if its width fits a 100 mm post at the distance of its foot and it rises well above it. The
+    goal's rear frame and the net's poles are thinner pipes, farther away than the foot the scan finds
+    for them: too thin for a post there."""
 
     @dataclass
     class Parameters:
@@ -47,7 +49,10 @@ class GoalPostDetector(Module):
         white_share: float = bounded(0.3, 1.0, 0.55)
         """white is at least this share of the brightest unsaturated value"""
         width_tolerance: float = bounded(0.1, 2.0, 0.6)
-        """share by which the width may differ from a post's at that distance"""
+        """share by which the width may exceed a post's at that distance (shading, blur)"""
+        width_low: float = bounded(0.1, 1.0, 0.75)
+        """the least share of a post's width at that distance: the goal's rear frame and the net's poles are
+        thinner pipes, and farther away than the foot the scan finds for them"""
         min_height: float = bounded(1.0, 20.0, 3.0)
         """the white above the foot must be this many widths high"""
 
@@ -103,7 +108,7 @@ class GoalPostDetector(Module):
             return None
         distance = float(np.linalg.norm(np.append(ground[0], 0.0) - projection.translation))
         expected = projection.fx * GOAL_POST_DIAMETER / distance
-        if abs(post_width - expected) > p.width_tolerance * expected + 1.5:
+        if post_width - expected > p.width_tolerance * expected + 1.5 or post_width < p.width_low * expected - 1.0:
             return None
         column = white[: foot + 1, centre]
         rise = foot - (np.nonzero(~column)[0].max() if (~column).any() else -1)

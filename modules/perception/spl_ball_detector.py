@@ -10,6 +10,7 @@ import numpy as np
 
 from tafel.core import Module, bounded, provides, requires
 from tafel.debug import drawing, request, stopwatch
+from tafel.modules.perception.ball_classifier import BallClassifier, features
 from tafel.modules.perception.image_geometry import ImageProjection, camera_views
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import CameraMatrixBuffer
@@ -25,6 +26,14 @@ from tafel.representations.perception import (
 )
 
 DRAW_CANDIDATES = request("SPLBallDetector:draw_candidates", "every ball candidate (grey) and accepted ball (blue) in the images")
+
+
+def carpet(hsv: np.ndarray, green: np.ndarray) -> tuple[float, float]:
+    """The carpet's median value and saturation (sampled), the measures of the light; (128, 128) without carpet."""
+    sampled = hsv[::4, ::4][green[::4, ::4]]
+    if len(sampled) < 10:
+        return 128.0, 128.0
+    return float(np.median(sampled[:, 2])), float(np.median(sampled[:, 1]))
 
 
 @dataclass
@@ -64,7 +73,7 @@ class SPLBallDetector(Module):
         size_high: float = bounded(1.0, 3.0, 1.5)
         min_radius: float = bounded(0.5, 10.0, 1.5)
         """px: smaller balls are not looked for"""
-        max_spots: int = bounded(1, 50, 8)
+        max_spots: int = bounded(1, 50, 16)
         """candidates checked per image"""
         green_inside_max: float = bounded(0.0, 1.0, 0.25)
         green_around_min: float = bounded(0.0, 1.0, 0.3)
@@ -86,12 +95,24 @@ class SPLBallDetector(Module):
         """the black patches (mean value) must be darker than this share of the carpet's value around"""
         dark_spot_min: float = bounded(0.0, 1.0, 0.02)
         """share of dark pixels a candidate needs round its centre (a square of its thickness)"""
+        classifier: bool = True
+        """the learned classifier (``ball_classifier``) decides the candidates that passed the checks"""
+        classifier_min: float = bounded(-5.0, 5.0, 0.0)
+        """the classifier's boosted score a ball needs (higher: fewer false balls, more missed ones)"""
+
+    def __init__(self) -> None:
+        self.model: BallClassifier | None = None
+        self.examined: list[tuple[str, Spot, float]] = []
+        """this frame's candidates with their checks' score (0: rejected), for training and debugging"""
 
     def execute(self) -> None:
         found: list[BallCandidate] = []
         self.ball_image_percept.candidates = found
+        self.examined = []
         if not self.field_color.valid:
             return
+        if self.parameters.classifier and self.model is None:
+            self.model = BallClassifier()
         for camera, image, projection in camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer):
             with stopwatch("SPLBallDetector:image"):
                 hsv, green = self.segmented_image.hsv(camera), self.segmented_image.green(camera)
@@ -103,11 +124,20 @@ class SPLBallDetector(Module):
                         beside = self.beside_post(hsv, green, spot, white)
                         score = self.check(hsv, green, beside, white, beside_post=True)[0] if beside else 0.0
                         spot = beside or spot
+                    self.examined.append((camera, spot, score))
+                    if score and self.parameters.classifier:
+                        score = self.classify(hsv, green, spot, score)
                     if DRAW_CANDIDATES:
                         drawing(f"image:{camera}").circle(spot.x, spot.y, spot.radius, color="blue" if score else "gray")
                     if score:
                         found.append(self.candidate(camera, image, spot, score))
         found.sort(key=lambda c: -c.fill)
+
+    def classify(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, score: float) -> float:
+        """``score`` if the classifier takes the spot for a ball, else 0."""
+        assert self.model is not None
+        row = features(hsv, green, spot.x, spot.y, spot.radius, *carpet(hsv, green))
+        return score if float(self.model.scores(row)[0]) >= self.parameters.classifier_min else 0.0
 
     def dark_pixels(self, hsv: np.ndarray, green: np.ndarray) -> np.ndarray | None:
         """Pixels darker than ``black_contrast`` times the carpet's median value (the ball's black patches
@@ -183,14 +213,19 @@ class SPLBallDetector(Module):
         if known:
             fits &= ys >= boundary[xs]  # the centre lies on the field; only the top may reach over its edge
         if dark is not None:  # a ball has black patches: spots without dark pixels near their centre are none
-            fits &= self.dark_share(dark, xs, ys, np.maximum(radii, 1.0)) >= p.dark_spot_min
+            # (a field without any green leaves the distance transform unbounded: radii beyond the image are none)
+            fits &= self.dark_share(dark, xs, ys, np.clip(radii, 1.0, max(height, width))) >= p.dark_spot_min
         # the spots most like a ball's size first: lines are thinner, robots and the border thicker
         order = np.argsort(np.abs(np.log(np.maximum(radii[fits], 0.5) / np.maximum(expected[fits], 0.5))))
         chosen: list[Spot] = []
         for x, y, r, e in zip(xs[fits][order], ys[fits][order], radii[fits][order], expected[fits][order]):
             if all((x - s.x) ** 2 + (y - s.y) ** 2 > (s.expected * 1.5) ** 2 for s in chosen):
                 spot = Spot(float(x), float(y), float(max(r, 0.5 * (r + e))), float(e))
-                chosen.append(self.inside_image(spot, ~green) if spot.x < e or spot.x > width - 1 - e or spot.y > height - 1 - e else spot)
+                if spot.x < e or spot.x > width - 1 - e or spot.y > height - 1 - e:
+                    spot = self.inside_image(spot, ~green)  # moved: it may now be a spot chosen already
+                    if any((spot.x - s.x) ** 2 + (spot.y - s.y) ** 2 <= (s.expected * 1.5) ** 2 for s in chosen):
+                        continue
+                chosen.append(spot)
                 if len(chosen) >= p.max_spots:
                     break
         return chosen
