@@ -98,7 +98,9 @@ class SPLBallDetector(Module):
         classifier: bool = True
         """the learned classifier (``ball_classifier``) decides the candidates that passed the checks"""
         classifier_min: float = bounded(-5.0, 5.0, 0.0)
-        """the classifier's boosted score a ball needs (higher: fewer false balls, more missed ones)"""
+        """the classifier's score (a logit) a ball needs (higher: fewer false balls, more missed ones)"""
+        classifier_at_edge: bool = False
+        """the classifier also decides candidates whose square reaches out of the image"""
 
     def __init__(self) -> None:
         self.model: BallClassifier | None = None
@@ -134,8 +136,14 @@ class SPLBallDetector(Module):
         found.sort(key=lambda c: -c.fill)
 
     def classify(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, score: float) -> float:
-        """``score`` if the classifier takes the spot for a ball, else 0."""
+        """``score`` if the classifier takes the spot for a ball, else 0. A ball cut by the image's edge is
+        left to the checks: its square reaches out of the image, and the classifier, which learned far
+        more edge-cut things that are no ball (dark corners, the hall), turns down the balls there too."""
         assert self.model is not None
+        height, width = green.shape
+        side = 1.1 * spot.radius  # the classifier's square round the spot
+        if not self.parameters.classifier_at_edge and not (side <= spot.x <= width - side and side <= spot.y <= height - side):
+            return score
         row = features(hsv, green, spot.x, spot.y, spot.radius, *carpet(hsv, green))
         return score if float(self.model.scores(row)[0]) >= self.parameters.classifier_min else 0.0
 
