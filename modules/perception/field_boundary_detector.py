@@ -33,6 +33,17 @@ def lower_hull(xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return xs[hull], ys[hull]
 
 
+def local_medians(tops: np.ndarray, found: np.ndarray, reach: int) -> np.ndarray:
+    """For each found column, the median of the found columns' ``tops`` within ``reach`` columns of it.
+    One window per column over the tops with NaN where none was found, so numpy does it at once (a
+    median per column in Python took most of the detector's time)."""
+    n_cols = len(tops)
+    padded = np.full(n_cols + 2 * reach, np.nan, np.float32)
+    padded[reach : reach + n_cols][found] = tops[found]
+    windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * reach + 1)[np.nonzero(found)[0]]
+    return np.nanmedian(windows, axis=1)
+
+
 @requires(SegmentedImage, FieldColor)
 @uses(CameraImageTop, CameraImageBottom, CameraMatrixBuffer)
 @provides(FieldBoundary)
@@ -127,7 +138,7 @@ class FieldBoundaryDetector(Module):
         if found.sum() >= 3:  # outliers: far above the median of the columns around them (green in the hall)
             reach = max(1, int(p.outlier_window * n_cols))
             indices = np.nonzero(found)[0]
-            local = np.array([np.median(tops[indices[(indices >= i - reach) & (indices <= i + reach)]]) for i in indices])
+            local = local_medians(tops, found, reach)
             found[indices[tops[indices] < local - p.outlier_rise * height]] = False
         xs = (np.arange(n_cols) + 0.5) * p.cell
         if not found.any():
