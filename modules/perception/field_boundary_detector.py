@@ -33,6 +33,25 @@ def lower_hull(xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return xs[hull], ys[hull]
 
 
+def highest_field_rows(field: np.ndarray, lines: np.ndarray, max_gap: int) -> np.ndarray:
+    """For each column of the cells' ``field`` (rows x columns), the highest field row reached from the
+    column's lowest field cell upwards across gaps of at most ``max_gap`` cells (cells on ``lines`` do
+    not count as gap); the row count where a column has no field.
+
+    All columns and rows at once: scanning from the bottom, a cell's gap is the number of gap cells
+    since the last field cell below it; a column stops at the first cell whose gap is too long."""
+    n_rows, n_cols = field.shape
+    up = field[::-1]  # row 0 is the image's bottom row
+    step = np.cumsum(~up & ~lines[::-1], axis=0)  # gap cells from the bottom up to each cell
+    rows = np.arange(n_rows)[:, None]
+    last_field = np.maximum.accumulate(np.where(up, rows, -1), axis=0)  # the last field cell at or below
+    started = last_field >= 0
+    gap = step - np.take_along_axis(step, np.maximum(last_field, 0), axis=0)
+    alive = ~np.logical_or.accumulate(started & (gap > max_gap), axis=0)
+    reached = (alive & up)[::-1]  # back to image rows: the first reached row from the top is the highest
+    return np.where(reached.any(axis=0), np.argmax(reached, axis=0), n_rows)
+
+
 def local_medians(tops: np.ndarray, found: np.ndarray, reach: int) -> np.ndarray:
     """For each found column, the median of the found columns' ``tops`` within ``reach`` columns of it.
     One window per column over the tops with NaN where none was found, so numpy does it at once (a
@@ -120,19 +139,10 @@ class FieldBoundaryDetector(Module):
             field &= np.arange(n_rows)[:, None] >= lowest[None, :]
         # from each column's lowest field cell upwards, across gaps of at most max_gap
         max_gap = int(round(p.max_gap * height / p.cell))
-        started = np.zeros(n_cols, bool)
-        alive = np.ones(n_cols, bool)
-        gap = np.zeros(n_cols, int)
-        top = np.full(n_cols, n_rows)
         lines = np.zeros_like(field)
         if white is not None and white.shape == green.shape:
             lines = cv2.resize(white.astype(np.float32), (n_cols, n_rows), interpolation=cv2.INTER_AREA) >= p.green_share
-        for row in range(n_rows - 1, -1, -1):
-            here = field[row]
-            started |= here
-            gap = np.where(here, 0, np.where(lines[row], gap, gap + 1))
-            alive &= ~started | (gap <= max_gap)
-            top = np.where(alive & here, row, top)
+        top = highest_field_rows(field, lines, max_gap)
         found = top < n_rows
         tops = top.astype(np.float32) * p.cell
         if found.sum() >= 3:  # outliers: far above the median of the columns around them (green in the hall)
