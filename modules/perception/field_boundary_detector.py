@@ -21,11 +21,12 @@ def lower_hull(xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The largest convex function below the points (image y grows downwards, so: the boundary with the
     dents of goal posts and robots in front of it removed). ``xs`` ascending."""
     hull: list[int] = []
-    for i in range(len(xs)):
+    x, y = xs.tolist(), ys.tolist()  # Python floats: numpy scalars made this loop several times slower
+    for i in range(len(x)):
         while len(hull) >= 2:
             a, b = hull[-2], hull[-1]
             # drop b if it lies above the segment a -> i (then b is a dent, not part of the hull)
-            if (ys[b] - ys[a]) * (xs[i] - xs[a]) >= (ys[i] - ys[a]) * (xs[b] - xs[a]):
+            if (y[b] - y[a]) * (x[i] - x[a]) >= (y[i] - y[a]) * (x[b] - x[a]):
                 hull.pop()
             else:
                 break
