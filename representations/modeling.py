@@ -41,7 +41,8 @@ class RobotPose:
     """Where the robot is on the field (field frame of the README): ``x``, ``y`` in mm, ``rotation`` in
     rad (0: facing the opponent goal). ``valid`` once the localization trusts it; ``lost`` while it has
     lost track and relocalizes (``valid`` is then false). ``deviation`` is the position's standard
-    deviation (mm), ``rotation_deviation`` the rotation's (rad)."""
+    deviation (mm), ``rotation_deviation`` the rotation's (rad), ``mirror_probability`` that of the
+    mirrored twin."""
 
     valid: bool = False
     lost: bool = False
@@ -50,6 +51,9 @@ class RobotPose:
     rotation: float = bounded(-math.pi, math.pi)
     deviation: float = bounded(0.0, 1e6, 1e6)
     rotation_deviation: float = bounded(0.0, 10.0, math.pi)
+    mirror_probability: float = bounded(0.0, 1.0, 0.5)
+    """how likely the robot is at this pose's twin (turned by 180 degrees about the centre spot, which
+    the field cannot tell apart) rather than here; ``valid`` only while it is low"""
 
     def to_field(self, x: float, y: float) -> tuple[float, float]:
         """A point in the robot frame (mm) on the field (mm)."""

@@ -16,9 +16,10 @@ from tafel.modules.modeling.self_locator import SelfLocator, low_variance_indice
 from tafel.representations import field
 from tafel.representations.game import GameState, Penalty, RobotInfo, TeamInfo
 from tafel.representations.infrastructure import FrameInfo
-from tafel.representations.modeling import RobotPose
+from tafel.representations.modeling import KnownPose, RobotPose
 from tafel.representations.motion_control import FallDirection, FallPhase, FallState, Odometry
-from tafel.representations.perception import GoalPostPercept, LinePercept
+from tafel.representations.perception import BallPercept, GoalPostPercept, LinePercept
+from tafel.representations.team import TeamMate, TeamMates, TeamMessage
 from tests.support.field_views import line_percept, post_percept
 
 FRAME_NS = 33_333_333
@@ -34,13 +35,27 @@ class Run:
         self.frame = 0
         self.odometry = np.zeros(3)  # x, y, rotation in the start frame
 
-    def step(self, pose: tuple[float, float, float], seeing: bool = True, head: float | None = None) -> RobotPose:
+    def step(self, pose: tuple[float, float, float], seeing: bool = True, head: float | None = None,
+             ball: tuple[float, float] | None = None, team_ball: tuple[float, float] | None = None, message: int | None = None) -> RobotPose:
+        """One frame at the true ``pose``: seeing the field (and the ``ball`` on the field, if given) as
+        perfect detectors would; a teammate reporting the ball at ``team_ball`` (field), if given, in a new
+        message every second (or in message number ``message``)."""
         self.frame += 1
         look = HEADS[(self.frame // 30) % len(HEADS)] if head is None else head
         lines = line_percept(pose, self.rng, head=look) if seeing else LinePercept(segments=[])
         posts = post_percept(pose, head=look) if seeing else GoalPostPercept(posts=[])
         odometry = Odometry(x=float(self.odometry[0]), y=float(self.odometry[1]), rotation=float(self.odometry[2]))
-        self.harness.set(FrameInfo(frame_number=self.frame, time_ns=self.frame * FRAME_NS), odometry, lines, posts)
+        seen = BallPercept()
+        if ball is not None:
+            bx, by = RobotPose(x=pose[0], y=pose[1], rotation=pose[2]).to_robot(*ball)
+            seen = BallPercept(seen=True, x=bx + self.rng.normal(0.0, 50.0), y=by + self.rng.normal(0.0, 50.0))
+        mates = TeamMates(mates=[])
+        if team_ball is not None:
+            number = self.frame // 30 if message is None else message
+            said = TeamMessage(team=1, player=3, sent_ms=1000 * number, pose_valid=True, ball_seen=True, ball_x=team_ball[0],
+                               ball_y=team_ball[1], ball_age=0.2)
+            mates = TeamMates(mates=[TeamMate(message=said, age=0.5)])
+        self.harness.set(FrameInfo(frame_number=self.frame, time_ns=self.frame * FRAME_NS), odometry, lines, posts, seen, mates)
         return copy.copy(self.harness.execute()[RobotPose])  # the blackboard's instance changes every frame
 
     def walk(self, pose: tuple[float, float, float], forward: float, left: float, turn: float) -> tuple[float, float, float]:
@@ -56,6 +71,24 @@ class Run:
 def error(pose: RobotPose, truth: tuple[float, float, float]) -> tuple[float, float]:
     """(mm, degrees) between an estimate and the truth."""
     return math.hypot(pose.x - truth[0], pose.y - truth[1]), abs(math.degrees(math.remainder(pose.rotation - truth[2], math.tau)))
+
+
+def twin_of(truth: tuple[float, float, float]) -> tuple[float, float, float]:
+    """The pose the field cannot tell from ``truth``: turned by 180 degrees about the centre spot."""
+    return -truth[0], -truth[1], math.remainder(truth[2] + math.pi, math.tau)
+
+
+def mirrored(pose: RobotPose, truth: tuple[float, float, float]) -> bool:
+    """A valid pose at the truth's twin rather than at the truth."""
+    return pose.valid and error(pose, twin_of(truth))[0] < 500.0 and error(pose, truth)[0] > 1000.0
+
+
+def penalty(run: Run, penalized: bool) -> None:
+    """The GameController's word on this robot (team 1, player 2): penalized or playing."""
+    state = GameState(team_number=1, player_number=2, teams=[TeamInfo(team_number=1, players=[RobotInfo() for _ in range(20)])])
+    if penalized:
+        state.teams[0].players[1].penalty = Penalty.leaving_the_field
+    run.harness.set(state)
 
 
 OWN_HALF_POSES = [(-1500.0, 0.0, 0.0), (-3200.0, 1800.0, -0.7), (-600.0, -2200.0, 2.5), (-4000.0, -500.0, 1.2)]
@@ -99,15 +132,16 @@ def test_follows_the_walk_by_odometry_between_percepts() -> None:
 
 
 @pytest.mark.slow
-def test_a_kidnapped_robot_says_it_is_lost_and_finds_itself_again() -> None:
+def test_a_kidnapped_robot_says_it_is_lost_and_finds_itself_again_by_the_teams_ball() -> None:
     run = Run()
-    start, elsewhere = (-1500.0, 0.0, 0.0), (-3500.0, 2000.0, -1.5)
+    start, elsewhere, ball = (-1500.0, 0.0, 0.0), (-3500.0, 2000.0, -1.5), (-3000.0, 500.0)
     for _ in range(120):
         run.step(start)
     lost_seen, recovered_at = False, None
-    for i in range(300):  # 10 s carried elsewhere; odometry knows nothing of it
-        pose = run.step(elsewhere)
+    for i in range(300):  # 10 s carried elsewhere; odometry knows nothing of it; the team sees the ball
+        pose = run.step(elsewhere, ball=ball, team_ball=ball)
         lost_seen |= pose.lost
+        assert not mirrored(pose, elsewhere)
         if recovered_at is None and pose.valid and error(pose, elsewhere)[0] < 200.0:
             recovered_at = i
     assert lost_seen
@@ -177,12 +211,78 @@ def test_mirror_takes_the_own_half_when_the_robot_was_carried_far(pose: tuple, t
 
 
 @pytest.mark.slow
-def test_a_robot_carried_across_the_field_relocalizes_in_its_own_half() -> None:
+def test_a_robot_carried_alone_never_takes_the_twin_and_says_it_is_unsure() -> None:
+    """Carried by nobody the rules name, with no teammate: the field cannot tell the twins apart, so the
+    pose is not valid (and lost) rather than perhaps mirrored, wherever it was carried."""
     run = Run()
-    for truth in [(-1500.0, 0.0, 0.0), (-3500.0, 1800.0, -2.2), (-1000.0, -2200.0, 1.0), (-2500.0, 0.0, 3.0)]:
+    for _ in range(120):
+        run.step((-1500.0, 0.0, 0.0))
+    for truth in [(2500.0, -1000.0, 2.5), (-3500.0, 1800.0, -2.2), (3200.0, 1500.0, 0.3)]:
         for _ in range(240):  # 8 s at each place
             pose = run.step(truth)
-        assert pose.valid and error(pose, truth)[0] < 150.0, (truth, pose)
+            assert not mirrored(pose, truth), (truth, pose)
+        assert not pose.valid and pose.lost and 0.05 < pose.mirror_probability < 0.95, (truth, pose)
+        assert min(error(pose, truth)[0], error(pose, twin_of(truth))[0]) < 200.0  # one of the twins, undecided
+
+
+def test_a_teammates_ball_breaks_the_tie() -> None:
+    """Carried into the other half: undecided between the twins until a ball seen lies where a teammate
+    says it is, which only the true pose explains."""
+    run = Run()
+    for _ in range(120):
+        run.step((-1500.0, 0.0, 0.0))
+    truth, ball = (2500.0, -1000.0, 2.5), (1500.0, -1600.0)
+    for _ in range(150):  # 5 s alone: unsure
+        pose = run.step(truth)
+        assert not mirrored(pose, truth)
+    assert not pose.valid
+    for _ in range(90):  # 3 s with the ball seen and the team's word on it
+        pose = run.step(truth, ball=ball, team_ball=ball)
+        assert not mirrored(pose, truth)
+    assert pose.valid and error(pose, truth)[0] < 150.0 and error(pose, truth)[1] < 10.0
+    assert pose.mirror_probability < 0.05
+
+
+def test_a_confident_pose_does_not_jump_to_its_mirror_on_weak_evidence() -> None:
+    """Told where it is (in the other half, where no placement rule helps), a teammate then claims the ball
+    at the twin's side in one message: the pose stays valid. Only messages that keep saying so for
+    seconds turn it (three at least), and the turn passes through unsure."""
+    run = Run()
+    truth, ball = (2000.0, -800.0, 2.0), (1200.0, -300.0)
+    run.harness.set(KnownPose(serial=1, x=truth[0], y=truth[1], rotation=truth[2]))
+    for _ in range(60):
+        pose = run.step(truth, ball=ball)
+    assert pose.valid and error(pose, truth)[0] < 150.0
+    wrong = (-ball[0], -ball[1])  # a teammate that is itself mirrored
+    for _ in range(30):  # a second of seeing the ball where one message says it is not
+        pose = run.step(truth, ball=ball, team_ball=wrong, message=1)
+        assert pose.valid and error(pose, truth)[0] < 150.0
+    states = [run.step(truth, ball=ball, team_ball=wrong) for _ in range(240)]  # 8 s of messages saying the same
+    first_invalid = next(i for i, p in enumerate(states) if not p.valid)
+    first_mirrored = next(i for i, p in enumerate(states) if mirrored(p, truth))  # evidence that keeps coming decides
+    assert all(error(p, truth)[0] < 150.0 for p in states[:first_invalid])
+    assert first_invalid < first_mirrored and first_mirrored >= 45  # through unsure, after three messages in all
+    assert mirrored(states[-1], truth)  # here wrongly: the teammate lied
+
+
+def test_a_penalized_robot_returning_is_placed_on_its_own_halfs_touchline() -> None:
+    """Penalized in the opponent half (where continuity alone would keep it), put back by the referee on a
+    touchline of its own half: the rules' placement decides the side."""
+    run = Run()
+    before, returned = (2500.0, 1000.0, 0.0), (-3000.0, 3000.0, -math.pi / 2)
+    run.harness.set(KnownPose(serial=1, x=before[0], y=before[1], rotation=before[2]))
+    for _ in range(60):
+        pose = run.step(before)
+    assert pose.valid and error(pose, before)[0] < 150.0
+    penalty(run, True)
+    for _ in range(30):
+        run.step(returned, seeing=False)
+    penalty(run, False)
+    for _ in range(120):  # 4 s
+        pose = run.step(returned)
+        assert not mirrored(pose, returned)
+    assert pose.valid and error(pose, returned)[0] < 150.0 and error(pose, returned)[1] < 10.0
+    assert pose.mirror_probability < 0.05
 
 
 @given(st.lists(st.floats(0.0, 1.0), min_size=1, max_size=50))
@@ -225,11 +325,9 @@ def test_after_a_penalty_it_starts_again_on_the_own_touchlines() -> None:
     start, returned = (-1500.0, 0.0, 0.0), (-2800.0, -3000.0, math.pi / 2)
     for _ in range(120):
         run.step(start)
-    penalized = GameState(team_number=1, player_number=2, teams=[TeamInfo(team_number=1, players=[RobotInfo() for _ in range(20)])])
-    penalized.teams[0].players[1].penalty = Penalty.leaving_the_field
-    run.harness.set(penalized)
+    penalty(run, True)
     run.step(start)
-    run.harness.set(GameState(team_number=1, player_number=2, teams=[TeamInfo(team_number=1, players=[RobotInfo() for _ in range(20)])]))
+    penalty(run, False)
     particles = []
     for i in range(90):  # 3 s
         pose = run.step(returned)

@@ -9,20 +9,22 @@ import numpy as np
 
 from tafel.core import Module, bounded, provides, requires, uses
 from tafel.debug import drawing, plot, request
-from tafel.modules.modeling.field_model import FIELD_MODEL, OWN_HALF, mirror
+from tafel.modules.modeling.field_model import FIELD_MODEL, OWN_HALF
+from tafel.modules.modeling.mirror_hypotheses import SideBelief, fold, freshest_team_ball, twin
 from tafel.representations import field
 from tafel.representations.game import GameState
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import KnownPose, RobotPose
 from tafel.representations.motion_control import FallState, Odometry
-from tafel.representations.perception import GoalPostPercept, LinePercept
+from tafel.representations.perception import BallPercept, GoalPostPercept, LinePercept
+from tafel.representations.team import TeamMates
 
 KNOWN_POSE_STD, KNOWN_ROTATION_STD = 30.0, 0.03  # mm and rad: the particles' spread round a pose told (KnownPose)
 DRAW_PARTICLES = request("SelfLocator:draw_particles", "every particle and the estimate on the field canvas")
 
 
 @requires(Odometry, LinePercept, GoalPostPercept, FrameInfo)
-@uses(FallState, GameState, KnownPose)
+@uses(FallState, GameState, KnownPose, BallPercept, TeamMates)
 @provides(RobotPose)
 class SelfLocator(Module):
     """Monte Carlo localization.
@@ -33,10 +35,13 @@ class SelfLocator(Module):
       distance map), goal posts by their distance to the nearest post, the centre circle's centre by
       its distance to the centre spot. Noise grows with the distance of what was seen. Poses beyond
       the field's lines are unlikely (the referee takes such robots off), beyond the carpet more so.
-    - The field looks the same turned by 180 degrees. Particles start in the own half (the robot
-      enters the field there), and every particle made anew is put on the side nearer to the last
-      valid estimate: continuity decides. If both sides are far from it, the robot was carried, and
-      the own half is taken (referees put penalized robots back there).
+    - The field looks the same turned by 180 degrees. The particles track one of two twins (each is
+      folded onto the side nearer the estimate) and the other is kept apart as the mirror hypothesis;
+      ``SideBelief`` decides between them: the rules' placement in the own half (at the start, after a
+      penalty) traced back by odometry, the team's ball against the ball seen, and the history (the
+      belief carries on while tracked, and a confident one turns only on much evidence). The pose is
+      valid only once the side is decided; a robot carried elsewhere by nobody the rules name starts
+      undecided, and says so (``valid`` false) rather than guess the twin.
     - Lost: when the measurements keep fitting much worse than they used to (the robot was carried
       or slipped), part of the particles are made anew from what is seen (sensor resetting): around
       a seen post at its measured distance, on the centre circle's position, or on a field line.
@@ -73,9 +78,33 @@ class SelfLocator(Module):
         lost_ratio: float = bounded(0.0, 1.0, 0.45)
         reset_share: float = bounded(0.0, 1.0, 0.25)
         """share of the particles made anew per frame while lost"""
-        carried_distance: float = bounded(0.0, 20000.0, 2000.0)
-        """mm: a new pose this far from the last valid one, as from its twin, means the robot was carried
-        (a referee moves penalized robots to their own half): it is put in the own half, not the nearer one"""
+        side_decided: float = bounded(0.5, 20.0, 3.0)
+        """log-odds of one twin over the other needed for a valid pose (3: about 95 %)"""
+        side_cap: float = bounded(1.0, 50.0, 10.0)
+        """largest log-odds the side belief holds: what evidence for the twin must overcome"""
+        placement_cap: float = bounded(0.0, 50.0, 6.0)
+        """log-odds against a twin that puts the robot's placement well beyond the halfway line (counted
+        once, not every frame) ..."""
+        placement_rate: float = bounded(0.0, 1.0, 0.2)
+        """... of which at most this share a frame"""
+        team_ball_std: float = bounded(10.0, 5000.0, 300.0)
+        """mm: the team's ball against the ball seen ..."""
+        team_ball_std_per_m: float = bounded(0.0, 1000.0, 100.0)
+        """... plus this per metre of the seen ball's distance ..."""
+        team_ball_std_per_s: float = bounded(0.0, 5000.0, 300.0)
+        """... plus this per second of the team ball's age"""
+        team_ball_max_age: float = bounded(0.0, 30.0, 3.0)
+        """s: older team balls are not used"""
+        team_ball_rate: float = bounded(0.0, 1.0, 0.12)
+        """share of the team ball's log-likelihood ratio counted per frame (frames see the same ball) ..."""
+        team_message_cap: float = bounded(0.0, 50.0, 4.0)
+        """... and at most this much log-odds from one teammate's message: a confident side turns only
+        on several messages that keep saying so"""
+        continuity_distance: float = bounded(0.0, 5000.0, 1000.0)
+        """mm: relocalized this near where it was lost (and within ``continuity_rotation``, unless it
+        fell), the robot was not carried: the side belief carries on ..."""
+        continuity_rotation: float = bounded(0.0, 3.2, 0.6)
+        """... rad"""
         search_share: float = bounded(0.0, 1.0, 0.05)
         """share made anew per frame before the first fix"""
         outside_std: float = bounded(10.0, 5000.0, 300.0)
@@ -105,14 +134,20 @@ class SelfLocator(Module):
         self.evidence: set[str] = set()  # what was seen since: one line alone fits many places
         self.was_penalized = False
         self.known_serial = 0  # the last KnownPose taken
+        self.side = SideBelief()
+        self.anchor: np.ndarray | None = None  # the estimate the side belief is about, moved by odometry: carried since?
+        self.fell_at = -math.inf  # s of the last fall: after one the heading may be anything, the place not
 
     def execute(self) -> None:
+        odometry = (self.odometry.x, self.odometry.y, self.odometry.rotation)
         if len(self.particles) != self.parameters.particles:
             self.particles = FIELD_MODEL.own_half(self.rng, self.parameters.particles)
+            self.side.place(odometry)  # the robot enters the field in its own half
         penalized = self.game_state.penalized
         if self.was_penalized and not penalized:
             self.particles = FIELD_MODEL.penalty_return(self.rng, self.parameters.particles)
-            self.trusted = self.estimate = self.concentrated_since = None
+            self.trusted = self.estimate = self.concentrated_since = self.anchor = None
+            self.side.place(odometry)  # the referee put it on a touchline of its own half
         self.was_penalized = penalized
         self.predict()
         if self.known_pose.serial != self.known_serial:
@@ -133,6 +168,7 @@ class SelfLocator(Module):
         previous, self.last_odometry = self.last_odometry, now
         if not self.fall_state.upright and self.was_upright:
             self.particles[:, 2] += self.rng.normal(0.0, p.fallen_rotation_noise, len(self.particles))
+            self.fell_at = self.frame_info.time_s
         self.best = None
         if previous is None:
             return
@@ -142,6 +178,9 @@ class SelfLocator(Module):
         turn = math.remainder(now[2] - previous[2], math.tau)
         if self.estimate is not None:
             self.estimate = moved(self.estimate, forward, left, turn)
+        if self.anchor is not None:
+            self.anchor = moved(self.anchor, forward, left, turn)
+        self.side.walked(math.hypot(forward, left))
         n = len(self.particles)
         step = math.hypot(forward, left)
         forward = forward + self.rng.normal(0.0, p.translation_noise * step + 1.0, n)
@@ -161,6 +200,8 @@ class SelfLocator(Module):
         self.trusted, self.estimate, self.best = (pose.x, pose.y, pose.rotation), told, None
         self.slow = self.fast = 0.0  # the measurements' fit is learnt anew at this place
         self.concentrated_since, self.evidence = self.frame_info.time_s - self.parameters.confirm_after, {"told"}
+        self.side.told(self.parameters.side_cap)
+        self.anchor = told.copy()
 
     # ----------------------------------------------------------------------------------- sensing
     def weigh(self) -> float | None:
@@ -195,13 +236,20 @@ class SelfLocator(Module):
         log_weight += self.on_field_prior()
         weights = np.exp(log_weight - log_weight.max())
         weights /= weights.sum()
-        self.best = self.particles[int(np.argmax(weights))].copy()
+        best = self.particles[int(np.argmax(weights))]
         if 1.0 / np.sum(weights**2) < 0.5 * len(weights):
             self.particles = self.particles[low_variance_indices(weights, self.rng)]
             n = len(self.particles)
             self.particles[:, :2] += self.rng.normal(0.0, p.roughening, (n, 2))
             self.particles[:, 2] += self.rng.normal(0.0, p.roughening_rotation, n)
+        reference = self.reference()
+        self.particles = fold(self.particles, reference)  # both twins' particles in one cloud
+        self.best = fold(best[None, :], reference)[0]
         return fit
+
+    def reference(self) -> np.ndarray:
+        """The pose the particles are folded towards: the estimate, or before one the own half's middle."""
+        return self.estimate if self.estimate is not None else np.array(OWN_HALF)
 
     def on_field_prior(self) -> np.ndarray:
         """Log-prior of each particle's place: a robot far beyond the lines is taken off by the referee, and
@@ -216,18 +264,18 @@ class SelfLocator(Module):
         return np.stack([x + c * points[:, 0] - s * points[:, 1], y + s * points[:, 0] + c * points[:, 1]], axis=-1)
 
     def reset_if_lost(self, fit: float) -> None:
-        """Make part of the particles anew from the percepts while lost, or before the first fix."""
+        """Make part of the particles anew from the percepts while lost, or while the pose is not valid."""
         p = self.parameters
         self.slow += p.alpha_slow * (fit - self.slow) if self.slow else fit
         self.fast += p.alpha_fast * (fit - self.fast) if self.fast else fit
         plot("SelfLocator:fit", fit)
         lost = self.fast < p.lost_ratio * self.slow
-        if not lost and self.trusted is not None:
+        if not lost and self.robot_pose.valid:
             return
-        # before the first fix a few fresh particles a frame keep every pose that fits what is seen alive
+        # until the pose is valid a few fresh particles a frame keep every pose that fits what is seen alive
         count = int((p.reset_share if lost else p.search_share) * len(self.particles))
         fresh = FIELD_MODEL.poses_from_percepts(self.rng, count, self.line_percept, self.goal_post_percept)
-        fresh = mirror(fresh, towards=self.trusted or OWN_HALF, far=p.carried_distance)
+        fresh = fold(fresh, self.reference())
         self.particles[self.rng.choice(len(self.particles), len(fresh), replace=False)] = fresh
 
     # ---------------------------------------------------------------------------------- estimate
@@ -252,9 +300,13 @@ class SelfLocator(Module):
         elif self.concentrated_since is None:
             self.concentrated_since = now
         if self.concentrated_since is not None:
+            self.decide_side(pose)
             self.evidence |= self.evidence_seen(pose.rotation)
         pose.valid = (self.concentrated_since is not None and now - self.concentrated_since >= p.confirm_after
-                      and bool(self.evidence & {"circle", "post", "told"} or {"along", "across"} <= self.evidence))
+                      and bool(self.evidence & {"circle", "post", "told"} or {"along", "across"} <= self.evidence)
+                      and self.side.odds >= p.side_decided)
+        pose.mirror_probability = 1.0 / (1.0 + math.exp(self.side.odds))
+        plot("SelfLocator:side_odds", self.side.odds)
         pose.lost = lost or (self.trusted is not None and not pose.valid)
         if pose.valid:
             self.trusted = (pose.x, pose.y, pose.rotation)
@@ -264,6 +316,39 @@ class SelfLocator(Module):
                 canvas.line(x, y, x + 120 * math.cos(heading), y + 120 * math.sin(heading), color="gray")
             canvas.robot_pose(pose.x, pose.y, pose.rotation, color="blue" if pose.valid else "red", width=2)
 
+    def decide_side(self, pose: RobotPose) -> None:
+        """With the particles gathered on one pose: was the robot carried there from where they last
+        gathered (then the side is open again), or did it slip or fall; what the placement and the
+        team's ball say of the twins; turn to the twin when the evidence favours it."""
+        p, side = self.parameters, self.side
+        if self.anchor is not None:
+            fell = self.frame_info.time_s - self.fell_at < 10.0
+            stayed = side.stayed(self.estimate, self.anchor, p.continuity_distance, math.inf if fell else p.continuity_rotation)
+            if stayed is None:
+                side.carried(placed_since=self.trusted is None)
+                self.anchor = None
+            elif stayed == "twin":  # the old side, as the particles were folded the other way
+                self.turn_to_twin(pose)
+                side.flip()
+        odometry = (self.odometry.x, self.odometry.y, self.odometry.rotation)
+        side.add_placement(self.estimate, odometry, p.placement_cap, p.placement_rate * p.placement_cap, p.side_cap)
+        team, ball = freshest_team_ball(self.team_mates, p.team_ball_max_age), self.ball_percept
+        if team is not None and ball.seen and math.isfinite(ball.x) and math.isfinite(ball.y):
+            std = p.team_ball_std + p.team_ball_std_per_m * math.hypot(ball.x, ball.y) / 1000.0 + p.team_ball_std_per_s * team.age
+            side.add_team_ball(self.estimate, (ball.x, ball.y), team, std, p.team_ball_rate, p.team_message_cap, p.side_cap)
+        if side.odds < 0.0:
+            self.turn_to_twin(pose)
+            side.flip()
+        if side.odds >= p.side_decided:  # a decided side is about this estimate from now on
+            self.anchor = self.estimate.copy()
+
+    def turn_to_twin(self, pose: RobotPose) -> None:
+        """Track the twin: every particle, the estimate and the pose turned about the centre spot."""
+        self.particles = twin(self.particles)
+        self.estimate = twin(self.estimate)
+        if self.best is not None:
+            self.best = twin(self.best)
+        pose.x, pose.y, pose.rotation = float(self.estimate[0]), float(self.estimate[1]), float(self.estimate[2])
 
     def near(self, centre: np.ndarray) -> np.ndarray:
         """Which particles are within 600 mm and 0.6 rad of ``centre``."""
