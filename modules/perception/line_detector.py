@@ -229,7 +229,7 @@ class LineDetector(Module):
             # refit on the inliers (principal axis), then cut at the outermost inliers
             chosen = points[inliers]
             centre = chosen.mean(axis=0)
-            axis = np.linalg.svd(chosen - centre)[2][0]
+            axis = np.linalg.svd(chosen - centre, full_matrices=False)[2][0]  # the full U (N x N) took ms for a few hundred points
             along = (chosen - centre) @ axis
             start, end = centre + along.min() * axis, centre + along.max() * axis
             if np.linalg.norm(end - start) >= 2 * LINE_WIDTH:
