@@ -13,8 +13,8 @@ import cv2
 import numpy as np
 import pytest
 
-from tafel.core.logfile import read_log
-from tafel.core.serialization import deserialize
+from tafel.core.logs import read_log
+from tafel.core.logs.serialization import deserialize
 from tafel.modules.motion.kinematics import CAMERA_LINKS, angles_by_name, camera_pose_in_torso, link_poses, robot_frame_from_torso
 from tafel.modules.motion.stand_motion import stand_pose
 from tafel.platforms.images import (
