@@ -475,9 +475,9 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
                 self.tell_pose = True
                 return where + "; the localization starts anew at this pose (KnownPose)"
             twin = f"x={-x:.0f} y={-y:.0f} mm, rotation {math.remainder(heading + math.pi, math.tau):.3f} rad"
-            return (f"{where}. The field looks the same turned by 180 degrees: the localization may take the mirrored pose "
-                    f"({twin}), as it does for a robot carried by a referee, which it puts in its own half; "
-                    "add -reset on to tell it the true pose")
+            return (f"{where}. The field looks the same turned by 180 degrees ({twin} looks alike): carried where no rule "
+                    "places a robot, the localization keeps RobotPose not valid until a teammate's ball or a placement "
+                    "decides the side; add -reset on to tell it the true pose")
 
         def push(args: Mapping[str, Any]) -> str:
             fx, fy = number(args, "x", limit=MAX_PUSH), number(args, "y", limit=MAX_PUSH)
