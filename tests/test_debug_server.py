@@ -373,7 +373,7 @@ def test_the_listening_line_and_port_conflicts(program: Program) -> None:
 
 def test_unknown_canvas_and_bytes_without_plus_say_what_would_be_right(program: Program) -> None:
     answer = program.ask("drawings:get -canvas nosuch")
-    assert answer.startswith("error:") and "no canvas 'nosuch'" in answer and "field, image:top, image:bottom" in answer
+    assert answer.startswith("error:") and "no canvas 'nosuch'" in answer and "field, robot, image:top, image:bottom" in answer
     close = program.ask("drawings:get -canvas image:tpo")
     assert "did you mean 'image:top'" in close
     raw = program.ask("representation:get -name BallModel")

@@ -140,7 +140,7 @@ def test_getting_up_from_lying(robot: Robot, side: str) -> None:
 def test_a_push_that_topples_the_robot_is_detected_as_a_fall_and_it_gets_up(robot: Robot) -> None:
     robot.ask("sim:push -x 400")
     phases, postures = set(), set()
-    deadline = robot.status()["time"] + 4.0
+    deadline = robot.status()["time"] + 6.0  # simulated s: a loaded machine samples the phases less often
     while robot.status()["time"] < deadline:
         phases.add(re.search(r"phase: (\w+)", robot.ask("representation:print FallState -context motion")).group(1))
         postures.add(robot.status()["posture"])
