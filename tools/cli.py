@@ -592,6 +592,7 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
                   simulated=True)
     report_recording(recorder)
     if box is not None:
+        box[0].finish()
         print(box[0].status(), flush=True)
     return 1 if any(s.failure for s in stats.values()) else 0
 
@@ -667,6 +668,7 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
                   notes=notes)
     report_recording(recorder)
     if box is not None:
+        box[0].finish()
         print(box[0].status(), flush=True)
     return 1 if any(s.failure for s in stats.values()) else 0
 

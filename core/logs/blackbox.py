@@ -185,6 +185,7 @@ class BlackBox:
         self.last_save = -math.inf
         self.suppressed = 0
         self.on_save: list[Callable[[str, Path], None]] = []
+        self.writers: list[threading.Thread] = []
 
     # -------------------------------------------------------------------------------------- the sink
     def write(self, topic: str, cls: type, time_ns: int, sequence: int, data: bytes,
@@ -228,8 +229,16 @@ class BlackBox:
         metadata = {**self.metadata, "blackbox_trigger": trigger, "blackbox_time_s": f"{at_ns * 1e-9:.3f}",
                     "blackbox_seconds": f"{self.seconds:g}"}
         log.warning("black box: %s at %.2f s; writing the last %g s to %s", trigger, at_ns * 1e-9, self.seconds, path)
-        threading.Thread(target=self._write, args=(path, messages, metadata, trigger), name="tafel-blackbox", daemon=True).start()
+        writer = threading.Thread(target=self._write, args=(path, messages, metadata, trigger), name="tafel-blackbox", daemon=True)
+        self.writers.append(writer)
+        writer.start()
         return path
+
+    def finish(self, timeout_s: float = 30.0) -> None:
+        """Wait for the saves under way (the program is ending: a file cut off would be half a log)."""
+        deadline = time.monotonic() + timeout_s
+        for writer in self.writers:
+            writer.join(max(0.0, deadline - time.monotonic()))
 
     def _write(self, path: Path, messages: list[PendingMessage], metadata: dict[str, str], trigger: str) -> None:
         try:
