@@ -348,6 +348,9 @@ def test_an_image_carries_the_drawings_of_its_own_frame_and_plot_names_come_when
     try:
         with connect(f"ws://127.0.0.1:{view.server.port}/ws") as socket:
             assert ask(socket, "subscribe CameraImageTop PlotNames").startswith("subscribed")
+            deadline = time.monotonic() + 10.0  # the view learns of the subscription on its own thread
+            while not {"CameraImageTop", "PlotNames"} <= set(view.wanted) and time.monotonic() < deadline:
+                time.sleep(0.01)
             circle = lambda frame: DebugDrawingPrimitive("image:top", "circle", [frame, 10.0, 5.0], "orange")  # noqa: E731
             field_line = DebugDrawingPrimitive("field", "line", [0.0, 0.0, 1.0, 1.0])
             for frame in (5, 6):  # as a loop hands them over: the frame's image first, its drawings after it
