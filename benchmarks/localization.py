@@ -48,7 +48,7 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 from tafel.representations.modeling import RobotPose  # noqa: E402
 from tafel.representations.motion_control import MotionRequest, MotionType  # noqa: E402
 from tafel.representations.perception import BallPercept  # noqa: E402
-from tafel.tools.scene_frames import Perception, SceneRenderer  # noqa: E402
+from tafel.tools.scene_frames import Perception, SceneRenderer, random_ball_scene  # noqa: E402
 from tests.support.kidnapping import Kidnapping, KidnapRun  # noqa: E402
 from tests.support.simulation import Simulation  # noqa: E402
 from tests.test_localization import ROUTE  # noqa: E402
@@ -66,12 +66,11 @@ def ball_detection(engine: str, frames: int, seed: int = 0) -> dict[str, float]:
         rng = np.random.default_rng(seed)
         scenes = 0
         while scenes < frames:
-            pose = (rng.uniform(-4300, 4300), rng.uniform(-2800, 2800), rng.uniform(-math.pi, math.pi))
-            head = (rng.uniform(-0.8, 0.8), rng.uniform(-0.3, 0.45))
-            distance, bearing = rng.uniform(300.0, 5000.0), pose[2] + head[0] + rng.normal(0.0, 0.5)
-            ball = (pose[0] + distance * math.cos(bearing), pose[1] + distance * math.sin(bearing))
-            if abs(ball[0]) > 4800 or abs(ball[1]) > 3300:
+            scene = random_ball_scene(rng)
+            if scene is None:
                 continue
+            pose, head, ball = scene
+            distance = math.hypot(ball[0] - pose[0], ball[1] - pose[1])
             scenes += 1
             views = renderer.frames(pose, head, ball)
             percept = perception(views)[BallPercept]

@@ -168,3 +168,16 @@ def project_ball(matrix: CameraMatrix, ball: tuple[float, float], width: int, he
     x = width / 2 - fx * local[1] / local[0]
     y = height / 2 - fy * local[2] / local[0]
     return x, y, fx * spl.BALL_RADIUS / float(np.linalg.norm(local))
+
+
+def random_ball_scene(rng: np.random.Generator) -> tuple[tuple[float, float, float], tuple[float, float], tuple[float, float]] | None:
+    """A seeded random scene for perception figures: the robot's pose anywhere on the field (mm, rad), its head
+    (yaw, pitch; rad), and the ball 0.3 to 5 m away, roughly where the head looks; None when the ball would be
+    off the carpet (draw again)."""
+    pose = (rng.uniform(-4300, 4300), rng.uniform(-2800, 2800), rng.uniform(-math.pi, math.pi))
+    head = (rng.uniform(-0.8, 0.8), rng.uniform(-0.3, 0.45))
+    distance, bearing = rng.uniform(300.0, 5000.0), pose[2] + head[0] + rng.normal(0.0, 0.5)
+    ball = (pose[0] + distance * math.cos(bearing), pose[1] + distance * math.sin(bearing))
+    if abs(ball[0]) > 4800 or abs(ball[1]) > 3300:
+        return None
+    return pose, head, ball

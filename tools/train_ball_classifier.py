@@ -40,7 +40,7 @@ from tafel.modules.perception.ball_classifier import FEATURES, MODEL_PATH, featu
 from tafel.modules.perception.spl_ball_detector import SPLBallDetector, carpet
 from tafel.platforms.images import posed_image
 from tafel.representations.motion import CameraMatrix
-from tafel.tools.scene_frames import LabelledFrame, Perception
+from tafel.tools.scene_frames import LabelledFrame, Perception, random_ball_scene
 
 REPO = Path(__file__).resolve().parent.parent
 DEFAULT_REAL = REPO / "tests" / "data" / "real_images"
@@ -189,12 +189,10 @@ def simulated(collector: Collector, engine: str, scenes: int, seed: int, painted
             perception = perception_without_classifier()
             made = 0
             while made < scenes:
-                pose = (rng.uniform(-4300, 4300), rng.uniform(-2800, 2800), rng.uniform(-math.pi, math.pi))
-                head = (rng.uniform(-0.8, 0.8), rng.uniform(-0.3, 0.45))
-                distance, bearing = rng.uniform(300.0, 5000.0), pose[2] + head[0] + rng.normal(0.0, 0.5)
-                ball = (pose[0] + distance * math.cos(bearing), pose[1] + distance * math.sin(bearing))
-                if abs(ball[0]) > 4800 or abs(ball[1]) > 3300:
+                scene = random_ball_scene(rng)
+                if scene is None:
                     continue
+                pose, head, ball = scene
                 made += 1
                 views = renderer.frames(pose, head, ball)
                 painted: dict[str, list[tuple[float, float, float]]] = {camera: [] for camera in views}
