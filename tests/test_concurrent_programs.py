@@ -49,3 +49,24 @@ def test_a_users_representation_reaches_every_process_with_the_web_view_on(tmp_p
     assert frames(result.stdout)["motion"] == 150
     counts = [m for m in read_log(log).messages if m.topic.endswith("HeartbeatCount")]
     assert len(counts) > 10
+
+
+def test_a_final_report_sent_just_before_the_process_ended_is_not_taken_for_a_death() -> None:
+    """The supervisor polls the pipes, then the processes: a context that stops cleanly in between has
+    its last report unread. It must read it before it calls the context dead (seen once as
+    'cognition process died (exit code 0)' on Ctrl-C during start-up)."""
+    import multiprocessing
+
+    from tafel.core.runtime.concurrent import ConcurrentRuntime
+    from tafel.core.runtime.context import ContextStats
+
+    runtime = ConcurrentRuntime.__new__(ConcurrentRuntime)
+    runtime.stats = {"cognition": ContextStats(name="cognition")}
+    receiver, sender = multiprocessing.Pipe(duplex=False)
+    sender.send(ContextStats(name="cognition", frames=0, finished=True))
+    sender.close()
+    connections = {"cognition": receiver}
+    runtime._read_last_reports("cognition", connections)
+    assert runtime.stats["cognition"].finished and not runtime.stats["cognition"].failure
+    runtime._read_last_reports("cognition", connections)  # the closed pipe: nothing more, no error
+    assert "cognition" not in connections

@@ -285,6 +285,7 @@ class ConcurrentRuntime:
                 if not process.is_alive() and name not in reported_dead:
                     reported_dead.add(name)
                     self.exit_codes[name] = process.exitcode
+                    self._read_last_reports(name, open_connections)
                     if not self.stats[name].finished:
                         self._ended(name, f"process died (exit code {process.exitcode})")
                         open_connections.pop(name, None)
@@ -298,6 +299,16 @@ class ConcurrentRuntime:
                 self._stopping_since = self._stopping_since or time.monotonic()
                 if time.monotonic() - self._stopping_since > self.grace_s:
                     break  # a context that does not stop in time: run() ends it
+
+    def _read_last_reports(self, name: str, open_connections: dict[str, Any]) -> None:
+        """A process that ended may have sent its final report after the last wait: read what is left,
+        so that a clean end between two polls is not taken for a death."""
+        connection = open_connections.get(name)
+        try:
+            while connection is not None and connection.poll():
+                self.stats[name] = connection.recv()
+        except (EOFError, OSError):
+            open_connections.pop(name, None)
 
     def _ended(self, name: str, why: str) -> None:
         """A context died or failed (a stuck module): a failure of the program, whichever context it was.
