@@ -5,7 +5,6 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 
 from tafel.core import array, bounded, representation
@@ -82,22 +81,14 @@ class BallImagePercept:
 @representation
 class FieldColor:
     """The field's green, estimated from the images each frame (OpenCV HSV: hue 0..180, saturation and
-    value 0..255), so that a change of light moves it rather than breaking every detector."""
+    value 0..255), so that a change of light moves it rather than breaking every detector.
+    ``FieldColorProvider`` segments the images by it (``green_mask`` in its file)."""
 
     valid: bool = False
     hue: float = 60.0
     hue_tolerance: float = 12.0
     saturation_min: float = 60.0
     value_min: float = 40.0
-
-    def mask(self, hsv: np.ndarray) -> np.ndarray:
-        """Which pixels of an HSV image (h x w x 3 uint8) are field green (h x w bool)."""
-        low, high = self.hue - self.hue_tolerance, self.hue + self.hue_tolerance
-        mask = cv2.inRange(hsv, (max(0.0, low), self.saturation_min, self.value_min), (min(179.0, high), 255, 255))
-        if low < 0 or high > 179:  # the range wraps round red
-            wrapped = (low + 180, 179.0) if low < 0 else (0.0, high - 180)
-            mask |= cv2.inRange(hsv, (wrapped[0], self.saturation_min, self.value_min), (wrapped[1], 255, 255))
-        return mask > 0
 
 
 class Camera(str, enum.Enum):

@@ -12,25 +12,27 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tafel.core.testing import ModuleHarness
+from tafel.modules.communication.game_controller_codec import (
+    GAME_SIZE,
+    PacketError,
+    ReturnPacket,
+    decode_game_state,
+    decode_return,
+    encode_game_state,
+    encode_return,
+)
 from tafel.modules.communication.game_controller_reporter import GameControllerReporter
 from tafel.modules.communication.game_state_provider import GameStateProvider
 from tafel.modules.motion.chest_button_provider import ChestButtonProvider
 from tafel.representations.game import (
-    GAME_SIZE,
     Datagram,
     GameControllerPackets,
     GameControllerReturn,
     GamePhase,
     GameState,
-    PacketError,
     Penalty,
-    ReturnPacket,
     SetPlay,
     State,
-    decode_game_state,
-    decode_return,
-    encode_game_state,
-    encode_return,
 )
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion import ChestButton, TouchSensorData

@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 from tafel.core.testing import ModuleHarness
 from tafel.modules.modeling.field_model import FIELD_MODEL
 from tafel.modules.perception.field_boundary_detector import FieldBoundaryDetector, lower_hull
-from tafel.modules.perception.field_color_provider import FieldColorProvider
+from tafel.modules.perception.field_color_provider import FieldColorProvider, green_mask
 from tafel.modules.perception.image_geometry import ImageProjection
 from tafel.modules.perception.line_detector import longest_arc, white_runs
 from tafel.platforms.field_world import ball_is_black, ball_texture, paint_ball_texture
@@ -195,6 +195,20 @@ def test_no_green_no_field_colour_and_no_crash() -> None:
     board = ModuleHarness(FieldColorProvider, CameraImageTop(image=grey), CameraImageBottom(image=np.zeros((0, 0, 3), np.uint8))).execute()
     assert not board[FieldColor].valid
     assert board[SegmentedImage].bottom_hsv.size == 0
+
+
+@settings(max_examples=60, deadline=None)
+@given(hue=st.integers(0, 179), tolerance=st.integers(1, 40), saturation_min=st.integers(0, 255), value_min=st.integers(0, 255))
+def test_the_green_mask_is_a_hue_band_round_the_circle_above_saturation_and_value(hue: int, tolerance: int, saturation_min: int,
+                                                                                 value_min: int) -> None:
+    """Every hue within ``tolerance`` of the field's, counted round the circle (0 and 179 are neighbours), with
+    saturation and value at least their minimums, and nothing else."""
+    h, s, v = np.meshgrid(np.arange(180), [0, 1, 64, 127, 128, 254, 255], [0, 1, 64, 127, 128, 254, 255], indexing="ij")
+    hsv = np.stack([h, s, v], axis=-1).reshape(180, -1, 3).astype(np.uint8)
+    color = FieldColor(valid=True, hue=hue, hue_tolerance=tolerance, saturation_min=saturation_min, value_min=value_min)
+    distance = np.minimum(np.abs(hsv[..., 0].astype(int) - hue), 180 - np.abs(hsv[..., 0].astype(int) - hue))
+    expected = (distance <= tolerance) & (hsv[..., 1] >= saturation_min) & (hsv[..., 2] >= value_min)
+    np.testing.assert_array_equal(green_mask(color, hsv), expected)
 
 
 def test_the_boundary_ignores_what_stands_on_the_field() -> None:

@@ -565,8 +565,9 @@ def test_team_messages_that_claim_this_robots_number_are_counted_not_dropped_sil
     (someone speaking in its name, or a teammate with the same number) is left out too, and counted."""
     from tafel.core.testing import ModuleHarness
     from tafel.modules.communication.team_mates_provider import TeamMatesProvider
+    from tafel.modules.communication.team_message_codec import pack_message
     from tafel.representations.game import Datagram, GameState
-    from tafel.representations.team import IncomingTeamMessages, OutgoingTeamMessage, TeamMates, TeamMessage, pack_message
+    from tafel.representations.team import IncomingTeamMessages, OutgoingTeamMessage, TeamMates, TeamMessage
 
     own = pack_message(TeamMessage(team=1, player=2, sent_ms=1000, x=100.0))
     spoofed = pack_message(TeamMessage(team=1, player=2, sent_ms=1000, x=-4000.0, ball_seen=True))

@@ -14,6 +14,7 @@ from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.role_provider import RoleProvider
 from tafel.modules.communication.game_state_provider import GameStateProvider
 from tafel.modules.communication.team_mates_provider import TeamMatesProvider
+from tafel.modules.communication.team_message_codec import TeamMessageError, pack_message, unpack_message
 from tafel.modules.communication.team_message_sender import TeamMessageSender, send_interval
 from tafel.representations.game import Datagram, GameControllerPackets, GameState, RobotInfo, State, TeamInfo
 from tafel.representations.modeling import BallModel, RobotPose
@@ -27,9 +28,6 @@ from tafel.representations.team import (
     TeamMate,
     TeamMates,
     TeamMessage,
-    TeamMessageError,
-    pack_message,
-    unpack_message,
 )
 
 # the layout of the README's table: header, version, team, player, flags, role, intention, sent (ms),

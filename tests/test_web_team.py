@@ -18,8 +18,10 @@ from typing import Any
 
 import pytest
 
-from tafel.representations.game import GameState, Penalty, RobotInfo, State, TeamInfo, encode_game_state
-from tafel.representations.team import Intention, Role, TeamMessage, pack_message
+from tafel.modules.communication.game_controller_codec import encode_game_state
+from tafel.modules.communication.team_message_codec import pack_message
+from tafel.representations.game import GameState, Penalty, RobotInfo, State, TeamInfo
+from tafel.representations.team import Intention, Role, TeamMessage
 from tafel.tools.match import free_udp_port
 from tafel.tools.team import FORGET_AFTER_S, TeamListener
 from tests.support.browser import WebProgram, launch, missing_browser, open_page, wait_for

@@ -38,22 +38,11 @@ import math
 import socket
 from dataclasses import dataclass, field
 
+from tafel.modules.communication.game_controller_codec import MAX_PLAYERS, PacketError, decode_return, encode_game_state
 from tafel.platforms.match_world import MatchWorld, Side
 from tafel.platforms.network import listening_socket
 from tafel.representations import field as pitch
-from tafel.representations.game import (
-    MAX_PLAYERS,
-    GamePhase,
-    GameState,
-    PacketError,
-    Penalty,
-    RobotInfo,
-    SetPlay,
-    State,
-    TeamInfo,
-    decode_return,
-    encode_game_state,
-)
+from tafel.representations.game import GamePhase, GameState, Penalty, RobotInfo, SetPlay, State, TeamInfo
 from tafel.representations.team import MAX_MESSAGE_BYTES
 
 PACKET_INTERVAL_S = 0.5

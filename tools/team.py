@@ -30,9 +30,11 @@ from tafel.debug.router import DebugRouter
 from tafel.debug.server import DebugServer
 from tafel.debug.values import representation_message
 from tafel.debug.websocket import WebServer
+from tafel.modules.communication.game_controller_codec import PacketError, decode_game_state
+from tafel.modules.communication.team_message_codec import TeamMessageError, unpack_message
 from tafel.platforms.network import listening_socket
-from tafel.representations.game import GAME_CONTROLLER_PORT, GameState, PacketError, decode_game_state
-from tafel.representations.team import TEAM_PORT_BASE, TeamMate, TeamMates, TeamMessage, TeamMessageError, unpack_message
+from tafel.representations.game import GAME_CONTROLLER_PORT, GameState
+from tafel.representations.team import TEAM_PORT_BASE, TeamMate, TeamMates, TeamMessage
 from tafel.tools.debugging import field_geometry
 from tafel.tools.web.view import STATIC
 

@@ -6,7 +6,8 @@ import math
 from dataclasses import dataclass
 
 from tafel.core import Module, bounded, provides, requires, uses
-from tafel.representations.game import SEND_SLACK_S, GameControllerReturn, GameState, ReturnPacket, encode_return
+from tafel.modules.communication.game_controller_codec import SEND_SLACK_S, ReturnPacket, encode_return
+from tafel.representations.game import GameControllerReturn, GameState
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import FallState

@@ -6,17 +6,8 @@ from dataclasses import dataclass
 
 from tafel.core import Module, bounded, provides, requires, uses
 from tafel.core.framework.parameters import choice_of
-from tafel.representations.game import (
-    MAX_PLAYERS,
-    GameControllerPackets,
-    GameState,
-    PacketError,
-    Penalty,
-    RobotInfo,
-    State,
-    TeamInfo,
-    decode_game_state,
-)
+from tafel.modules.communication.game_controller_codec import MAX_PLAYERS, PacketError, decode_game_state
+from tafel.representations.game import GameControllerPackets, GameState, Penalty, RobotInfo, State, TeamInfo
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import ChestButton
 

@@ -6,9 +6,10 @@ from collections import deque
 from dataclasses import dataclass
 
 from tafel.core import Module, bounded, provides, requires, uses
+from tafel.modules.communication.team_message_codec import TeamMessageError, unpack_message
 from tafel.representations.game import GameState
 from tafel.representations.infrastructure import FrameInfo
-from tafel.representations.team import IncomingTeamMessages, OutgoingTeamMessage, TeamMate, TeamMates, TeamMessageError, unpack_message
+from tafel.representations.team import IncomingTeamMessages, OutgoingTeamMessage, TeamMate, TeamMates
 
 #: this robot's own messages remembered, to know their echoes: far more than are sent while one is on the way
 OWN_MESSAGES_KEPT = 32

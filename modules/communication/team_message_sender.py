@@ -7,11 +7,13 @@ import math
 from dataclasses import dataclass
 
 from tafel.core import Module, bounded, provides, requires, uses
-from tafel.representations.game import SEND_SLACK_S, GamePhase, GameState, Penalty, State
+from tafel.modules.communication.game_controller_codec import SEND_SLACK_S
+from tafel.modules.communication.team_message_codec import pack_message
+from tafel.representations.game import GamePhase, GameState, Penalty, State
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import FallState
-from tafel.representations.team import OutgoingTeamMessage, PlayerRole, TeamMessage, pack_message
+from tafel.representations.team import OutgoingTeamMessage, PlayerRole, TeamMessage
 
 
 def send_interval(budget: int, players: int, remaining_s: float, reserve: int, min_interval: float) -> float:

@@ -18,6 +18,17 @@ from tafel.representations.perception import CameraImageBottom, CameraImageTop, 
 WHITE_SATURATION_MAX = 70
 
 
+def green_mask(color: FieldColor, hsv: np.ndarray) -> np.ndarray:
+    """Which pixels of an HSV image (h x w x 3 uint8) are field green by ``color`` (h x w bool); the hue
+    range may wrap round red (OpenCV hue is 0..179)."""
+    low, high = color.hue - color.hue_tolerance, color.hue + color.hue_tolerance
+    mask = cv2.inRange(hsv, (max(0.0, low), color.saturation_min, color.value_min), (min(179.0, high), 255, 255))
+    if low < 0 or high > 179:  # the range wraps round red
+        wrapped = (low + 180, 179.0) if low < 0 else (0.0, high - 180)
+        mask |= cv2.inRange(hsv, (wrapped[0], color.saturation_min, color.value_min), (wrapped[1], 255, 255))
+    return mask > 0
+
+
 @requires(CameraImageTop, CameraImageBottom)
 @uses(CameraMatrixBuffer)
 @provides(FieldColor, SegmentedImage)
@@ -59,7 +70,7 @@ class FieldColorProvider(Module):
         self.estimate()
         for camera in ("top", "bottom"):
             hsv = segmented.hsv(camera)
-            green = self.field_color.mask(hsv) if hsv.size else np.zeros((0, 0), bool)
+            green = green_mask(self.field_color, hsv) if hsv.size else np.zeros((0, 0), bool)
             setattr(segmented, f"{camera}_green", green)
             # white: the brightest unsaturated pixels off the field (sampled: a percentile of every pixel costs)
             step = self.parameters.step

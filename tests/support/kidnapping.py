@@ -17,10 +17,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tafel.modules.communication.team_message_codec import pack_message
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionRequest, MotionType
 from tafel.representations.perception import BallPercept
-from tafel.representations.team import Role, TeamMessage, pack_message
+from tafel.representations.team import Role, TeamMessage
 from tests.support.simulation import PERCEPTION, Simulation
 
 WINDOW_S = 12.0  # s judged after each kidnapping
