@@ -38,6 +38,12 @@ class LookAtBallBehavior(Module):
     While penalized the head holds still where it is (``max_speed`` 0): the rules allow a penalized
     robot no motion at all until the GameController unpenalizes it. Then it looks for the ball anew."""
 
+    ball_model: BallModel
+    frame_info: FrameInfo
+    robot_pose: RobotPose
+    game_state: GameState
+    head_motion_request: HeadMotionRequest
+
     @dataclass
     class Parameters:
         camera_height: float = 480.0
@@ -65,6 +71,8 @@ class LookAtBallBehavior(Module):
         """rad of head yaw a glance reaches to either side"""
         glance_min_ball_distance: float = 900.0
         """mm: nearer balls are never looked away from"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.search_start: tuple[float, float, float] | None = None  # (time s, yaw rad, direction)

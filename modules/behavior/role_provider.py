@@ -30,6 +30,12 @@ class RoleProvider(Module):
     Teammates heard within ``mate_timeout`` s that are neither penalized nor fallen take part.
     """
 
+    game_state: GameState
+    team_mates: TeamMates
+    ball_model: BallModel
+    fall_state: FallState
+    player_role: PlayerRole
+
     @dataclass
     class Parameters:
         walk_speed: float = bounded(50.0, 1000.0, 200.0)
@@ -40,6 +46,8 @@ class RoleProvider(Module):
         """s the current striker counts quicker"""
         mate_timeout: float = bounded(0.5, 30.0, 4.0)
         """s after a teammate's last message that it still takes part"""
+
+    parameters: Parameters
 
     def execute(self) -> None:
         game, out = self.game_state, self.player_role

@@ -60,6 +60,19 @@ class SoccerBehavior(Module):
     which options are active, in which state and for how long, ``OptionGraph`` what they all are.
     """
 
+    game_state: GameState
+    player_role: PlayerRole
+    ball_model: BallModel
+    odometry: Odometry
+    motion_info: MotionInfo
+    frame_info: FrameInfo
+    robot_pose: RobotPose
+    team_mates: TeamMates
+    obstacles: Obstacles
+    motion_request: MotionRequest
+    activation_graph: ActivationGraph
+    option_graph: OptionGraph
+
     @dataclass
     class Parameters(KickParameters):
         search_turn: float = bounded(0.0, 2.0, 0.6)
@@ -93,6 +106,8 @@ class SoccerBehavior(Module):
         """mm: within this of the ball the striker goes straight for it (a duel for the ball is no push)"""
         shootout_aim: float = bounded(0.0, 700.0, 450.0)
         """mm beside the goal's centre the shoot-out kick aims (the side away from the keeper)"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.options = OptionRunner(PlaySoccer)

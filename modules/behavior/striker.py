@@ -29,10 +29,19 @@ class Striker(Module):
     - There, with the ball in front of the foot: kick, and wait for the kick to end.
     """
 
+    ball_model: BallModel
+    odometry: Odometry
+    motion_info: MotionInfo
+    frame_info: FrameInfo
+    robot_pose: RobotPose
+    motion_request: MotionRequest
+
     @dataclass
     class Parameters(KickParameters):
         search_turn: float = bounded(0.0, 2.0, 0.6)
         """rad/s while the ball is lost"""
+
+    parameters: Parameters
 
     def execute(self) -> None:
         p, ball, out = self.parameters, self.ball_model, self.motion_request

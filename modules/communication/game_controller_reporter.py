@@ -21,10 +21,19 @@ class GameControllerReporter(Module):
     address: player and team, whether the robot has fallen, its pose, and the ball (age, and position
     relative to the robot). The rules allow two a second; the platform refuses more."""
 
+    game_state: GameState
+    frame_info: FrameInfo
+    robot_pose: RobotPose
+    ball_model: BallModel
+    fall_state: FallState
+    game_controller_return: GameControllerReturn
+
     @dataclass
     class Parameters:
         interval: float = bounded(0.5, 10.0, 1.0)
         """s between return packets"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.last_sent_s = -math.inf

@@ -31,12 +31,19 @@ class GameStateProvider(Module):
     on a real robot; the simulators' configuration says PLAYING, so that ``tafel run`` plays at once.
     """
 
+    game_controller_packets: GameControllerPackets
+    frame_info: FrameInfo
+    chest_button: ChestButton
+    game_state: GameState
+
     @dataclass
     class Parameters:
         start_state: str = choice_of(STATES, "initial")
         """the state before any GameController is heard: initial, ready, set, playing, finished or standby"""
         timeout: float = bounded(0.1, 60.0, 2.0)
         """s without a packet for this team after which the GameController counts as not heard"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.last_heard_ns: int | None = None

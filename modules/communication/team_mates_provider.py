@@ -26,10 +26,18 @@ class TeamMatesProvider(Module):
     someone speaks in its name, or a teammate has the same number. A teammate not heard for
     ``forget_after`` s is dropped."""
 
+    incoming_team_messages: IncomingTeamMessages
+    game_state: GameState
+    frame_info: FrameInfo
+    outgoing_team_message: OutgoingTeamMessage
+    team_mates: TeamMates
+
     @dataclass
     class Parameters:
         forget_after: float = bounded(1.0, 600.0, 10.0)
         """s after a teammate's last message"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.heard: dict[int, tuple[int, TeamMate]] = {}  # player -> (received ns, what it said)

@@ -46,6 +46,14 @@ class TeamMessageSender(Module):
     interval only grows and the team never spends more than its budget. A robot that never heard one
     (the rules' manual mode) sends every ``interval_without_game_controller`` s."""
 
+    game_state: GameState
+    player_role: PlayerRole
+    frame_info: FrameInfo
+    robot_pose: RobotPose
+    ball_model: BallModel
+    fall_state: FallState
+    outgoing_team_message: OutgoingTeamMessage
+
     @dataclass
     class Parameters:
         reserve: int = bounded(0, 1000, 20)
@@ -55,6 +63,8 @@ class TeamMessageSender(Module):
         interval_without_game_controller: float = bounded(0.1, 60.0, 2.0)
         half_s: float = bounded(1.0, 3600.0, 600.0)
         """s of one half: the SPL's 600; practice games with shorter halves set theirs (tafel match does)"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.last_sent_s = -math.inf

@@ -69,6 +69,11 @@ class KalmanBallModeler(Module):
       that agree with each other (the ball was really moved) restart the filter there.
     """
 
+    ball_percept: BallPercept
+    frame_info: FrameInfo
+    odometry: Odometry
+    ball_model: BallModel
+
     @dataclass
     class Parameters:
         acceleration_noise: float = 1500.0
@@ -91,6 +96,8 @@ class KalmanBallModeler(Module):
         """s without a percept after which the model is no longer valid"""
         nominal_dt: float = 1.0 / 30.0
         """s, step used when the frame clock does not advance"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.axes: tuple[AxisFilter, AxisFilter] | None = None

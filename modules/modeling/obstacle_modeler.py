@@ -23,6 +23,12 @@ class ObstacleModeler(Module):
     meanwhile); a seen robot within ``same_robot`` mm of a teammate is that teammate, and one seen
     again within two robot radii of where it was remembered replaces that memory."""
 
+    frame_info: FrameInfo
+    robots_percept: RobotsPercept
+    team_mates: TeamMates
+    robot_pose: RobotPose
+    obstacles: Obstacles
+
     @dataclass
     class Parameters:
         memory_s: float = bounded(0.0, 10.0, 1.0)
@@ -35,6 +41,8 @@ class ObstacleModeler(Module):
         """mm: a seen robot this near a teammate is the teammate"""
         max_distance: float = bounded(500.0, 15000.0, 4000.0)
         """mm: obstacles farther away are left out"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.seen: list[tuple[float, float, float]] = []  # field mm, mm, and when (s)

@@ -53,6 +53,17 @@ class SelfLocator(Module):
       ambiguity for a robot carried into the other half, which the rules above put in its own half.
     """
 
+    odometry: Odometry
+    line_percept: LinePercept
+    goal_post_percept: GoalPostPercept
+    frame_info: FrameInfo
+    fall_state: FallState
+    game_state: GameState
+    known_pose: KnownPose
+    ball_percept: BallPercept
+    team_mates: TeamMates
+    robot_pose: RobotPose
+
     @dataclass
     class Parameters:
         particles: int = bounded(20, 5000, 400)
@@ -120,6 +131,8 @@ class SelfLocator(Module):
         """mm of noise added to resampled particles, against their collapse onto a few ..."""
         roughening_rotation: float = bounded(0.0, 1.0, 0.15)
         """... and rad"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.rng = np.random.default_rng(0)  # fixed: replaying a log localizes the same way

@@ -19,10 +19,16 @@ class SimpleBallModeler(Module):
     cannot diverge.
     """
 
+    ball_percept: BallPercept
+    frame_info: FrameInfo
+    ball_model: BallModel
+
     @dataclass
     class Parameters:
         forget_after: float = 2.0
         """s without a percept after which the model is no longer valid"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.last_seen_ns: int | None = None

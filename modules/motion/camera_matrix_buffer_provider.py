@@ -18,6 +18,11 @@ from tafel.representations.motion import CAMERA_MATRIX_HISTORY, CameraMatrixBott
 class CameraMatrixBufferProvider(Module):
     """Appends this frame's camera matrices, dropping the oldest when the buffer is full."""
 
+    frame_info: FrameInfo
+    camera_matrix_top: CameraMatrixTop
+    camera_matrix_bottom: CameraMatrixBottom
+    camera_matrix_buffer: CameraMatrixBuffer
+
     def execute(self) -> None:
         if not (self.camera_matrix_top.valid and self.camera_matrix_bottom.valid):
             return

@@ -14,6 +14,12 @@ class CameraMatrixProvider(Module):
     """Forward kinematics: the torso placed over the lower foot and tilted as the IMU says, then the
     head joints and the camera mounts of the reference figures."""
 
+    joint_sensor_data: JointSensorData
+    inertial_model: InertialModel
+    camera_matrix_top: CameraMatrixTop
+    camera_matrix_bottom: CameraMatrixBottom
+    torso_pose: TorsoPose
+
     def execute(self) -> None:
         poses = link_poses(angles_by_name(self.joint_sensor_data.position), CAMERA_LINKS)
         torso = robot_frame_from_torso(poses, self.inertial_model.roll, self.inertial_model.pitch)

@@ -15,10 +15,16 @@ class ChestButtonProvider(Module):
     """Counts presses at motion's rate: a press is the button held for at least ``min_press`` s and let
     go. Shorter blips (contact bounce, a brush of the hand) do not count."""
 
+    touch_sensor_data: TouchSensorData
+    frame_info: FrameInfo
+    chest_button: ChestButton
+
     @dataclass
     class Parameters:
         min_press: float = bounded(0.0, 2.0, 0.05)
         """s the button must be held"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.down_since: float | None = None

@@ -24,6 +24,12 @@ class FallDetector(Module):
     While the get-up motion plays, the state is ``getting_up`` whatever the tilt.
     """
 
+    inertial_sensor_data: InertialSensorData
+    frame_info: FrameInfo
+    motion_selection: MotionSelection
+    keyframe_output: KeyframeOutput
+    fall_state: FallState
+
     @dataclass
     class Parameters:
         stagger_angle: float = bounded(0.05, 1.0, 0.3)
@@ -36,6 +42,8 @@ class FallDetector(Module):
         """rad of tilt of a lying robot"""
         settle: float = bounded(0.0, 3.0, 0.4)
         """s a lying robot must be still"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.still_since: int | None = None

@@ -20,6 +20,12 @@ class HeadMotion(Module):
     (``CognitionStatus.alive`` false) it brings the head slowly to the safe position instead.
     """
 
+    head_motion_request: HeadMotionRequest
+    joint_sensor_data: JointSensorData
+    frame_info: FrameInfo
+    cognition_status: CognitionStatus
+    head_joint_targets: HeadJointTargets
+
     @dataclass
     class Parameters:
         yaw_limit: float = math.radians(119.5)
@@ -38,6 +44,8 @@ class HeadMotion(Module):
         """0..1"""
         nominal_dt: float = 0.01
         """s, step used when the frame clock does not advance"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.last_time_ns: int | None = None

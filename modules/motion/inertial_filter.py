@@ -16,12 +16,17 @@ class InertialFilter(Module):
     """Low-pass filters the IMU. The torso angles come from the IMU's own fusion (the NAO's board and
     the simulators both deliver them); filtering them takes out sensor noise, not motion."""
 
+    inertial_sensor_data: InertialSensorData
+    inertial_model: InertialModel
+
     @dataclass
     class Parameters:
         angle_smoothing: float = 0.5
         """0..1, weight of the previous angle estimate per frame (0: raw)"""
         rate_smoothing: float = 0.3
         """0..1, weight of the previous gyroscope and accelerometer values per frame"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.started = False

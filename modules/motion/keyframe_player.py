@@ -38,11 +38,21 @@ class KeyframePlayer(Module):
     it is (``aborted``); a get-up then starts again once the robot lies still.
     """
 
+    motion_selection: MotionSelection
+    motion_request: MotionRequest
+    fall_state: FallState
+    joint_sensor_data: JointSensorData
+    inertial_sensor_data: InertialSensorData
+    frame_info: FrameInfo
+    keyframe_output: KeyframeOutput
+
     @dataclass
     class Parameters:
         motions_dir: str = folder_within(SHIPPED_MOTIONS)
         """folder of the motion files (empty: the shipped config/motions). Configuration may name any
         folder; a debug client only the shipped one, the configured one, or a folder inside them"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.motions: dict[str, KeyframeMotion | None] = {}

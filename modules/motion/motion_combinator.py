@@ -28,6 +28,15 @@ class MotionCombinator(Module):
     the next without a jump), the head from the head motion unless a get-up, fall or sit moves it, and
     ``MotionInfo`` for cognition."""
 
+    motion_selection: MotionSelection
+    motion_request: MotionRequest
+    body_joint_targets: BodyJointTargets
+    walking_engine_output: WalkingEngineOutput
+    keyframe_output: KeyframeOutput
+    head_joint_targets: HeadJointTargets
+    joint_command: JointCommand
+    motion_info: MotionInfo
+
     def execute(self) -> None:
         selection, command = self.motion_selection, self.joint_command
         weights = np.asarray(selection.weights, dtype=float)

@@ -36,6 +36,13 @@ class MotionSelector(Module):
     - The joint commands blend from the old motion into the new one over ``blend_time``.
     """
 
+    motion_request: MotionRequest
+    fall_state: FallState
+    frame_info: FrameInfo
+    walking_engine_output: WalkingEngineOutput
+    keyframe_output: KeyframeOutput
+    motion_selection: MotionSelection
+
     @dataclass
     class Parameters:
         blend_time: float = bounded(0.0, 2.0, 0.3)
@@ -45,6 +52,8 @@ class MotionSelector(Module):
         catch_time: float = bounded(0.0, 0.5, 0.12)
         """s a fall must go on while walking before the protective motion takes over: the walk's step
         adjustment catches a push in that time, a real fall still meets the protective motion before the ground"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.kicked = False

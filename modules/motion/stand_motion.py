@@ -32,12 +32,18 @@ def stand_pose() -> np.ndarray:
 class StandMotion(Module):
     """Interpolates from the measured joint positions to ``STAND_POSE`` with a cosine ramp, then holds."""
 
+    joint_sensor_data: JointSensorData
+    frame_info: FrameInfo
+    body_joint_targets: BodyJointTargets
+
     @dataclass
     class Parameters:
         duration: float = 1.5
         """s from the start pose to the stand"""
         stiffness: float = 0.9
         """0..1 for all body joints"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.start_pose: np.ndarray | None = None

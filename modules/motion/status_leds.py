@@ -30,6 +30,10 @@ class StatusLeds(Module):
     over. Cognition's health is the team's: eyes blue and ears lit while it runs, eyes red and ears
     dark in the frame it stalls or dies (motion then moves safely)."""
 
+    cognition_status: CognitionStatus
+    game_state: GameState
+    led_request: LedRequest
+
     def execute(self) -> None:
         leds, game, alive = self.led_request, self.game_state, self.cognition_status.alive
         leds.chest = (PENALIZED if game.penalized else CHEST[game.state]).copy()

@@ -36,6 +36,14 @@ TUNED = ("step_duration", "hip_height", "torso_offset_x", "foot_lift", "sway", "
 @requires(MotionRequest, MotionSelection, FrameInfo, InertialSensorData, FsrData)
 @provides(WalkingEngineOutput, Odometry)
 class WalkingEngine(Module):
+    motion_request: MotionRequest
+    motion_selection: MotionSelection
+    frame_info: FrameInfo
+    inertial_sensor_data: InertialSensorData
+    fsr_data: FsrData
+    walking_engine_output: WalkingEngineOutput
+    odometry: Odometry
+
     @dataclass
     class Parameters:
         step_duration: float = bounded(0.15, 0.6, 0.25)
@@ -97,6 +105,8 @@ class WalkingEngine(Module):
         """per mm of capture-point error beyond the deadband, how much faster the step goes (it lands sooner)"""
         max_hurry: float = bounded(1.0, 3.0, 1.6)
         """the fastest a step may go, as a multiple of its duration's speed"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.support = Foot.left  # the first swing foot is the right one

@@ -22,6 +22,10 @@ class BallDetector(Module):
     share of its enclosing circle that is orange). Needs nothing but images, so it runs on a webcam too;
     ``BallLocator`` puts the candidates on the ground where camera matrices exist."""
 
+    camera_image_top: CameraImageTop
+    camera_image_bottom: CameraImageBottom
+    ball_image_percept: BallImagePercept
+
     @dataclass
     class Parameters:
         hue_min: int = 3
@@ -34,6 +38,8 @@ class BallDetector(Module):
         min_fill: float = 0.55
         """share of the enclosing circle that must be orange"""
         max_candidates: int = 5
+
+    parameters: Parameters
 
     def execute(self) -> None:
         found: list[BallCandidate] = []

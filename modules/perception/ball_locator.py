@@ -28,12 +28,18 @@ class BallLocator(Module):
     """Intersects each candidate's ray with the plane at ball height and keeps the largest candidate
     whose size in the image fits the distance: a ball far away cannot look large."""
 
+    ball_image_percept: BallImagePercept
+    camera_matrix_buffer: CameraMatrixBuffer
+    ball_percept: BallPercept
+
     @dataclass
     class Parameters:
         size_tolerance: float = 0.45
         """the radius may differ by this share from what the distance predicts"""
         time_aligned: bool = True
         """use the camera matrix of the image's time; false: the newest (to measure what alignment gains)"""
+
+    parameters: Parameters
 
     def execute(self) -> None:
         percept = self.ball_percept

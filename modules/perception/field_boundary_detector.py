@@ -78,6 +78,13 @@ class FieldBoundaryDetector(Module):
     it, and where the camera's pose is known nothing above the horizon can be field at all. One such
     point above the edge would otherwise pull the whole hull up."""
 
+    segmented_image: SegmentedImage
+    field_color: FieldColor
+    camera_image_top: CameraImageTop
+    camera_image_bottom: CameraImageBottom
+    camera_matrix_buffer: CameraMatrixBuffer
+    field_boundary: FieldBoundary
+
     @dataclass
     class Parameters:
         cell: int = bounded(2, 32, 4)
@@ -95,6 +102,8 @@ class FieldBoundaryDetector(Module):
         """white (a line the scan crosses): unsaturated and at least this share of the image's brightest value"""
         horizon_margin: float = bounded(0.0, 0.5, 0.03)
         """share of the image height above the horizon that may still be field (the camera's pose is not exact)"""
+
+    parameters: Parameters
 
     def execute(self) -> None:
         if not self.field_color.valid:

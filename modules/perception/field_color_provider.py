@@ -44,6 +44,12 @@ class FieldColorProvider(Module):
     looks at a wall, or is lifted) keeps the last estimate.
     """
 
+    camera_image_top: CameraImageTop
+    camera_image_bottom: CameraImageBottom
+    camera_matrix_buffer: CameraMatrixBuffer
+    field_color: FieldColor
+    segmented_image: SegmentedImage
+
     @dataclass
     class Parameters:
         hue_low: int = bounded(0, 180, 25)
@@ -59,6 +65,8 @@ class FieldColorProvider(Module):
         """weight of this frame's estimate against the previous one"""
         step: int = bounded(1, 16, 4)
         """px between sampled pixels"""
+
+    parameters: Parameters
 
     def execute(self) -> None:
         segmented = self.segmented_image

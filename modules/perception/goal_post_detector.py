@@ -41,6 +41,14 @@ class GoalPostDetector(Module):
     goal's rear frame and the net's poles are thinner pipes, farther away than the foot the scan finds
     for them: too thin for a post there."""
 
+    camera_image_top: CameraImageTop
+    camera_image_bottom: CameraImageBottom
+    segmented_image: SegmentedImage
+    field_color: FieldColor
+    field_boundary: FieldBoundary
+    camera_matrix_buffer: CameraMatrixBuffer
+    goal_post_percept: GoalPostPercept
+
     @dataclass
     class Parameters:
         band: int = bounded(2, 60, 12)
@@ -55,6 +63,8 @@ class GoalPostDetector(Module):
         thinner pipes, and farther away than the foot the scan finds for them"""
         min_height: float = bounded(1.0, 20.0, 3.0)
         """the white above the foot must be this many widths high"""
+
+    parameters: Parameters
 
     def execute(self) -> None:
         self.goal_post_percept.posts = []

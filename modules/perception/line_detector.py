@@ -78,6 +78,16 @@ class LineDetector(Module):
     masked out before. Then, on the ground: the centre circle (points on a
     circle of the known radius, found by RANSAC), then straight segments, greedily, by RANSAC too."""
 
+    camera_image_top: CameraImageTop
+    camera_image_bottom: CameraImageBottom
+    segmented_image: SegmentedImage
+    field_color: FieldColor
+    field_boundary: FieldBoundary
+    camera_matrix_buffer: CameraMatrixBuffer
+    goal_post_percept: GoalPostPercept
+    ball_image_percept: BallImagePercept
+    line_percept: LinePercept
+
     @dataclass
     class Parameters:
         step: int = bounded(1, 32, 5)
@@ -104,6 +114,8 @@ class LineDetector(Module):
         """line points kept per frame"""
         iterations: int = bounded(5, 500, 40)
         """RANSAC tries per segment"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.rng = np.random.default_rng(0)  # fixed: a replay fits the same lines

@@ -66,6 +66,14 @@ class SPLBallDetector(Module):
       uniformly dark and have no patches darker than the carpet beside them.
     """
 
+    camera_image_top: CameraImageTop
+    camera_image_bottom: CameraImageBottom
+    segmented_image: SegmentedImage
+    field_color: FieldColor
+    field_boundary: FieldBoundary
+    camera_matrix_buffer: CameraMatrixBuffer
+    ball_image_percept: BallImagePercept
+
     @dataclass
     class Parameters:
         size_low: float = bounded(0.2, 1.0, 0.55)
@@ -101,6 +109,8 @@ class SPLBallDetector(Module):
         """the classifier's score (a logit) a ball needs (higher: fewer false balls, more missed ones)"""
         classifier_at_edge: bool = False
         """the classifier also decides candidates whose square reaches out of the image"""
+
+    parameters: Parameters
 
     def __init__(self) -> None:
         self.model: BallClassifier | None = None
