@@ -17,7 +17,7 @@ from tafel.core.framework.errors import (
     ModuleDefinitionError,
     UnknownModuleError,
 )
-from tafel.core.framework.module import Module
+from tafel.core.framework.module import Module, Requirements
 from tafel.core.framework.naming import did_you_mean
 from tafel.core.framework.representation import is_representation
 
@@ -26,14 +26,14 @@ from tafel.core.framework.representation import is_representation
 class Plan:
     """A valid configuration: active modules in execution order and the provider of each representation."""
 
-    order: list[type]
+    order: list[type[Module]]
     #: representation class -> providing module class, or None when it comes from outside
-    provider: dict[type, type | None]
+    provider: dict[type, type[Module] | None]
 
 
-def module_names(modules: Sequence[type]) -> dict[str, type]:
+def module_names(modules: Sequence[type[Module]]) -> dict[str, type[Module]]:
     """Module classes by name; rejects non-modules and duplicate names."""
-    by_name: dict[str, type] = {}
+    by_name: dict[str, type[Module]] = {}
     for cls in modules:
         if not (isinstance(cls, type) and issubclass(cls, Module)):
             raise ModuleDefinitionError(f"module lists take Module subclasses, got {cls!r}")
@@ -47,7 +47,7 @@ def module_names(modules: Sequence[type]) -> dict[str, type]:
     return by_name
 
 
-def resolve_module(name: str, by_name: Mapping[str, type], what: str = "module") -> type:
+def resolve_module(name: str, by_name: Mapping[str, type[Module]], what: str = "module") -> type[Module]:
     try:
         return by_name[name]
     except KeyError:
@@ -55,7 +55,7 @@ def resolve_module(name: str, by_name: Mapping[str, type], what: str = "module")
 
 
 def build_plan(
-    modules: Sequence[type],
+    modules: Sequence[type[Module]],
     *,
     external: Iterable[type] = (),
     providers: Mapping[str, str] | None = None,
@@ -73,13 +73,13 @@ def build_plan(
     enabled = [m for m in modules if m.__name__ not in disabled]
     declared = {m: m.requirements() for m in modules}
 
-    candidates: dict[type, list[type]] = {}
+    candidates: dict[type, list[type[Module]]] = {}
     for m in enabled:
         for rep in declared[m].provides:
             candidates.setdefault(rep, []).append(m)
 
     chosen = _choose_providers(modules, by_name, enabled, declared, candidates, external, providers or {})
-    provider: dict[type, type | None] = {rep: None for rep in external}
+    provider: dict[type, type[Module] | None] = {rep: None for rep in external}
     provider.update(chosen)
 
     active = [m for m in enabled if not declared[m].provides or any(chosen.get(r) is m for r in declared[m].provides)]
@@ -89,16 +89,16 @@ def build_plan(
 
 
 def _choose_providers(
-    modules: Sequence[type],
-    by_name: Mapping[str, type],
-    enabled: list[type],
-    declared: Mapping[type, object],
-    candidates: dict[type, list[type]],
+    modules: Sequence[type[Module]],
+    by_name: Mapping[str, type[Module]],
+    enabled: list[type[Module]],
+    declared: Mapping[type[Module], Requirements],
+    candidates: dict[type, list[type[Module]]],
     external: list[type],
     providers: Mapping[str, str],
-) -> dict[type, type]:
-    all_reps = {r.__name__: r for m in modules for r in declared[m].provides}  # type: ignore[attr-defined]
-    choices: dict[type, type] = {}
+) -> dict[type, type[Module]]:
+    all_reps = {r.__name__: r for m in modules for r in declared[m].provides}
+    choices: dict[type, type[Module]] = {}
     for rep_name, module_name in providers.items():
         if rep_name not in all_reps:
             raise UnknownModuleError(
@@ -107,7 +107,7 @@ def _choose_providers(
             )
         rep = all_reps[rep_name]
         module = resolve_module(module_name, by_name)
-        able = [m.__name__ for m in modules if rep in declared[m].provides]  # type: ignore[attr-defined]
+        able = [m.__name__ for m in modules if rep in declared[m].provides]
         if module.__name__ not in able:
             raise UnknownModuleError(
                 f"providers chooses {module_name} for {rep_name}, but {module_name} does not provide "
@@ -120,20 +120,20 @@ def _choose_providers(
             )
         choices[rep] = module
 
-    chosen: dict[type, type] = {}
-    for rep, able in candidates.items():
+    chosen: dict[type, type[Module]] = {}
+    for rep, modules_able in candidates.items():
         if rep in external:
             raise ConflictingProvidersError(
                 f"{rep.__name__} is provided from outside this manager (platform or other context) and by "
-                f"{', '.join(m.__name__ for m in able)}; disable the module, or stop providing "
+                f"{', '.join(m.__name__ for m in modules_able)}; disable the module, or stop providing "
                 f"{rep.__name__} externally"
             )
         if rep in choices:
             chosen[rep] = choices[rep]
-        elif len(able) == 1:
-            chosen[rep] = able[0]
+        elif len(modules_able) == 1:
+            chosen[rep] = modules_able[0]
         else:
-            names = [m.__name__ for m in able]
+            names = [m.__name__ for m in modules_able]
             raise ConflictingProvidersError(
                 f"{rep.__name__} is provided by {' and '.join(names)}; choose one with "
                 f'providers={{"{rep.__name__}": "{names[0]}"}} (in configuration: '
@@ -143,21 +143,21 @@ def _choose_providers(
 
 
 def _check_missing(
-    active: list[type],
-    declared: Mapping[type, object],
-    provider: Mapping[type, type | None],
-    modules: Sequence[type],
+    active: list[type[Module]],
+    declared: Mapping[type[Module], Requirements],
+    provider: Mapping[type, type[Module] | None],
+    modules: Sequence[type[Module]],
     disabled: set[str],
-    candidates: Mapping[type, list[type]],
+    candidates: Mapping[type, list[type[Module]]],
 ) -> None:
     problems = []
     for m in active:
         req = declared[m]
         # what a module only uses may be missing: it then reads the representation's defaults
-        for rep in req.requires:  # type: ignore[attr-defined]
+        for rep in req.requires:
             if rep in provider:
                 continue
-            off = [o.__name__ for o in modules if o.__name__ in disabled and rep in declared[o].provides]  # type: ignore[attr-defined]
+            off = [o.__name__ for o in modules if o.__name__ in disabled and rep in declared[o].provides]
             hint = f" ({', '.join(off)} would, but is disabled)" if off else ""
             problems.append(
                 f"{m.__name__} requires {rep.__name__}, but no module provides it{hint} and it is not "
@@ -170,12 +170,13 @@ def _check_missing(
         )
 
 
-def _topological_order(active: list[type], declared: Mapping[type, object], provider: Mapping[type, type | None]) -> list[type]:
+def _topological_order(active: list[type[Module]], declared: Mapping[type[Module], Requirements],
+                       provider: Mapping[type, type[Module] | None]) -> list[type[Module]]:
     index = {m: i for i, m in enumerate(active)}
-    successors: dict[type, list[tuple[type, type]]] = {m: [] for m in active}
+    successors: dict[type[Module], list[tuple[type[Module], type]]] = {m: [] for m in active}
     indegree = {m: 0 for m in active}
     for m in active:
-        for rep in declared[m].requires:  # type: ignore[attr-defined]
+        for rep in declared[m].requires:
             source = provider.get(rep)
             if source is not None and source is not m and source in index:
                 successors[source].append((m, rep))
@@ -183,7 +184,7 @@ def _topological_order(active: list[type], declared: Mapping[type, object], prov
     ready = [(index[m], m.__name__) for m in active if indegree[m] == 0]
     heapq.heapify(ready)
     by_name = {m.__name__: m for m in active}
-    order: list[type] = []
+    order: list[type[Module]] = []
     while ready:
         _, name = heapq.heappop(ready)
         m = by_name[name]
@@ -198,20 +199,20 @@ def _topological_order(active: list[type], declared: Mapping[type, object], prov
     return order
 
 
-def _cycle_error(remaining: list[type], successors: Mapping[type, list[tuple[type, type]]]) -> DependencyCycleError:
+def _cycle_error(remaining: list[type[Module]], successors: Mapping[type[Module], list[tuple[type[Module], type]]]) -> DependencyCycleError:
     """Find one cycle among the modules left over by the sort and describe it as a path.
 
     Every left-over module still has a left-over predecessor (that is why it was left over), so walking
     predecessors must come back to a module already visited; that loop is a cycle.
     """
     left = set(remaining)
-    predecessors: dict[type, tuple[type, type]] = {}
+    predecessors: dict[type[Module], tuple[type[Module], type]] = {}
     for source in remaining:
         for target, rep in successors[source]:
             if target in left:
                 predecessors.setdefault(target, (source, rep))
-    walk: list[type] = []
-    seen_at: dict[type, int] = {}
+    walk: list[type[Module]] = []
+    seen_at: dict[type[Module], int] = {}
     node = remaining[0]
     while node not in seen_at:
         seen_at[node] = len(walk)
@@ -231,7 +232,7 @@ def _cycle_error(remaining: list[type], successors: Mapping[type, list[tuple[typ
 
 
 def prune_unsatisfiable(
-    modules: Sequence[type], external: Iterable[type], disabled: Iterable[str] = ()
+    modules: Sequence[type[Module]], external: Iterable[type], disabled: Iterable[str] = ()
 ) -> dict[str, list[str]]:
     """Modules that cannot run because something they read is provided by nobody, transitively.
 

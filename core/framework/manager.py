@@ -96,7 +96,7 @@ class _Slot:
     __slots__ = ("name", "cls", "instance", "run", "times", "first_frame", "errors", "last_error",
                  "undo", "read_marks", "write_marks", "chosen", "logged_at", "logged_errors")
 
-    def __init__(self, cls: type, frame: int) -> None:
+    def __init__(self, cls: type[Module], frame: int) -> None:
         self.name = cls.__name__
         self.cls = cls
         self.instance: Any = None
@@ -113,7 +113,7 @@ class _Slot:
         self.logged_errors = 0  # errors counted when that line was written
 
 
-def _chosen_outputs(cls: type, plan: Plan) -> frozenset[type]:
+def _chosen_outputs(cls: type[Module], plan: Plan) -> frozenset[type]:
     """The representations ``cls`` writes to the blackboard under ``plan``."""
     return frozenset(r for r in cls.requirements().provides if plan.provider.get(r) is cls)
 
@@ -136,7 +136,7 @@ class ModuleManager:
 
     def __init__(
         self,
-        modules: Sequence[type],
+        modules: Sequence[type[Module]],
         *,
         name: str = "cognition",
         external: Iterable[type] = (),
@@ -235,7 +235,7 @@ class ModuleManager:
         return [m.__name__ for m in self._modules]
 
     @property
-    def module_classes(self) -> list[type]:
+    def module_classes(self) -> list[type[Module]]:
         """All module classes known to this manager, active or not."""
         return list(self._modules)
 
@@ -243,7 +243,7 @@ class ModuleManager:
     def external(self) -> list[type]:
         return list(self._external)
 
-    def module_class(self, name: str) -> type:
+    def module_class(self, name: str) -> type[Module]:
         """The class of the configured module ``name`` (``UnknownModuleError`` with the closest names)."""
         return resolve_module(name, self._by_name)
 
@@ -385,7 +385,7 @@ class ModuleManager:
     def disabled(self) -> set[str]:
         return set(self._disabled)
 
-    def replace_module(self, new_cls: type, parameters: Mapping[str, Any] | None = None,
+    def replace_module(self, new_cls: type[Module], parameters: Mapping[str, Any] | None = None,
                        slot: _Slot | None = None) -> _Slot | None:
         """Run ``new_cls`` instead of the module class of the same name, keeping the blackboard: hot reload.
 
@@ -420,7 +420,7 @@ class ModuleManager:
         return next((s for s in self._slots if s.name == name), None)
 
     # ------------------------------------------------------------------ internals
-    def _apply(self, plan: Plan, old_provider: Mapping[type, type | None], keep: Iterable[_Slot] = ()) -> Plan:
+    def _apply(self, plan: Plan, old_provider: Mapping[type, type[Module] | None], keep: Iterable[_Slot] = ()) -> Plan:
         """Switch to a checked plan: keep running instances, create new ones, reset changed outputs.
 
         New instances are built before anything changes, so a failing constructor leaves the running
@@ -462,7 +462,7 @@ class ModuleManager:
             slot.write_marks.append((rep.__name__, mark))
         object.__setattr__(instance, "parameters", make_parameters(cls, self._parameters.get(cls.__name__)))
         try:
-            instance.__init__()
+            cls.__init__(instance)
         except Exception as exc:
             rule = " (a module's constructor takes no arguments)" if isinstance(exc, TypeError) else ""
             raise ModuleDefinitionError(f"constructing {cls.__name__} failed{rule}: {exc}") from exc
@@ -471,10 +471,10 @@ class ModuleManager:
         slot.run = instance.execute
 
 
-def make_module(cls: type, **attributes: Any) -> Module:
+def make_module(cls: type[Module], **attributes: Any) -> Module:
     """A module instance wired to plain objects, bypassing the blackboard (for baselines and tools)."""
     instance = cls.__new__(cls)
     for name, value in attributes.items():
         object.__setattr__(instance, name, value)
-    instance.__init__()
+    cls.__init__(instance)
     return instance

@@ -124,7 +124,7 @@ class _Unbound:
 
 
 _ATTRIBUTE_NAMES: dict[type, dict[str, type]] = {}
-_KNOWN: dict[str, type] = {}
+_KNOWN: dict[str, type[Module]] = {}
 #: module classes whose annotations were checked against their complete declarations
 _CHECKED: weakref.WeakSet[type] = weakref.WeakSet()
 _UNRESOLVED = object()
@@ -214,7 +214,7 @@ def _check_annotations(cls: type, *, complete: bool) -> None:
                     f"{resolved.__name__}; add @requires({resolved.__name__}) or remove the annotation")
 
 
-def find_module(name: str) -> type:
+def find_module(name: str) -> type[Module]:
     """The module class called ``name`` (or ``package.module:ClassName``), with suggestions if unknown.
 
     Every Module subclass registers itself by class name when it is defined (the newest definition of a
@@ -240,7 +240,7 @@ def find_module(name: str) -> type:
     raise UnknownModuleError(f"unknown module {name!r}: {did_you_mean(name, _KNOWN)}")
 
 
-def _attribute_names(cls: type) -> dict[str, type]:
+def _attribute_names(cls: type[Module]) -> dict[str, type]:
     names = _ATTRIBUTE_NAMES.get(cls)
     if names is None:
         names = _ATTRIBUTE_NAMES[cls] = cls.requirements().attribute_names()

@@ -16,7 +16,7 @@ import sys
 import typing
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, TypeVar, overload
+from typing import Any, TypeVar, dataclass_transform, overload
 
 import numpy as np
 
@@ -110,6 +110,7 @@ def representation(cls: type[T], /) -> type[T]: ...
 def representation(*, state: bool = True) -> Callable[[type[T]], type[T]]: ...
 
 
+@dataclass_transform(field_specifiers=(dataclasses.field,))
 def representation(cls: type[T] | None = None, /, *, state: bool = True) -> Any:
     """Make ``cls`` a representation: a dataclass with defaults for every field, registered by name.
 
@@ -119,6 +120,10 @@ def representation(cls: type[T] | None = None, /, *, state: bool = True) -> Any:
 
     Raises ``RepresentationDefinitionError`` for unsupported field types and when another module
     already registered a representation of the same class name.
+
+    Type checkers see a dataclass (``dataclass_transform``), so keyword arguments are checked; they take a
+    field without a default as required, so give one (``x: float = 0.0``) where checked code builds the
+    representation without it.
     """
     if cls is None:
         return lambda target: _make_representation(target, state)

@@ -17,7 +17,7 @@ from tafel.core.framework.config import CONTEXTS, ConfigError, context_section
 from tafel.core.framework.errors import ConflictingProvidersError, MissingProviderError
 from tafel.core.framework.graph import build_plan
 from tafel.core.framework.manager import ModuleManager
-from tafel.core.framework.module import find_module
+from tafel.core.framework.module import Module, find_module
 from tafel.core.runtime.platform import Platform
 from tafel.core.runtime.status import CognitionStatus
 
@@ -30,7 +30,7 @@ class ContextPlan:
 
     name: str
     rate_hz: float
-    modules: list[type]
+    modules: list[type[Module]]
     providers: dict[str, str]
     disabled: list[str]
     parameters: dict[str, dict[str, Any]]
@@ -64,7 +64,7 @@ class ContextPlan:
             reps.update(requirements.reads(), requirements.provides)
         return reps
 
-    def active_modules(self) -> list[type]:
+    def active_modules(self) -> list[type[Module]]:
         off = set(self.disabled) | set(self.pruned) | set(self.replaced)
         return [m for m in self.modules if m.__name__ not in off]
 
@@ -188,7 +188,7 @@ def _provided_by_any_platform(current: type[Platform] | Platform) -> set[str]:
     return names
 
 
-def _provided(modules: list[type]) -> set[type]:
+def _provided(modules: list[type[Module]]) -> set[type]:
     return {rep for m in modules for rep in m.requirements().provides}
 
 

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import builtins
 import copy
 import math
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, TypeVar
 
 from tafel.core.framework.manager import Blackboard, ModuleManager
+from tafel.core.framework.module import Module
 from tafel.core.framework.representation import get_representation, is_representation
 
 R = TypeVar("R")
@@ -34,7 +36,7 @@ class ModuleHarness:
     persist between frames until set again or fed.
     """
 
-    def __init__(self, module: type, *inputs: Any, parameters: Mapping[str, Any] | None = None,
+    def __init__(self, module: type[Module], *inputs: Any, parameters: Mapping[str, Any] | None = None,
                  context: str | None = None, rate_hz: float | None = None, start_ns: int = 0) -> None:
         declared = module.requirements()
         self.module_class = module
@@ -145,12 +147,12 @@ class ModuleHarness:
         frame_info = _frame_info_class()
         if recorded_clock is not None:  # a replayed frame keeps its recorded number and time
             self.frame_number, self.time_ns = recorded_clock
-        elif self._clock_given and frame_info in self.blackboard:  # the test set FrameInfo: it is the clock
+        elif self._clock_given and frame_info is not None and frame_info in self.blackboard:  # the test set FrameInfo: it is the clock
             info = self.blackboard[frame_info]
             self.frame_number, self.time_ns = info.frame_number, info.time_ns
         elif self.frame_number > 1:
             self.time_ns += self.period_ns
-        if frame_info in self.blackboard and not self._clock_given:
+        if frame_info is not None and frame_info in self.blackboard and not self._clock_given:
             info = self.blackboard[frame_info]
             info.frame_number, info.time_ns = self.frame_number, self.time_ns
         self._clock_given = False
@@ -165,15 +167,15 @@ class ModuleHarness:
                            f"{', '.join(r.__name__ for r in self._history) or 'nothing'}")
         return list(self._history[rep])
 
-    def reads(self, module: type | None = None) -> set[type]:
+    def reads(self, module: type | None = None) -> builtins.set[type]:  # builtins: the class has a method set
         """The representations the module read in the last frame (any field of them)."""
         return self._accessed(module, "readers")
 
-    def writes(self, module: type | None = None) -> set[type]:
+    def writes(self, module: type | None = None) -> builtins.set[type]:
         """The representations the module wrote in the last frame."""
         return self._accessed(module, "writers")
 
-    def _accessed(self, module: type | None, kind: str) -> set[type]:
+    def _accessed(self, module: type | None, kind: str) -> builtins.set[type]:
         name = (module or self.module_class).__name__
         if name != self.module_class.__name__:
             raise ValueError(f"this harness runs {self.module_class.__name__}, not {name}")
@@ -185,14 +187,14 @@ class ModuleHarness:
         return self.blackboard[rep]
 
 
-def _frame_info_class() -> type | None:
+def _frame_info_class() -> type[Any] | None:
     try:
         return get_representation("FrameInfo")
     except KeyError:
         return None
 
 
-def run_module(module: type, *inputs: Any, frames: int = 1, parameters: Mapping[str, Any] | None = None) -> Blackboard:
+def run_module(module: type[Module], *inputs: Any, frames: int = 1, parameters: Mapping[str, Any] | None = None) -> Blackboard:
     """Run ``module`` alone for ``frames`` frames on a blackboard holding ``inputs``; return it."""
     return ModuleHarness(module, *inputs, parameters=parameters).execute(frames)
 

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from tafel.core.framework.module import Module
 from tafel.core.testing.compare import differences
 from tafel.core.testing.harness import ModuleHarness, R, _frame_info_class, context_of
 
@@ -24,7 +25,7 @@ class ReplayFrame:
 
 @dataclass
 class ReplayResult:
-    module: type
+    module: type[Module]
     path: Path
     context: str
     frames: list[ReplayFrame]
@@ -46,7 +47,7 @@ class ReplayResult:
         return found
 
 
-def replay_module(module: type, path: str | Path, *, start_s: float = 0.0, seconds: float | None = None,
+def replay_module(module: type[Module], path: str | Path, *, start_s: float = 0.0, seconds: float | None = None,
                   context: str | None = None, parameters: Mapping[str, Any] | None = None,
                   allow_missing: Iterable[type] = ()) -> ReplayResult:
     """Feed ``module`` its recorded inputs from a log, frame by frame with the recorded frame times.
