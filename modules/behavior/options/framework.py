@@ -33,7 +33,7 @@ from __future__ import annotations
 import dataclasses
 import inspect
 from collections.abc import Callable, Iterable
-from typing import Any, ClassVar, Generic, TypeVar
+from typing import Any, ClassVar, Generic, TypeVar, cast
 
 from tafel.core import TafelError
 from tafel.representations.behavior import ActivationGraph, ActiveOption, OptionGraph, OptionInfo, OptionState
@@ -105,13 +105,14 @@ class Option(Generic[B]):
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
-        cls.states, commons = {}, []
+        cls.states = {}
+        commons: list[tuple[StateMethod, tuple[str, ...]]] = []
         for _, member in inspect.getmembers(cls, callable):
             spec = getattr(member, "__tafel_state__", None)
-            if spec is not None:
-                cls.states[spec.name] = (spec, member)
+            if spec is not None:  # marked by @state, which takes state methods only
+                cls.states[spec.name] = (spec, cast(StateMethod, member))
             if hasattr(member, "__tafel_common__"):
-                commons.append((member, member.__tafel_common__))
+                commons.append((cast(StateMethod, member), member.__tafel_common__))
         where = f"option {cls.__name__}"
         if not cls.states:
             raise OptionError(f"{where} has no state: mark at least one method with @state(initial=True)")

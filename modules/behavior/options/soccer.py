@@ -58,7 +58,7 @@ class GoTo(Option["SoccerBehavior"]):
         return "there" if math.hypot(target_x, target_y) < b.parameters.arrived and abs(turn) < 0.15 else "walk"
 
     @state(initial=True)
-    def walk(self, b: SoccerBehavior) -> Next:
+    def walk(self, b: SoccerBehavior) -> None:
         """Walk to the pose; round a robot or a closed area in the way, facing the way meanwhile."""
         x, y, rotation = self.target(b)
         pose = b.robot_pose
@@ -71,13 +71,13 @@ class GoTo(Option["SoccerBehavior"]):
         b.walk_to(way_x, way_y, turn)
 
     @state(final=True)
-    def there(self, b: SoccerBehavior) -> Next:
+    def there(self, b: SoccerBehavior) -> None:
         """Stand: the pose is reached."""
         self.target(b)
         b.stand()
 
     @state
-    def lost(self, b: SoccerBehavior) -> Next:
+    def lost(self, b: SoccerBehavior) -> None:
         """Turn on the spot while the robot does not know where it is (the head looks around)."""
         b.turn(LOST_TURN)
 
@@ -106,12 +106,12 @@ class Striker(Option["SoccerBehavior"]):
         return "search"
 
     @state(initial=True)
-    def search(self, b: SoccerBehavior) -> Next:
+    def search(self, b: SoccerBehavior) -> None:
         """Nobody knows where the ball is: turn on the spot (the head searches)."""
         b.turn(b.parameters.search_turn)
 
     @state
-    def kick(self, b: SoccerBehavior) -> Next:
+    def kick(self, b: SoccerBehavior) -> None:
         """Walk behind the ball on the kick's line and kick (``kicking.approach_and_kick``)."""
         ball, p, out = b.ball_model, b.parameters, b.motion_request
         direction = b.indirect_direction() if b.indirect else goal_direction(ball, b.robot_pose, b.odometry)
@@ -120,13 +120,13 @@ class Striker(Option["SoccerBehavior"]):
             out.target_x, out.target_y = waypoint(out.target_x, out.target_y, b.robot_discs(), p.obstacle_margin)
 
     @state
-    def to_teammates_ball(self, b: SoccerBehavior) -> Next:
+    def to_teammates_ball(self, b: SoccerBehavior) -> None:
         """Walk to where a teammate sees the ball, facing the opponent goal."""
         bx, by = b.ball_on_field() or (0.0, 0.0)
         self.call(GoTo, x=bx, y=by, rotation=math.atan2(-by, pitch.LENGTH / 2 - bx))
 
     @state
-    def wait_outside(self, b: SoccerBehavior) -> Next:
+    def wait_outside(self, b: SoccerBehavior) -> None:
         """The rules keep the team away from the ball: stand between it and the own goal, just outside."""
         bx, by = b.ball_on_field() or (0.0, 0.0)
         dx, dy = OWN_GOAL_X - bx, -by
@@ -150,6 +150,7 @@ class Goalkeeper(Option["SoccerBehavior"]):
         _, by = b.ball_on_field() or (0.0, 0.0)
         x, y = OWN_GOAL_X + 300.0, max(-500.0, min(500.0, 0.3 * by))
         self.call(GoTo, x=x, y=y, rotation=b.facing_ball(x, y))
+        return None
 
     @state(to=("guard",))
     def clear(self, b: SoccerBehavior) -> Next:
@@ -157,6 +158,7 @@ class Goalkeeper(Option["SoccerBehavior"]):
         if not (b.ball_model.valid and b.keeper_clears()):
             return "guard"
         self.call(Striker)
+        return None
 
 
 class Supporter(Option["SoccerBehavior"]):
@@ -165,7 +167,7 @@ class Supporter(Option["SoccerBehavior"]):
     calls = (GoTo,)
 
     @state(initial=True)
-    def support(self, b: SoccerBehavior) -> Next:
+    def support(self, b: SoccerBehavior) -> None:
         """``supporter_offset`` behind and beside the ball, at least a metre in front of the own goal."""
         bx, by = b.ball_on_field() or (0.0, 0.0)
         back, beside = b.parameters.supporter_offset
@@ -179,7 +181,7 @@ class Defender(Option["SoccerBehavior"]):
     calls = (GoTo,)
 
     @state(initial=True)
-    def defend(self, b: SoccerBehavior) -> Next:
+    def defend(self, b: SoccerBehavior) -> None:
         """A third of the way from the own goal to the ball."""
         bx, by = b.ball_on_field() or (0.0, 0.0)
         x, y = OWN_GOAL_X + 0.35 * (bx - OWN_GOAL_X), 0.35 * by
@@ -208,6 +210,7 @@ class Play(Option["SoccerBehavior"]):
         if b.own_free_kick():
             return "own_free_kick"
         self.call(ROLES[self.args.role])
+        return None
 
     @state(to=("play", "set_play_over"))
     def opponents_set_play(self, b: SoccerBehavior) -> Next:
@@ -220,6 +223,7 @@ class Play(Option["SoccerBehavior"]):
         if ball is not None:
             b.keep_out.append((*ball, FREE_KICK_DISTANCE + b.parameters.keep_out_margin))
         self.call(ROLES[self.args.role])
+        return None
 
     @state(to=("play",))
     def set_play_over(self, b: SoccerBehavior) -> Next:
@@ -227,6 +231,7 @@ class Play(Option["SoccerBehavior"]):
         if not b.opponents_set_play():
             return "play"
         self.call(ROLES[self.args.role])
+        return None
 
     @state(to=("play",))
     def own_free_kick(self, b: SoccerBehavior) -> Next:
@@ -235,6 +240,7 @@ class Play(Option["SoccerBehavior"]):
             return "play"
         b.indirect = True
         self.call(ROLES[self.args.role])
+        return None
 
 
 class ReadyPosition(Option["SoccerBehavior"]):
@@ -247,7 +253,7 @@ class ReadyPosition(Option["SoccerBehavior"]):
         return "penalty_kick" if b.game_state.set_play is SetPlay.penalty_kick else "kick_off"
 
     @state(initial=True)
-    def kick_off(self, b: SoccerBehavior) -> Next:
+    def kick_off(self, b: SoccerBehavior) -> None:
         """The role's place in the own half; the striker nearer the centre when its team kicks off."""
         game, role, p = b.game_state, b.player_role.role, b.parameters
         kicking_off = role is Role.striker and game.kicking_team == game.team_number
@@ -255,7 +261,7 @@ class ReadyPosition(Option["SoccerBehavior"]):
         self.go(getattr(p, f"ready_{name}"))
 
     @state
-    def penalty_kick(self, b: SoccerBehavior) -> Next:
+    def penalty_kick(self, b: SoccerBehavior) -> None:
         """The kicker behind the penalty mark; the defending keeper on its goal line, the others out of the
         penalty area."""
         game, role, p = b.game_state, b.player_role.role, b.parameters
@@ -288,12 +294,12 @@ class ShootOut(Option["SoccerBehavior"]):
         return "shoot" if b.ball_model.valid else "search"
 
     @state(initial=True)
-    def search(self, b: SoccerBehavior) -> Next:
+    def search(self, b: SoccerBehavior) -> None:
         """The kicker without a ball: turn on the spot."""
         b.turn(b.parameters.search_turn)
 
     @state
-    def shoot(self, b: SoccerBehavior) -> Next:
+    def shoot(self, b: SoccerBehavior) -> None:
         """Kick at the goal's corner on the side away from the keeper's (``shootout_aim`` mm beside the centre)."""
         ball, pose, p = b.ball_model, b.robot_pose, b.parameters
         if pose.valid:
@@ -304,7 +310,7 @@ class ShootOut(Option["SoccerBehavior"]):
         approach_and_kick(ball, direction, p, b.motion_request)
 
     @state
-    def keep_line(self, b: SoccerBehavior) -> Next:
+    def keep_line(self, b: SoccerBehavior) -> None:
         """On the goal line, across from the ball."""
         ball = b.ball_on_field()
         ball_y = ball[1] if ball is not None else 0.0
@@ -339,27 +345,27 @@ class PlaySoccer(Option["SoccerBehavior"]):
         return "opponents_kick_off" if self.state == "opponents_kick_off" else "playing"
 
     @state(initial=True)
-    def initial(self, b: SoccerBehavior) -> Next:
+    def initial(self, b: SoccerBehavior) -> None:
         """INITIAL: stand (the head looks around)."""
         b.stand()
 
     @state
-    def standby(self, b: SoccerBehavior) -> Next:
+    def standby(self, b: SoccerBehavior) -> None:
         """STANDBY: stand."""
         b.stand()
 
     @state
-    def ready(self, b: SoccerBehavior) -> Next:
+    def ready(self, b: SoccerBehavior) -> None:
         """READY: walk to the kick-off position."""
         self.call(ReadyPosition)
 
     @state
-    def set(self, b: SoccerBehavior) -> Next:
+    def set(self, b: SoccerBehavior) -> None:
         """SET: stand."""
         b.stand()
 
     @state
-    def playing(self, b: SoccerBehavior) -> Next:
+    def playing(self, b: SoccerBehavior) -> None:
         """PLAYING: the role's play."""
         self.call(Play, role=b.player_role.role)
 
@@ -371,24 +377,25 @@ class PlaySoccer(Option["SoccerBehavior"]):
             return "playing"
         b.keep_out.append((0.0, 0.0, pitch.CENTER_CIRCLE_DIAMETER / 2 + b.parameters.keep_out_margin))
         self.call(Play, role=b.player_role.role)
+        return None
 
     @state
-    def penalized(self, b: SoccerBehavior) -> Next:
+    def penalized(self, b: SoccerBehavior) -> None:
         """Penalized: stand still (the head too) until the GameController unpenalizes."""
         b.stand()
 
     @state
-    def finished(self, b: SoccerBehavior) -> Next:
+    def finished(self, b: SoccerBehavior) -> None:
         """FINISHED: sit."""
         b.sit()
 
     @state
-    def shoot_out_wait(self, b: SoccerBehavior) -> Next:
+    def shoot_out_wait(self, b: SoccerBehavior) -> None:
         """A penalty shoot-out before PLAYING: stand."""
         b.stand()
 
     @state
-    def shoot_out(self, b: SoccerBehavior) -> Next:
+    def shoot_out(self, b: SoccerBehavior) -> None:
         """A penalty shoot-out in PLAYING."""
         self.call(ShootOut)
 
