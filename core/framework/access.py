@@ -79,7 +79,7 @@ class ReadOnlyArray(np.ndarray):
     def __reduce__(self) -> Any:  # pickling or deep-copying yields a plain, writeable array
         return np.asarray(self).copy().__reduce__()
 
-    def __deepcopy__(self, memo: Any) -> np.ndarray:
+    def __deepcopy__(self, memo: Any) -> np.ndarray:  # type: ignore[override]  # a copy is a plain array on purpose: writeable
         return np.array(self, copy=True).view(np.ndarray)
 
 
@@ -164,6 +164,12 @@ class ReadOnlyView:
     """Base of the generated read-only view classes; one subclass per dataclass type."""
 
     __slots__ = ("_t", "_owner", "_rep", "_path", "_mark", "_cache")
+    _t: Any
+    _owner: str
+    _rep: str
+    _path: str
+    _mark: AccessMark
+    _cache: dict[str, tuple[Any, Any]]
 
     def __init__(self, target: Any, owner: str, rep: str, path: str, mark: AccessMark) -> None:
         object.__setattr__(self, "_t", target)
@@ -271,6 +277,11 @@ class WriterView:
     """
 
     __slots__ = ("_t", "_mark", "_undo", "_cache", "_owner")
+    _t: Any
+    _mark: AccessMark
+    _undo: list[tuple[Any, str, Any]]
+    _cache: dict[str, tuple[Any, Any]]
+    _owner: str
 
     def __init__(self, target: Any, mark: AccessMark, undo: list, owner: str = "") -> None:
         object.__setattr__(self, "_t", target)

@@ -155,14 +155,14 @@ def _make_representation(cls: type[T], state: bool) -> type[T]:
                 f"{name}.{field_name}: field names may not start with an underscore"
             )
         _install_default(cls, field_name, hints[field_name])
-    data_cls = dataclasses.dataclass(cls, eq=False, repr=False)
+    data_cls: Any = dataclasses.dataclass(cls, eq=False, repr=False)  # Any: it gets the attributes set below
     infos = tuple(_describe(name, f.name, hints[f.name], f) for f in dataclasses.fields(data_cls))
     setattr(data_cls, _FIELDS_ATTR, infos)
-    data_cls.__eq__ = _representation_eq  # type: ignore[method-assign]
-    data_cls.__hash__ = None  # type: ignore[assignment]
-    data_cls.__repr__ = _representation_repr  # type: ignore[method-assign]
-    data_cls.__tafel_representation__ = True  # type: ignore[attr-defined]
-    data_cls.__tafel_state__ = state  # type: ignore[attr-defined]
+    data_cls.__eq__ = _representation_eq
+    data_cls.__hash__ = None
+    data_cls.__repr__ = _representation_repr
+    data_cls.__tafel_representation__ = True
+    data_cls.__tafel_state__ = state
     _REGISTRY[name] = data_cls
     return data_cls
 

@@ -100,7 +100,7 @@ def conditions_from_config(table: Any) -> list[Condition]:
 class Triggers:
     """Watches the recorded stream for the events that save the black box; calls ``fire(reason, time_ns)``."""
 
-    def __init__(self, conditions: Sequence[Condition], fire: Callable[[str, int], None]) -> None:
+    def __init__(self, conditions: Sequence[Condition], fire: Callable[[str, int], object]) -> None:
         self.conditions = list(conditions)
         self.fire = fire
         self.since: dict[Condition, int | None] = dict.fromkeys(self.conditions)

@@ -5,6 +5,7 @@ memory. ``read_log`` reads a whole (small) log into memory for tests."""
 
 from __future__ import annotations
 
+import builtins
 import io
 import os
 import re
@@ -43,8 +44,9 @@ class LogChannel:
     metadata: dict[str, str]
     messages: int = 0
     bytes: int = 0
-    #: the schema as stored (a protobuf FileDescriptorSet), to copy the channel into another log
-    schema_data: bytes = b""
+    #: the schema as stored (a protobuf FileDescriptorSet), to copy the channel into another log (builtins: the
+    #: field above is called bytes)
+    schema_data: builtins.bytes = b""
 
     @property
     def context(self) -> str:

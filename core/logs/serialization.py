@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
+from google.protobuf.message import Message
 from google.protobuf.unknown_fields import UnknownFieldSet
 
 from tafel.core.framework.errors import TafelError
@@ -65,7 +66,7 @@ class MessageCodec:
     cls: type
     full_name: str
     file: descriptor_pb2.FileDescriptorProto
-    message_class: type
+    message_class: type[Message]
     encode: Callable[[Any], bytes]
     decode: Callable[[bytes], Any]
     fill: Callable[[Any, Any], None]
@@ -185,7 +186,7 @@ def _check_unknown(found: MessageCodec, message: Any) -> None:
     if len(unknown) == 0:
         return
     numbers = {f.number: f.name for f in found.file.message_type[0].field}
-    for item in unknown:
+    for item in (unknown[i] for i in range(len(unknown))):  # the stubs know indexing, not iteration
         if item.field_number in numbers:
             raise SerializationError(
                 f"{found.cls.__name__}.{numbers[item.field_number]}: the data holds this field with another "
@@ -370,17 +371,21 @@ def _generate(builder: _Builder, ids: dict[type, int]) -> None:
     exec(compile("\n".join(source), f"<tafel serializer {builder.cls.__name__}>", "exec"), builder.namespace)  # noqa: S102
 
 
+#: what a scalar field of each kind may hold
+_PYTHON_TYPES: dict[str, type | tuple[type, ...]] = {"bool": bool, "int": int, "float": (int, float), "str": str, "bytes": bytes}
+
+
 def _explain(cls: type, rep: Any, exc: Exception) -> str:
     """Find the field that could not be serialized, for an error message that names it."""
     for info in fields_of(cls):
         value = getattr(rep, info.name, None)
         if info.kind == "int" and isinstance(value, int) and not -(2**63) <= value < 2**63:
             return f"{cls.__name__}.{info.name} = {value} is outside the 64-bit range that can be stored"
-        expected = {"bool": bool, "int": int, "float": (int, float), "str": str, "bytes": bytes}.get(info.kind)
+        expected = _PYTHON_TYPES.get(info.kind)
         if expected is not None and not isinstance(value, expected) and not isinstance(value, np.generic):
             return f"{cls.__name__}.{info.name} holds {value!r} ({type(value).__name__}), but is declared {info.kind}"
         if info.kind == "ndarray" and not isinstance(value, np.ndarray):
             return f"{cls.__name__}.{info.name} holds {type(value).__name__}, but is declared numpy.ndarray"
-        if info.kind == "ndarray" and value.dtype.hasobject:
+        if info.kind == "ndarray" and isinstance(value, np.ndarray) and value.dtype.hasobject:
             return f"{cls.__name__}.{info.name} is an array of Python objects, which cannot be serialized"
     return f"cannot serialize {cls.__name__}: {exc}"

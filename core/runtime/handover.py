@@ -34,7 +34,7 @@ class HandoverError(TafelError, RuntimeError):
 
 def snapshot(instance: Any) -> dict[str, Any]:
     """Field values of a representation, copied so that later writes by its provider do not show."""
-    values = {}
+    values: dict[str, Any] = {}
     for name, value in instance.__dict__.items():
         if isinstance(value, np.ndarray):
             values[name] = value.copy()
@@ -92,6 +92,13 @@ _HEADER = struct.Struct("<Q")  # sequence number of the newest complete bundle
 _SLOT = struct.Struct("<QI")  # payload length, CRC-32 of the payload
 
 
+def _buffer(shm: shared_memory.SharedMemory) -> memoryview:
+    """The bytes of a shared memory block; closing it takes them away (then this raises)."""
+    if shm.buf is None:
+        raise HandoverError(f"hand-over channel {shm.name} is closed")
+    return shm.buf
+
+
 class SharedChannel:
     """Hand-over between processes through shared memory (single writer, any number of readers).
 
@@ -108,7 +115,7 @@ class SharedChannel:
         try:
             if create:
                 self._shm = shared_memory.SharedMemory(name=name, create=True, size=size)
-                self._shm.buf[: _HEADER.size] = b"\0" * _HEADER.size
+                _buffer(self._shm)[: _HEADER.size] = b"\0" * _HEADER.size
             else:
                 self._shm = shared_memory.SharedMemory(name=name)
         except OSError as exc:
@@ -139,7 +146,7 @@ class SharedChannel:
             )
         sequence = self._sequence + 1
         offset = self._slot_offset(sequence)
-        buf = self._shm.buf
+        buf = _buffer(self._shm)
         _SLOT.pack_into(buf, offset, len(payload), zlib.crc32(payload))
         start = offset + _SLOT.size
         buf[start : start + len(payload)] = payload
@@ -147,7 +154,7 @@ class SharedChannel:
         self._sequence = sequence
 
     def latest(self) -> Bundle | None:
-        buf = self._shm.buf
+        buf = _buffer(self._shm)
         for _ in range(100):
             (sequence,) = _HEADER.unpack_from(buf, 0)
             if sequence == 0:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -71,7 +71,7 @@ def _field_strategy(info: FieldInfo, max_list: int, max_axis: int) -> Any:
     elements = None
     low, high = _number_bounds(info, "float")
     if spec.dtype.kind == "f":
-        width = min(64, spec.dtype.itemsize * 8)
+        width: Literal[16, 32, 64] = 16 if spec.dtype.itemsize == 2 else 32 if spec.dtype.itemsize == 4 else 64
         if width < 64:  # the bounds must be representable at the array's width
             low, high = float(np.float32(low)), float(np.float32(high))
         elements = st.floats(min_value=low, max_value=high, allow_nan=False, allow_infinity=False, width=width)
