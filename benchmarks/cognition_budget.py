@@ -43,7 +43,7 @@ from tafel.platforms.images import posed_image  # noqa: E402
 from tafel.representations.infrastructure import FrameInfo  # noqa: E402
 from tafel.representations.motion import CameraMatrix, CameraMatrixBottom, CameraMatrixBuffer, CameraMatrixTop  # noqa: E402
 from tafel.representations.perception import CameraImageBottom, CameraImageTop  # noqa: E402
-from tafel.tools.stepped_program import SteppedProgram  # noqa: E402
+from tafel.tools.simulation.stepped_program import SteppedProgram  # noqa: E402
 
 DEFAULT_FOLDER = REPO.parent / "shared" / "real-images"
 FRAME_NS = 33_333_333  # 30 Hz
@@ -87,7 +87,7 @@ def real_pairs(folder: Path, top_size: tuple[int, int], bottom_size: tuple[int, 
 
 def rendered_pairs(count: int, top_size: tuple[int, int], bottom_size: tuple[int, int]) -> list[tuple[Shot, Shot]]:
     """(top, bottom) pairs of MuJoCo renders of random scenes (rendered at 640x480)."""
-    from tafel.tools.scene_frames import SceneRenderer
+    from tafel.tools.simulation.scene_frames import SceneRenderer
 
     pairs, pending = [], {}
     with SceneRenderer("mujoco", resolution="640x480") as renderer:

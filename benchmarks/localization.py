@@ -1,6 +1,6 @@
 """Perception and self-localization against simulator ground truth (MuJoCo by default).
 
-- Ball detector precision and recall on rendered scenes (``tools.scene_frames``): the robot anywhere
+- Ball detector precision and recall on rendered scenes (``tools.simulation.scene_frames``): the robot anywhere
   on the field, the head anywhere it can look, the ball 0.3 to 5 m away, so lines, goal posts, the
   penalty marks and the robot's own feet come into view. Precision over every frame in which a ball
   was reported; recall over the frames that show a ball within 4 m, at least half of it visible.
@@ -48,7 +48,7 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 from tafel.representations.modeling import RobotPose  # noqa: E402
 from tafel.representations.motion_control import MotionRequest, MotionType  # noqa: E402
 from tafel.representations.perception import BallPercept  # noqa: E402
-from tafel.tools.scene_frames import Perception, SceneRenderer, random_ball_scene  # noqa: E402
+from tafel.tools.simulation.scene_frames import Perception, SceneRenderer, random_ball_scene  # noqa: E402
 from tests.support.kidnapping import Kidnapping, KidnapRun  # noqa: E402
 from tests.support.simulation import Simulation  # noqa: E402
 from tests.test_localization import ROUTE  # noqa: E402

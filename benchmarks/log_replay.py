@@ -38,7 +38,8 @@ from tafel.platforms.log import LogPlatform
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel
 from tafel.representations.motion import InertialSensorData, JointSensorData
-from tafel.tools.cli import DEFAULT_CONFIG, discover_modules
+from tafel.tools.launch.defaults import DEFAULT_CONFIG
+from tafel.tools.launch.program import discover_modules
 
 MOTION_FRAMES = 10_000
 

@@ -26,7 +26,8 @@ from tafel.core.runtime import ConcurrentRuntime, ContextRunner, Limits, StopFla
 from tafel.core.runtime.handover import LocalChannel
 from tafel.core.runtime.program import plan_program
 from tafel.platforms.dummy import DummyPlatform
-from tafel.tools.cli import DEFAULT_CONFIG, discover_modules
+from tafel.tools.launch.defaults import DEFAULT_CONFIG
+from tafel.tools.launch.program import discover_modules
 
 
 def plans(load_ms: float):

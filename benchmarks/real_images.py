@@ -52,7 +52,7 @@ from tafel.representations import field  # noqa: E402
 from tafel.representations.field import BALL_RADIUS  # noqa: E402
 from tafel.representations.motion import CameraMatrix  # noqa: E402
 from tafel.representations.perception import BallImagePercept, GoalPostPercept, LinePercept  # noqa: E402
-from tafel.tools.scene_frames import Perception  # noqa: E402
+from tafel.tools.simulation.scene_frames import Perception  # noqa: E402
 
 DEFAULT_FOLDER = REPO.parent / "shared" / "real-images"
 RESOLUTIONS = {"640x480": 1.0, "320x240": 0.5}

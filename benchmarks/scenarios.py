@@ -17,9 +17,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from tafel.tools.batch import BatchInfo, run_jobs  # noqa: E402
-from tafel.tools.scenario_file import load_scenario  # noqa: E402
-from tafel.tools.scenarios import Job, run_job, run_seed, warm_up  # noqa: E402
+from tafel.tools.simulation.batch import BatchInfo, run_jobs  # noqa: E402
+from tafel.tools.simulation.scenario_file import load_scenario  # noqa: E402
+from tafel.tools.simulation.scenarios import Job, run_job, run_seed, warm_up  # noqa: E402
 
 SCENARIO = Path(__file__).resolve().parent / "scenarios" / "throughput.toml"
 

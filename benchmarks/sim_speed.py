@@ -26,7 +26,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from tafel.tools.match import cpu_seconds  # noqa: E402
+from tafel.tools.simulation.match import cpu_seconds  # noqa: E402
 from tests.support.simulation import Simulation  # noqa: E402
 
 ENGINES = ("mujoco", "pybullet")

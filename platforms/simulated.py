@@ -275,7 +275,7 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
 
     def pose_joints(self, angles: np.ndarray) -> None:
         """Set the joints to ``angles`` (rad, ``JOINT_NAMES`` order) at once, at rest: for rendering posed
-        scenes (``tools.scene_frames``), not for moving the robot physically."""
+        scenes (``tools.simulation.scene_frames``), not for moving the robot physically."""
         raise NotImplementedError
 
     def ball_mask(self, camera: str) -> np.ndarray:

@@ -346,7 +346,7 @@ def test_add_and_remove_module_edit_the_lists_without_restating_them() -> None:
 
 def test_status_line_rates_are_over_the_last_interval_and_shown_from_configuration() -> None:
     from tafel.core.runtime import ContextStats
-    from tafel.tools.cli import StatusLine
+    from tafel.tools.launch.status import StatusLine
 
     line = StatusLine("dummy", {"status": {"show": []}})
     first = line.format(10.0, {"motion": ContextStats("motion", frames=1000, wall_s=10.0)}, now=110.0)
@@ -357,7 +357,7 @@ def test_status_line_rates_are_over_the_last_interval_and_shown_from_configurati
 
 def test_the_tools_package_knows_no_representation_by_name() -> None:
     from tafel.core.framework.representation import registered_representations
-    from tafel.tools.cli import discover_modules
+    from tafel.tools.launch.program import discover_modules
 
     discover_modules()
     names = set(registered_representations()) - {"DebugDrawings", "DebugPlots", "ModuleTimes"}  # the debug data tools record
@@ -397,7 +397,7 @@ def test_a_run_that_keeps_up_says_nothing_about_its_pace() -> None:
 
 
 def test_the_pace_notice_needs_a_growing_lag_not_one_stall_made_up() -> None:
-    from tafel.tools.cli import StatusLine
+    from tafel.tools.launch.status import StatusLine
 
     line = StatusLine("dummy", {})
     # (wall s, platform s, s behind): a 1.5 s stall, made up at 1.25x, then on time

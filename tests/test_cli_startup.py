@@ -18,8 +18,8 @@ REPO = Path(__file__).resolve().parent.parent
 SMALL_LOG = REPO / "tests" / "data" / "ball_situation.mcap"
 #: what no light command may import: the simulators, OpenCV, Ray and the match and scenario code
 HEAVY = ("mujoco", "pybullet", "cv2", "ray", "tafel.platforms.match_world", "tafel.platforms.match_robot",
-         "tafel.platforms.mujoco_sim", "tafel.platforms.pybullet_sim", "tafel.tools.match", "tafel.tools.referee",
-         "tafel.tools.scenarios", "tafel.tools.scenario_file", "tafel.tools.scenario_predicates", "tafel.tools.replay_batch")
+         "tafel.platforms.mujoco_sim", "tafel.platforms.pybullet_sim", "tafel.tools.simulation.match", "tafel.tools.simulation.referee",
+         "tafel.tools.simulation.scenarios", "tafel.tools.simulation.scenario_file", "tafel.tools.simulation.scenario_predicates", "tafel.tools.simulation.replay_batch")
 
 PROBE = """
 import contextlib, io, json, sys
@@ -70,3 +70,27 @@ def test_every_subcommand_is_still_registered() -> None:
     assert probe["status"] == 0
     for command in ("run", "view", "platforms", "modules", "log", "console", "match", "scenarios", "replay-batch"):
         assert command in probe["out"]
+
+
+def test_help_imports_the_code_of_no_subcommand() -> None:
+    """``tafel --help`` builds every subcommand's parser but loads none of the code that runs one: not the
+    launch of a run, not the viewers, log tools or deploy, not the debug server."""
+    probe = imported_by("--help")
+    assert probe["status"] == 0
+    code = ("tafel.tools.launch.run", "tafel.tools.launch.program", "tafel.tools.launch.servers", "tafel.tools.cli.listing",
+            "tafel.tools.viewers", "tafel.tools.logs", "tafel.tools.robot", "tafel.debug")
+    loaded = [m for m in probe["modules"] if any(m == c or m.startswith(c + ".") for c in code)]
+    assert loaded == []
+
+
+def test_every_subcommand_names_code_that_exists() -> None:
+    """``COMMANDS`` names each subcommand's code by module and function, imported only when it runs: a
+    misspelt name would surface only then, so each is looked up here."""
+    from tafel.tools.cli.dispatch import COMMANDS, LazyCommand, build_parser
+
+    parser_commands = set(build_parser()._subparsers._group_actions[0].choices)  # type: ignore[union-attr]
+    assert set(COMMANDS) == parser_commands
+    lazy = [command for command in COMMANDS.values() if isinstance(command, LazyCommand)]
+    assert len(lazy) == len(COMMANDS) - 1  # view rewrites its arguments into run's
+    for command in lazy:
+        assert callable(command.target()), command

@@ -130,7 +130,8 @@ def test_every_process_of_a_concurrent_program_shares_one_origin(tmp_path: Path)
     from tafel.core.runtime import ConcurrentRuntime, Limits
     from tafel.core.runtime.platform import load_platform
     from tafel.core.runtime.program import plan_program
-    from tafel.tools.cli import DEFAULT_CONFIG, discover_modules
+    from tafel.tools.launch.defaults import DEFAULT_CONFIG
+    from tafel.tools.launch.program import discover_modules
 
     discover_modules()
     platform = load_platform("dummy")

@@ -18,7 +18,7 @@ from tafel.debug.executors import RateMeter, instrument
 from tafel.debug.protocol import parse
 from tafel.debug.values import pretty
 from tafel.representations.infrastructure import FrameInfo
-from tafel.tools.console import Completer
+from tafel.tools.viewers.console import Completer
 from tests.support.debug_user import DRAW, DebugUser, DebugUserOutput
 from tests.test_debug_server import Program
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from tafel.tools.deploy import DeployError, load_robots
+from tafel.tools.robot.deploy import DeployError, load_robots
 from tests.support.ssh_server import SshServer, free_port, missing
 from tests.test_cli_runtime import REPO, TAFEL
 

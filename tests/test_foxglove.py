@@ -168,7 +168,7 @@ def test_log_convert_gives_an_old_log_wall_clock_times_and_refuses_bad_input(tmp
 
 
 def test_the_layout_shows_only_topics_that_exist() -> None:
-    from tafel.tools.foxglove_channels import TOPICS
+    from tafel.tools.viewers.foxglove_channels import TOPICS
 
     layout = json.loads((REPO / "config" / "foxglove" / "tafel-layout.json").read_text())
     text = json.dumps(layout["configById"])
@@ -193,7 +193,7 @@ def test_every_panel_of_the_layout_is_placed() -> None:
 
 def test_the_programs_log_lines_are_recorded_as_foxglove_logs(tmp_path: Path) -> None:
     from tafel.core.logs.recording import Recorder
-    from tafel.tools.cli import foxglove_recording
+    from tafel.tools.launch.recording import foxglove_recording
 
     recorder = Recorder([])
     recorder.translate_factory = foxglove_recording(recorder, 80)
@@ -226,7 +226,7 @@ def test_each_json_channel_has_a_schema_its_messages_fit_field_by_field() -> Non
     from tafel.representations.behavior import ActivationGraph, ActiveOption
     from tafel.representations.infrastructure import FrameInfo
     from tafel.representations.motion import FsrData, InertialSensorData, JointCommand, JointSensorData
-    from tafel.tools.foxglove_channels import JSON_SCHEMAS, FoxgloveTranslator
+    from tafel.tools.viewers.foxglove_channels import JSON_SCHEMAS, FoxgloveTranslator
 
     translator = FoxgloveTranslator()
     rng = np.random.default_rng(3)
@@ -277,7 +277,7 @@ def test_the_layout_ships_in_the_package() -> None:
 
 
 def test_json_command_requests_say_what_to_send() -> None:
-    from tafel.tools.foxglove_live import command_from_json
+    from tafel.tools.viewers.foxglove_live import command_from_json
 
     assert command_from_json('{"command": " modules:list "}') == "modules:list"
     assert command_from_json('"ping"') == "ping"

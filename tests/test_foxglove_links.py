@@ -13,7 +13,7 @@ from tafel.modules.motion.kinematics import angles_by_name, link_poses, transfor
 from tafel.representations.motion import JOINT_NAMES, JointSensorData, TorsoPose
 from tafel.representations.motion_control import Odometry
 from tafel.representations.nao import JOINTS
-from tafel.tools.foxglove_channels import FoxgloveTranslator
+from tafel.tools.viewers.foxglove_channels import FoxgloveTranslator
 from tests.test_foxglove import sdk_class
 
 LIMITS = {joint.name: joint.limits for joint in JOINTS}

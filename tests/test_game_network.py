@@ -16,7 +16,7 @@ from tafel.platforms.network import GameNetwork, NetworkSettings
 from tafel.representations.game import GameControllerReturn
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.team import OutgoingTeamMessage
-from tafel.tools.match import free_udp_port
+from tafel.tools.simulation.match import free_udp_port
 from tests.test_debug_server import Program
 from tests.test_game_controller import RETURN, packet
 

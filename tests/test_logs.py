@@ -323,7 +323,7 @@ def test_chunks_hold_at_most_one_second_of_log_time_at_any_speed(recorded: Path)
 def test_the_progress_bar_draws_only_on_a_terminal() -> None:
     import io
 
-    from tafel.tools.log_tools import Progress
+    from tafel.tools.logs.log_tools import Progress
 
     class Terminal(io.StringIO):
         def isatty(self) -> bool:

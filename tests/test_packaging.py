@@ -68,7 +68,7 @@ def test_a_built_wheel_runs_from_anywhere(tmp_path: Path) -> None:
     work.mkdir()
     env = {k: v for k, v in os.environ.items() if k not in {"PYTHONPATH", "VIRTUAL_ENV"}}
     env["PATH"] = f"{env_dir / 'bin'}:{env['PATH']}"
-    where = subprocess.run([str(python), "-c", "import tafel.core, tafel.tools.cli as c; print(tafel.core.__file__); print(c.DEFAULT_CONFIG)"],
+    where = subprocess.run([str(python), "-c", "import tafel.core, tafel.tools.cli, tafel.tools.launch.defaults as d; print(tafel.core.__file__); print(d.DEFAULT_CONFIG)"],
                            cwd=work, env=env, check=True, capture_output=True, text=True).stdout.split()
     assert all(str(REPO) not in line for line in where), f"the installed package resolves into the source tree: {where}"
     assert Path(where[1], "general.toml").is_file(), "the default configuration does not ship inside the package"

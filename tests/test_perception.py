@@ -1,4 +1,4 @@
-"""The perception pipeline against rendered images with known positions (``tools.scene_frames``), and its
+"""The perception pipeline against rendered images with known positions (``tools.simulation.scene_frames``), and its
 parts alone: field colour, field boundary, image geometry, the SPL ball's texture.
 
 Rendered scenes are posed kinematically (no physics), so each takes a few milliseconds; opening a
@@ -37,7 +37,7 @@ from tafel.representations.perception import (
     LinePercept,
     SegmentedImage,
 )
-from tafel.tools.scene_frames import Perception, SceneRenderer
+from tafel.tools.simulation.scene_frames import Perception, SceneRenderer
 
 ENGINES = [pytest.param("mujoco", marks=pytest.mark.slow), pytest.param("pybullet", marks=pytest.mark.slow)]
 
@@ -377,7 +377,7 @@ def painted_candidates(rng: np.random.Generator, count: int) -> tuple[np.ndarray
     patches round its centre) on the carpet, half a thing of the same size that is none (a joint, a foot)."""
     from tafel.modules.perception.ball_classifier import features
     from tafel.modules.perception.spl_ball_detector import carpet
-    from tafel.tools.train_ball_classifier import distractors, realistic
+    from tafel.tools.simulation.train_ball_classifier import distractors, realistic
 
     rows, labels = [], []
     for i in range(count):
@@ -445,7 +445,7 @@ def test_the_shipped_classifier_is_small_and_shipped() -> None:
 @pytest.mark.slow
 def test_the_training_script_trains_on_renders_and_real_images(tmp_path) -> None:
     from tafel.modules.perception.ball_classifier import BallClassifier
-    from tafel.tools.train_ball_classifier import main
+    from tafel.tools.simulation.train_ball_classifier import main
 
     out = tmp_path / "model.npz"
     main(["--scenes", "3", "--real-variants", "1", "--epochs", "50", "--out", str(out)])

@@ -15,7 +15,7 @@ from tafel.representations.behavior import HeadMotionRequest
 from tafel.representations.infrastructure import CognitionStatus, FrameInfo
 from tafel.representations.motion import BodyJointTargets, HeadJointTargets, JointCommand, JointSensorData
 from tafel.representations.perception import BallPercept
-from tafel.tools.cli import discover_modules
+from tafel.tools.launch.program import discover_modules
 
 discover_modules()
 

@@ -1,4 +1,4 @@
-"""The simulated GameController (``tools/referee.py``) in a match's world without robot programs: robots
+"""The simulated GameController (``tools/simulation/referee.py``) in a match's world without robot programs: robots
 put where a test wants them, the referee ticked by hand, its packets read from the published layout."""
 
 from __future__ import annotations
@@ -11,8 +11,8 @@ import pytest
 
 from tafel.platforms.match_world import MatchWorld, Side
 from tafel.representations.game import Penalty, SetPlay, State
-from tafel.tools.match import free_udp_port
-from tafel.tools.referee import Player, Referee
+from tafel.tools.simulation.match import free_udp_port
+from tafel.tools.simulation.referee import Player, Referee
 
 TICK = 0.01
 

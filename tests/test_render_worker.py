@@ -14,7 +14,7 @@ from tafel.platforms import pybullet_sim
 from tafel.platforms.pybullet_sim import PybulletPlatform
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.perception import CameraImageBottom, CameraImageTop
-from tafel.tools.match import cpu_seconds
+from tafel.tools.simulation.match import cpu_seconds
 from tests.support.simulation import Simulation
 
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from tafel.core.logs import LogReader
-from tafel.tools.log_compare import compare_logs, field_differences
+from tafel.tools.logs.log_compare import compare_logs, field_differences
 from tests.test_cli_runtime import dummy, tafel
 
 FEEDBACK_REPS = "InertialModel,CameraMatrixTop,JointCommand,BallModel"

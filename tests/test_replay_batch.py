@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from tafel.tools.replay_batch import expand
+from tafel.tools.simulation.replay_batch import expand
 
 REPO = Path(__file__).resolve().parent.parent
 

@@ -17,9 +17,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tafel.core.logs import LogReader
-from tafel.tools.batch import BatchInfo, run_jobs
-from tafel.tools.scenario_file import ScenarioError, load_scenario
-from tafel.tools.scenarios import _Judge, perturbed_start, run_seed, summarize, wilson_interval
+from tafel.tools.simulation.batch import BatchInfo, run_jobs
+from tafel.tools.simulation.scenario_file import ScenarioError, load_scenario
+from tafel.tools.simulation.scenarios import _Judge, perturbed_start, run_seed, summarize, wilson_interval
 
 REPO = Path(__file__).resolve().parent.parent
 SHIPPED = sorted((REPO / "config" / "scenarios").glob("*.toml"))
@@ -329,7 +329,7 @@ def test_success_and_failure_are_detected_and_a_failed_run_keeps_a_replayable_lo
 @pytest.mark.slow
 def test_without_a_shared_folder_a_failed_runs_log_travels_back_with_its_row(tmp_path: Path) -> None:
     """What a Ray cluster's worker does when the caller gave no --artifacts: the log comes back as bytes."""
-    from tafel.tools.scenarios import Job, run_job
+    from tafel.tools.simulation.scenarios import Job, run_job
 
     scenario = load_scenario(write(tmp_path, FAILS))
     row = run_job(Job(scenario, 0, 5, artifacts=None))

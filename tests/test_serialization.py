@@ -22,7 +22,7 @@ from tafel.core.logs.serialization import (
     serialize,
 )
 from tafel.core.testing import strategy_for
-from tafel.tools.cli import discover_modules
+from tafel.tools.launch.program import discover_modules
 
 discover_modules()  # every representation of the project takes part in the round-trip property
 

@@ -37,8 +37,8 @@ from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import CameraMatrix, CameraMatrixBuffer, ChestButton, InertialSensorData, JointSensorData
 from tafel.representations.motion_control import FallState, MotionRequest, MotionSelection
 from tafel.representations.perception import CameraImageBottom, CameraImageTop
-from tafel.tools.cli import discover_modules
-from tafel.tools.stepped_program import SteppedProgram
+from tafel.tools.launch.program import discover_modules
+from tafel.tools.simulation.stepped_program import SteppedProgram
 
 #: floats no field or parameter takes: not finite, or beyond any range a robot needs
 BAD_FLOATS = (math.nan, math.inf, -math.inf, 1e308, -1e308, 2 * MAX_MAGNITUDE, -2 * MAX_MAGNITUDE)

@@ -22,8 +22,8 @@ from tafel.modules.communication.game_controller_codec import encode_game_state
 from tafel.modules.communication.team_message_codec import pack_message
 from tafel.representations.game import GameState, Penalty, RobotInfo, State, TeamInfo
 from tafel.representations.team import Intention, Role, TeamMessage
-from tafel.tools.match import free_udp_port
-from tafel.tools.team import FORGET_AFTER_S, TeamListener
+from tafel.tools.simulation.match import free_udp_port
+from tafel.tools.viewers.team import FORGET_AFTER_S, TeamListener
 from tests.support.browser import WebProgram, launch, missing_browser, open_page, wait_for
 from tests.test_web_view import screenshot_dir
 

@@ -35,7 +35,7 @@ from tafel.representations import load_all
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel
 from tafel.representations.perception import BallPercept, CameraImageTop
-from tafel.tools.live_feed import LiveFeed
+from tafel.tools.viewers.live_feed import LiveFeed
 
 load_all()
 
@@ -340,8 +340,8 @@ def receive_streamed(socket: Any, count: int) -> list[Any]:
 
 def test_an_image_carries_the_drawings_of_its_own_frame_and_plot_names_come_when_new(served: Served) -> None:
     from tafel.debug.concepts import DebugDrawingPrimitive, DebugDrawings, DebugPlots
-    from tafel.tools.live_feed import Handed
-    from tafel.tools.web.view import WebView
+    from tafel.tools.viewers.live_feed import Handed
+    from tafel.tools.viewers.web.view import WebView
 
     view = WebView(served.server, [CameraImageTop, BallModel], port=0)
     view.start()

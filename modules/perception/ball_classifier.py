@@ -8,7 +8,7 @@ light and colour casts do not matter), the carpet's share in eight sectors round
 the carpet; things at the field's edge have none above them) and a few colour figures measured
 against the carpet. A small neural network decides: small (a few kB, shipped as ``ball_classifier.npz``
 beside this file), fast (microseconds per candidate) and trained by
-``python -m tafel.tools.train_ball_classifier`` on simulator renders with ground truth plus the real
+``python -m tafel.tools.simulation.train_ball_classifier`` on simulator renders with ground truth plus the real
 images whose licence allows it.
 """
 
@@ -93,13 +93,13 @@ class BallClassifier:
     def __init__(self, path: Path | str = MODEL_PATH) -> None:
         path = Path(path)
         if not path.is_file():
-            raise FileNotFoundError(f"no ball classifier model at {path}: train one with python -m tafel.tools.train_ball_classifier")
+            raise FileNotFoundError(f"no ball classifier model at {path}: train one with python -m tafel.tools.simulation.train_ball_classifier")
         with np.load(path) as data:
             self.mean, self.scale = data["mean"], data["scale"]
             self.w1, self.b1, self.w2, self.b2 = data["w1"], data["b1"], data["w2"], data["b2"]
         if self.mean.shape != (FEATURES,) or self.w1.shape[0] != FEATURES:
             raise ValueError(f"{path} expects {self.w1.shape[0]} features, this code makes {FEATURES}: retrain it "
-                             "(python -m tafel.tools.train_ball_classifier)")
+                             "(python -m tafel.tools.simulation.train_ball_classifier)")
 
     def scores(self, rows: np.ndarray) -> np.ndarray:
         """The logit of each row of features (positive: a ball)."""

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from typing import Any
 
-from tafel.tools.stepped_program import SteppedProgram
+from tafel.tools.simulation.stepped_program import SteppedProgram
 
 #: the behaviour replaced by a robot that stands still: for tests of perception and head motion
 PERCEPTION = ["FieldColorProvider", "FieldBoundaryDetector", "SPLBallDetector", "BallDetector", "BallLocator", "LineDetector",

@@ -24,7 +24,7 @@ from tafel.core.logs import LogError, LogReader, write_slice
 
 def run_log_command(args: argparse.Namespace) -> int:
     if args.log_command == "compare":
-        from tafel.tools.log_compare import run_compare
+        from tafel.tools.logs.log_compare import run_compare
 
         return run_compare(args)
     if args.log_command in ("slice", "convert"):
@@ -57,8 +57,8 @@ def run_slice(args: argparse.Namespace) -> int:
         return 2
     translate = None
     if converting:
-        from tafel.tools.cli import discover_modules
-        from tafel.tools.foxglove_channels import FoxgloveTranslator
+        from tafel.tools.launch.program import discover_modules
+        from tafel.tools.viewers.foxglove_channels import FoxgloveTranslator
 
         discover_modules()  # every representation class, to decode what the log holds
         translate = FoxgloveTranslator(args.jpeg_quality).translate

@@ -16,7 +16,9 @@ from tafel.core.framework.config import edit_modules, load_config
 from tafel.core.runtime import Limits, LockstepRuntime
 from tafel.core.runtime.platform import load_platform
 from tafel.core.runtime.program import plan_program
-from tafel.tools.cli import DEFAULT_CONFIG, discover_modules, program_recorder
+from tafel.tools.launch.defaults import DEFAULT_CONFIG
+from tafel.tools.launch.program import discover_modules
+from tafel.tools.launch.recording import program_recorder
 
 
 class SteppedProgram:

@@ -29,9 +29,9 @@ from typing import Any
 
 import numpy as np
 
-from tafel.tools.batch import BatchError, BatchInfo, run_jobs
-from tafel.tools.scenario_file import Scenario, ScenarioError, load_scenario
-from tafel.tools.scenario_predicates import PREDICATES
+from tafel.tools.simulation.batch import BatchError, BatchInfo, run_jobs
+from tafel.tools.simulation.scenario_file import Scenario, ScenarioError, load_scenario
+from tafel.tools.simulation.scenario_predicates import PREDICATES
 
 #: the columns of every row, in the order CSV files show them
 COLUMNS = ["scenario", "run", "seed", "success", "time_to_success_s", "sim_s", "wall_s", "reason", "robot_x_mm", "robot_y_mm",
@@ -144,7 +144,7 @@ def _options(scenario: Scenario, start: Start, seed: int) -> dict[str, Any]:
 
 def play(scenario: Scenario, seed: int, record: Path | None = None) -> dict[str, Any]:
     """One run of ``scenario`` from ``seed``: success, when, why not, and where things ended."""
-    from tafel.tools.stepped_program import SteppedProgram
+    from tafel.tools.simulation.stepped_program import SteppedProgram
 
     start = perturbed_start(scenario, seed)
     began = time.perf_counter()
@@ -210,7 +210,7 @@ def _failure_log(job: Job, row: dict[str, Any]) -> dict[str, Any]:
 def warm_up(platforms: Sequence[str] = ("mujoco",)) -> None:
     """Imports, module discovery and the simulators' libraries, once per worker, before the clock starts."""
     from tafel.core.runtime.platform import load_platform
-    from tafel.tools.cli import discover_modules
+    from tafel.tools.launch.program import discover_modules
 
     discover_modules()
     for name in platforms:
@@ -278,7 +278,7 @@ def write_rows(path: Path, rows: Sequence[dict[str, Any]]) -> None:
 
 # ------------------------------------------------------------------------------------ the command
 def print_predicates() -> int:
-    from tafel.tools.scenario_predicates import REQUIRED, TIMING
+    from tafel.tools.simulation.scenario_predicates import REQUIRED, TIMING
 
     for name, kind in PREDICATES.items():
         print(f"{name} ({kind.when}): {kind.summary}")

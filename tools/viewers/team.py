@@ -6,7 +6,7 @@ ever sent, so it takes none of the team's message budget and is within the rules
 appears in the web view's Team panel with its pose, role, intention, ball, fallen or penalized, and
 the time since its last message; the GameController's state on top.
 
-The page is the web view's own (``tools/web/static``); here it is served by a debug server without
+The page is the web view's own (``tools/viewers/web/static``); here it is served by a debug server without
 contexts. What was heard goes out as the topics ``TeamMates`` and ``GameState``, the JSON a running
 program sends for the same representations, so the Team panel draws a program's teammates and a
 listened team the same way. ``team:robots`` (telnet, console) answers the same as JSON.
@@ -35,8 +35,8 @@ from tafel.modules.communication.team_message_codec import TeamMessageError, unp
 from tafel.platforms.network import listening_socket
 from tafel.representations.game import GAME_CONTROLLER_PORT, GameState
 from tafel.representations.team import TEAM_PORT_BASE, TeamMate, TeamMates, TeamMessage
-from tafel.tools.debugging import field_geometry
-from tafel.tools.web.view import STATIC
+from tafel.tools.viewers.field import field_geometry
+from tafel.tools.viewers.web.view import STATIC
 
 log = logging.getLogger("tafel.team")
 #: s after its last message that a robot leaves the view (TeamMatesProvider's default is 10)

@@ -26,10 +26,10 @@ from typing import Any
 
 from tafel.core.framework.naming import did_you_mean
 from tafel.core.logs import LogError, LogReader
-from tafel.tools.batch import BatchError, BatchInfo, run_jobs
-from tafel.tools.log_compare import compare_logs
-from tafel.tools.log_tools import decoded_messages
-from tafel.tools.scenarios import plural, warm_up
+from tafel.tools.logs.log_compare import compare_logs
+from tafel.tools.logs.log_tools import decoded_messages
+from tafel.tools.simulation.batch import BatchError, BatchInfo, run_jobs
+from tafel.tools.simulation.scenarios import plural, warm_up
 
 
 @dataclass(frozen=True)
@@ -81,7 +81,7 @@ def metric_means(path: Path, metrics: Sequence[str]) -> dict[str, float | None]:
 def check_metrics(metrics: Sequence[str], logs: Sequence[Path]) -> None:
     """Every ``REP.FIELD`` names a representation some log holds and a field it has; ``ValueError`` otherwise."""
     from tafel.core.framework.representation import fields_of, get_representation
-    from tafel.tools.cli import discover_modules
+    from tafel.tools.launch.program import discover_modules
 
     if not metrics:
         return
@@ -104,7 +104,7 @@ def check_metrics(metrics: Sequence[str], logs: Sequence[Path]) -> None:
 
 def replay_log(job: ReplayJob) -> dict[str, Any]:
     """A worker's task: replay one log, record, compare, measure. Never raises: errors are rows."""
-    from tafel.tools.stepped_program import SteppedProgram
+    from tafel.tools.simulation.stepped_program import SteppedProgram
 
     row: dict[str, Any] = {"log": job.log}
     began = time.perf_counter()

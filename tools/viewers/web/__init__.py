@@ -1,5 +1,5 @@
 """RobotControl in the browser: the page the program serves, and what feeds it."""
 
-from tafel.tools.web.view import STATIC, WebView, web_topics
+from tafel.tools.viewers.web.view import STATIC, WebView, web_topics
 
 __all__ = ["STATIC", "WebView", "web_topics"]

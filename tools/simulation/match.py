@@ -29,8 +29,8 @@ from typing import Any, TextIO
 
 from tafel.platforms.match_robot import AUTHKEY_ENV
 from tafel.platforms.match_world import TICK_NS, MatchWorld, Side
-from tafel.tools.arguments import MAX_PLAYERS_PER_TEAM
-from tafel.tools.referee import Player, Referee
+from tafel.tools.simulation.referee import Player, Referee
+from tafel.tools.simulation.rules import MAX_PLAYERS_PER_TEAM
 
 TEAM_NUMBERS = (1, 2)
 #: where robots enter (team frame, mm and rad): on the own half's touchline, facing the field

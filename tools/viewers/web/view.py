@@ -33,8 +33,8 @@ from tafel.debug.server import DebugServer
 from tafel.debug.values import jpeg_bytes, representation_message
 from tafel.debug.websocket import WebServer
 from tafel.representations.motion import JointSensorData, TorsoPose
-from tafel.tools.live_feed import Handed, LiveFeed, feed_order
-from tafel.tools.robot_links import links_message
+from tafel.tools.viewers.live_feed import Handed, LiveFeed, feed_order
+from tafel.tools.viewers.robot_links import links_message
 
 log = logging.getLogger("tafel.web")
 STATIC = Path(__file__).resolve().parent / "static"

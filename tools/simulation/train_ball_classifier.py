@@ -1,9 +1,9 @@
 """Train the ball classifier (``modules/perception/ball_classifier.py``) reproducibly.
 
-    python -m tafel.tools.train_ball_classifier [--scenes 250] [--seed 0] [--real tests/data/real_images] [--out PATH]
+    python -m tafel.tools.simulation.train_ball_classifier [--scenes 250] [--seed 0] [--real tests/data/real_images] [--out PATH]
 
 Data:
-- simulator renders with ground truth (``tools.scene_frames.SceneRenderer``, MuJoCo): the robot anywhere
+- simulator renders with ground truth (``tools.simulation.scene_frames.SceneRenderer``, MuJoCo): the robot anywhere
   on the field, the head anywhere, the ball 0.3 to 5 m away, at 640x480 and 320x240. Each image is first
   made to look like a real camera's (``realistic``: exposure, white balance and colour casts, gamma,
   vignetting, blur, sensor noise, YUV422 chroma subsampling, JPEG), and most get things painted in that
@@ -40,7 +40,7 @@ from tafel.modules.perception.ball_classifier import FEATURES, MODEL_PATH, featu
 from tafel.modules.perception.spl_ball_detector import SPLBallDetector, carpet
 from tafel.platforms.images import posed_image
 from tafel.representations.motion import CameraMatrix
-from tafel.tools.scene_frames import LabelledFrame, Perception, random_ball_scene
+from tafel.tools.simulation.scene_frames import LabelledFrame, Perception, random_ball_scene
 
 REPO = Path(__file__).resolve().parent.parent
 DEFAULT_REAL = REPO / "tests" / "data" / "real_images"
@@ -181,7 +181,7 @@ def simulated(collector: Collector, engine: str, scenes: int, seed: int, painted
     """Rows from ``scenes`` random rendered scenes at each resolution; ``painted_negatives``: every painted
     distractor is a row too, not only those the detector proposes (tried: it made the model timid, recall
     on real balls fell)."""
-    from tafel.tools.scene_frames import SceneRenderer
+    from tafel.tools.simulation.scene_frames import SceneRenderer
 
     rng = np.random.default_rng(seed)
     for resolution in RESOLUTIONS:

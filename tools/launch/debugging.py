@@ -23,6 +23,7 @@ from tafel.debug.protocol import Command, parse
 from tafel.debug.router import DebugRouter
 from tafel.debug.server import DebugServer
 from tafel.debug.session import IDLE_TIMEOUT
+from tafel.tools.viewers.field import field_geometry
 
 
 def recording_path(folder: Path, name: str) -> Path:
@@ -215,18 +216,6 @@ class ProgramDebug:
         if self.recorder is None:
             return "recording: not available"
         return json.dumps(self.recorder.status())
-
-
-def field_geometry() -> dict[str, Any]:
-    """What a view needs to draw the field to scale (``tafel.representations.field``)."""
-    from tafel.representations import field
-
-    return {"length": field.LENGTH, "width": field.WIDTH, "border": field.BORDER_STRIP, "line_width": field.LINE_WIDTH,
-            "lines": [list(s) for s in field.line_segments()],
-            "circle": {"x": 0.0, "y": 0.0, "radius": field.CENTER_CIRCLE_DIAMETER / 2},
-            "marks": [list(c) for c in field.mark_centres()], "mark_size": field.MARK_SIZE,
-            "posts": [list(p) for p in field.goal_post_positions()], "post_radius": field.GOAL_POST_DIAMETER / 2,
-            "goal_depth": field.GOAL_DEPTH, "ball_radius": field.BALL_RADIUS}
 
 
 def _default(value: Any) -> str:

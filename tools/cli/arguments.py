@@ -1,8 +1,9 @@
-"""The command lines of ``tafel``'s subcommands: argparse only, so that building the parser is cheap.
+"""The command lines of ``tafel`` and its subcommands: argparse only, so that building the parser is cheap.
 
 ``tafel --help``, ``tafel console`` and ``tafel log info`` build the whole parser; the code that runs a
 command (MuJoCo for ``match``, the scenario runner, protobuf for logs) is imported by that command alone
-(``tafel.tools.<module>``, loaded when it runs). Keep the imports here to the standard library.
+(``COMMANDS`` in ``dispatch.py`` names it; it is loaded when it runs). Keep the imports here to the
+standard library and the tools' modules of constants (``launch/defaults.py``, ``simulation/rules.py``).
 """
 
 from __future__ import annotations
@@ -12,6 +13,9 @@ import math
 import re
 from pathlib import Path
 from typing import Any
+
+from tafel.tools.launch.defaults import DEFAULT_DEBUG_PORT, DEFAULT_FOXGLOVE_PORT, DEFAULT_WEB_PORT
+from tafel.tools.simulation.rules import MAX_PLAYERS_PER_TEAM
 
 #: the factors ``--speed`` takes: slower than a thousandth of real time no frame would ever come
 SPEED_RANGE = (0.001, 1000.0)
@@ -64,10 +68,6 @@ def add_module_path_argument(parser: argparse.ArgumentParser) -> None:
                              "(repeatable; installed packages announce theirs in the entry point group tafel.modules)")
 
 
-#: robots a team may field in ``tafel match`` (the SPL's five)
-MAX_PLAYERS_PER_TEAM = 5
-
-
 def parse_teams(text: str) -> tuple[int, int]:
     """``--teams``: NvM with N, M from 0 to 5 and at least one robot, e.g. 2v2 or 1v0."""
     match = re.fullmatch(r"(\d)v(\d)", text.strip().lower())
@@ -101,7 +101,7 @@ def add_match_command(commands: Any) -> None:
 
 
 def add_scenario_commands(commands: Any) -> None:
-    from tafel.tools.batch import default_workers
+    from tafel.tools.simulation.batch import default_workers
 
     scenarios = commands.add_parser("scenarios", help="run scenario files many times with perturbations; success rates",
                                     description="Scenario tests: each file N times with seeded perturbations, headless at full "
@@ -125,7 +125,7 @@ def add_scenario_commands(commands: Any) -> None:
 
 
 def add_replay_batch_command(commands: Any) -> None:
-    from tafel.tools.batch import default_workers
+    from tafel.tools.simulation.batch import default_workers
 
     batch = commands.add_parser("replay-batch", help="replay many logs with a changed configuration or module; what differs",
                                 description="Replay every log (paths or globs) with the changes given, record the replay, and "
@@ -206,7 +206,7 @@ def team_number(text: str) -> int:
 
 
 def add_team_command(commands: Any) -> None:
-    """``tafel team``: the code is in ``tafel.tools.team``."""
+    """``tafel team``: the code is in ``tafel.tools.viewers.team``."""
     team = commands.add_parser("team", help="TeamControl in the browser: every robot of a team, from its messages on the network",
                                description="Listens (receive only, within the rules) to a team's messages on UDP 10000 + team "
                                            "number and to the GameController, and serves the web view's Team panel: every robot "
@@ -226,7 +226,7 @@ def add_team_command(commands: Any) -> None:
 
 
 def add_deploy_commands(commands: Any) -> None:
-    """``tafel robots`` and ``tafel deploy``: the code is in ``tafel.tools.deploy``."""
+    """``tafel robots`` and ``tafel deploy``: the code is in ``tafel.tools.robot.deploy``."""
     robots = commands.add_parser("robots", help="list the robots of robots.toml, whether they answer and which release they run")
     deploy = commands.add_parser("deploy", help="build, copy and install the program on a robot and (re)start it there",
                                  description="Builds the wheel, its dependencies for the robot and the configuration, copies "
@@ -238,3 +238,95 @@ def add_deploy_commands(commands: Any) -> None:
     for parser in (robots, deploy):
         parser.add_argument("--config", type=Path, metavar="DIR", help="a configuration folder with robots.toml (on top of the shipped one)")
         parser.add_argument("--ssh-config", type=Path, metavar="FILE", help="an SSH configuration file (default: your own)")
+
+
+def add_program_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--platform", help="where to run (see 'tafel platforms'); default from configuration")
+    parser.add_argument("--config", type=Path, metavar="DIR",
+                        help="a configuration folder whose layers go on top of the shipped defaults; "
+                             "parameter:store and modules:store write into DIR/private/private.toml")
+    parser.add_argument("--robot", help="robot layer config/robot/NAME.toml")
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                        help="override a configuration value, e.g. runtime.cognition_hz=15 (repeatable)")
+    parser.add_argument("--strict", action="store_true",
+                        help="modules the platform cannot feed are an error instead of being pruned")
+    parser.add_argument("--add-module", action="append", default=[], metavar="CONTEXT:MODULE",
+                        help="add a module to a context's list, e.g. cognition:SimpleBallModeler (repeatable)")
+    parser.add_argument("--remove-module", action="append", default=[], metavar="CONTEXT:MODULE",
+                        help="remove a module from a context's list (repeatable)")
+    add_module_path_argument(parser)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="tafel", description="Run and inspect Tafel robot control programs.")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND")
+    commands.required = True
+
+    run = commands.add_parser("run", help="run the program on a platform",
+                              epilog="Each platform has options of its own: tafel platforms --verbose lists them.")
+    add_program_arguments(run)
+    limit = run.add_mutually_exclusive_group()
+    limit.add_argument("--seconds", type=positive(float), help="stop after this much platform time")
+    limit.add_argument("--frames", type=positive(int), help="stop after N frames of the main context (motion, else cognition)")
+    run.add_argument("--speed", type=parse_speed, default=1.0, help="pace against the wall clock: a factor, or 'max'")
+    run.add_argument("--concurrent", action="store_true", help="run the contexts in parallel processes")
+    run.add_argument("--status-interval", type=positive(float), default=2.0, metavar="S",
+                     help="seconds between status lines (default: %(default)s)")
+    run.add_argument("-v", "--verbose", action="store_true", help="log informational messages")
+    run.add_argument("--record", type=Path, metavar="FILE.mcap", help="record representations into an MCAP log")
+    run.add_argument("--record-dir", type=Path, default=Path("logs"), metavar="DIR",
+                     help="the only folder debug clients may record into with log:start (default: %(default)s)")
+    run.add_argument("--record-reps", metavar="A,B",
+                     help="what to record besides the sensor data (default: [recording] representations; 'all': everything)")
+    run.add_argument("--debug-port", type=port_number, default=None, metavar="P", help=f"debug server port (default {DEFAULT_DEBUG_PORT}; 0 takes a free one)")
+    run.add_argument("--debug-host", default="127.0.0.1", metavar="H", help="debug server address (default: %(default)s)")
+    token = run.add_mutually_exclusive_group()
+    token.add_argument("--debug-token", metavar="T", help="clients must send 'auth T' first")
+    token.add_argument("--debug-token-file", type=Path, metavar="F",
+                       help="read the token from a file (it then does not show in ps); a trailing newline is dropped")
+    run.add_argument("--debug-max-connections", type=positive(int), default=32, metavar="N",
+                     help="debug connections served at once; more get an error line (default: %(default)s)")
+    run.add_argument("--debug-idle-timeout", type=positive(float), default=30.0, metavar="S",
+                     help="close a debug connection that has not authenticated (without a token: sent no command) "
+                          "within S seconds (default: %(default)s)")
+    run.add_argument("--no-debug", action="store_true", help="run without the debug server (and without the web view)")
+    run.add_argument("--web-port", type=port_number, default=DEFAULT_WEB_PORT, metavar="P",
+                     help="serve RobotControl in the browser on the debug server's address at this port "
+                          "(default %(default)s; 0 takes a free one)")
+    run.add_argument("--no-web", action="store_true", help="run without the web view")
+    run.add_argument("--watch", action="store_true",
+                     help="reload a module into the running program when its source file changes (keeps the blackboard)")
+    run.add_argument("--foxglove", nargs="?", const=f"127.0.0.1:{DEFAULT_FOXGLOVE_PORT}", metavar="[HOST:]PORT",
+                     help=f"serve Foxglove and Lichtblick live over WebSocket (default 127.0.0.1:{DEFAULT_FOXGLOVE_PORT}; "
+                          "with --debug-token clients must give it: ws://HOST:PORT/?token=T)")
+
+    # the tools' command lines only: each tool's code (MuJoCo for match, protobuf for logs) loads when it runs
+    add_log_commands(commands)
+    add_console_command(commands)
+    add_match_command(commands)
+    add_team_command(commands)
+    add_scenario_commands(commands)
+    add_replay_batch_command(commands)
+    add_deploy_commands(commands)
+
+    platforms = commands.add_parser("platforms", help="list the platforms and what they provide and consume")
+    platforms.add_argument("--verbose", "-v", action="store_true", help="also list each platform's options")
+
+    view = commands.add_parser("view", help="RobotControl in the browser for a recorded log: play, pause, step and scrub",
+                               epilog="The recorded representations are shown as recorded; modules whose outputs the log "
+                                      "does not hold run again on the recorded data.")
+    view.add_argument("file", type=Path, metavar="FILE.mcap")
+    view.add_argument("--web-port", type=port_number, default=DEFAULT_WEB_PORT, metavar="P",
+                      help="serve the page at this port (default %(default)s; 0 takes a free one)")
+    view.add_argument("--debug-port", type=port_number, default=0, metavar="P", help="debug server port (default: a free one)")
+    view.add_argument("--debug-host", default="127.0.0.1", metavar="H", help="the address of both (default: %(default)s)")
+    view.add_argument("--debug-token", metavar="T", help="clients and the page must send 'auth T' first")
+    view.add_argument("--speed", type=parse_speed, default=1.0, help="playing speed: a factor, or 'max'")
+    add_module_path_argument(view)
+
+    modules = commands.add_parser("modules", help="show the module graph of both contexts")
+    add_program_arguments(modules)
+    modules.add_argument("--dot", action="store_true", help="print Graphviz DOT of both contexts and their hand-overs")
+    return parser
+
+

@@ -19,7 +19,7 @@ from tafel.core.framework.config import ConfigError, apply_overrides, check_conf
 from tafel.core.framework.naming import did_you_mean
 from tafel.core.framework.representation import fields_of, get_representation
 from tafel.representations.field import BORDER_STRIP, LENGTH, WIDTH
-from tafel.tools.scenario_predicates import PREDICATES, REQUIRED, TIMING, Parameter
+from tafel.tools.simulation.scenario_predicates import PREDICATES, REQUIRED, TIMING, Parameter
 
 PLATFORMS = ("mujoco", "pybullet")
 CONTEXTS = ("cognition", "motion")
@@ -344,7 +344,7 @@ def _parameter(f: _File, table: tuple[Any, ...], values: dict[str, Any], key: st
 
 
 def _check_representation(f: _File, table: tuple[Any, ...], p: dict[str, Any]) -> None:
-    from tafel.tools.cli import discover_modules  # the representations register as their modules are imported
+    from tafel.tools.launch.program import discover_modules  # the representations register as their modules are imported
 
     discover_modules()
     try:

@@ -1,0 +1,1 @@
+"""Recorded logs: ``tafel log info``, ``export``, ``slice``, ``convert`` and ``compare``."""

@@ -1,0 +1,1 @@
+"""The real robot: ``tafel robots`` and ``tafel deploy`` (with ``deploy_robot.sh``, run on the robot)."""
