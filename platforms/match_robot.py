@@ -35,6 +35,7 @@ from tafel.platforms.mujoco_sim import GL_BACKEND, MujocoRobot, close_renderers,
 from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS
 from tafel.platforms.robot_model import mjcf_assets, robot_prefix
 from tafel.platforms.simulated import SimulatedRobotPlatform
+from tafel.representations.geometry import Pose2D
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import RobotPose
 from tafel.representations.motion import HEAD_YAW, JOINT_COUNT, FsrData, InertialSensorData, JointCommand, JointSensorData, TouchSensorData
@@ -146,13 +147,12 @@ class MatchRobotPlatform(SimulatedRobotPlatform):
     def robots_near(self, x: float, y: float, heading: float) -> list[SeenRobot]:
         """The other robots within ``ROBOT_SEEN_DISTANCE`` and ``ROBOT_SEEN_ANGLE`` of the torso's heading
         (what sonar and cameras would tell), robot frame mm, without noise beyond the pose's."""
-        seen, c, s = [], math.cos(heading), math.sin(heading)
+        seen, here = [], Pose2D(x, y, heading)
         for index, world in enumerate(self.snapshot.robots if self.snapshot is not None else ()):
             if index == self.index:
                 continue
             ox, oy, _ = self.side.to_team(*world)
-            dx, dy = ox - x, oy - y
-            rx, ry = c * dx + s * dy, -s * dx + c * dy
+            rx, ry = here.to_local(ox, oy)
             if math.hypot(rx, ry) < ROBOT_SEEN_DISTANCE and abs(math.atan2(ry, rx)) < ROBOT_SEEN_ANGLE:
                 seen.append(SeenRobot(rx, ry))
         return seen

@@ -24,6 +24,7 @@ from tafel.platforms.field_world import BALL_COLORS
 from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS, NetworkedPlatform
 from tafel.platforms.robot_model import STANDING_HEIGHT
 from tafel.representations import field
+from tafel.representations.geometry import Pose2D
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import KnownPose
 from tafel.representations.motion import (
@@ -447,11 +448,7 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
 
     def ball_in_robot_frame(self) -> tuple[float, float]:
         """The ball relative to the robot (mm): the frame between the feet, turned with the torso."""
-        bx, by = self.ball_position()
-        x, y, heading = self.robot_pose()
-        dx, dy = bx - x, by - y
-        c, s = math.cos(-heading), math.sin(-heading)
-        return dx * c - dy * s, dx * s + dy * c
+        return Pose2D(*self.robot_pose()).to_local(*self.ball_position())
 
     # ------------------------------------------------------------------------ debug commands
     def commands(self) -> Mapping[str, tuple[str, Any]]:

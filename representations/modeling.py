@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from tafel.core import bounded, representation
+from tafel.representations.geometry import Pose2D
 
 
 @representation
@@ -55,16 +56,17 @@ class RobotPose:
     """how likely the robot is at this pose's twin (turned by 180 degrees about the centre spot, which
     the field cannot tell apart) rather than here; ``valid`` only while it is low"""
 
+    def as_pose2d(self) -> Pose2D:
+        """The robot frame on the field, to compute with (the fields stay what logs hold)."""
+        return Pose2D(self.x, self.y, self.rotation)
+
     def to_field(self, x: float, y: float) -> tuple[float, float]:
         """A point in the robot frame (mm) on the field (mm)."""
-        c, s = math.cos(self.rotation), math.sin(self.rotation)
-        return self.x + c * x - s * y, self.y + s * x + c * y
+        return self.as_pose2d().to_global(x, y)
 
     def to_robot(self, x: float, y: float) -> tuple[float, float]:
         """A point on the field (mm) in the robot frame (mm)."""
-        dx, dy = x - self.x, y - self.y
-        c, s = math.cos(self.rotation), math.sin(self.rotation)
-        return c * dx + s * dy, -s * dx + c * dy
+        return self.as_pose2d().to_local(x, y)
 
     def status_text(self) -> str:
         if not self.valid:
@@ -83,3 +85,6 @@ class KnownPose:
     x: float = bounded(-15000.0, 15000.0)
     y: float = bounded(-15000.0, 15000.0)
     rotation: float = bounded(-math.pi, math.pi)
+
+    def as_pose2d(self) -> Pose2D:
+        return Pose2D(self.x, self.y, self.rotation)

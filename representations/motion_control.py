@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from tafel.core import array, bounded, representation
+from tafel.representations.geometry import Pose2D
 from tafel.representations.motion import JOINT_COUNT
 
 
@@ -106,11 +107,16 @@ class MotionInfo:
 class Odometry:
     """The robot's pose change since the program started, accumulated from the walk's own foot
     placements and the torso's yaw rate: x, y (mm) and rotation (rad) in the frame the robot had at the
-    start. Ground truth is never used. Differences of two readings give the motion between them."""
+    start. Ground truth is never used. Differences of two readings give the motion between them
+    (``now.as_pose2d().relative_to(before.as_pose2d())``)."""
 
     x: float = 0.0
     y: float = 0.0
     rotation: float = 0.0
+
+    def as_pose2d(self) -> Pose2D:
+        """The robot's pose in the odometry frame, to compute with."""
+        return Pose2D(self.x, self.y, self.rotation)
 
 
 class FallPhase(enum.Enum):

@@ -11,6 +11,7 @@ from dataclasses import dataclass, fields
 from tafel.core import bounded
 from tafel.debug.concepts import modify_fields
 from tafel.representations import field
+from tafel.representations.geometry import Pose2D
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import Foot, MotionRequest, MotionType, Odometry
 
@@ -51,13 +52,11 @@ def approach_and_kick(ball: BallModel, kick_direction: float, p: KickParameters,
     p = modify_fields("Kick", p, KICK_TUNED)
     foot = Foot.left if ball.y >= 0 else Foot.right
     side = p.foot_offset if foot is Foot.left else -p.foot_offset
-    c, s = math.cos(kick_direction), math.sin(kick_direction)
     # behind the ball on the kick's line, shifted so that the kicking foot (not the centre) meets it
-    target_x = ball.x - c * p.behind + s * side
-    target_y = ball.y - s * p.behind - c * side
+    target_x, target_y = Pose2D(ball.x, ball.y, kick_direction).to_global(-p.behind, -side)
     # the ball as the kicking foot sees it, in the kick's frame
-    along = c * ball.x + s * ball.y
-    across = -s * ball.x + c * ball.y - side
+    along, across = Pose2D(0.0, 0.0, kick_direction).to_local(ball.x, ball.y)
+    across -= side
     if abs(along - p.behind) < p.kick_tolerance_x and abs(across) < p.kick_tolerance_y and abs(kick_direction) < p.kick_tolerance_angle:
         out.motion, out.kick_foot, out.kick_direction = MotionType.kick, foot, kick_direction
     else:

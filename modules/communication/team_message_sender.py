@@ -102,10 +102,9 @@ class TeamMessageSender(Module):
     def message(self, game: GameState, now: float) -> TeamMessage:
         pose, ball, role = self.robot_pose, self.ball_model, self.player_role
         ball_x, ball_y = ball.field_position(pose)
-        c, s = math.cos(pose.rotation), math.sin(pose.rotation)
+        ball_vx, ball_vy = pose.as_pose2d().rotated(ball.vx, ball.vy)
         return TeamMessage(team=game.team_number, player=game.player_number, sent_ms=int(now * 1000), pose_valid=pose.valid,
                            fallen=not self.fall_state.upright, penalized=game.penalized, x=pose.x, y=pose.y, rotation=pose.rotation,
-                           ball_seen=ball.valid, ball_x=ball_x, ball_y=ball_y, ball_vx=c * ball.vx - s * ball.vy,
-                           ball_vy=s * ball.vx + c * ball.vy,
+                           ball_seen=ball.valid, ball_x=ball_x, ball_y=ball_y, ball_vx=ball_vx, ball_vy=ball_vy,
                            ball_age=-1.0 if self.ball_seen_s is None else now - self.ball_seen_s,
                            role=role.role, intention=role.intention, time_to_ball=role.time_to_ball)

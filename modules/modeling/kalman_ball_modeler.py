@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 from tafel.core import Module, provides, requires, uses
 from tafel.debug.concepts import modify_fields
+from tafel.representations.geometry import Pose2D
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel
 from tafel.representations.motion_control import Odometry
@@ -132,10 +133,7 @@ class KalmanBallModeler(Module):
         previous, self.last_odometry = self.last_odometry, now
         if previous is None or self.axes is None:
             return
-        c, s = math.cos(previous[2]), math.sin(previous[2])
-        dx, dy = now[0] - previous[0], now[1] - previous[1]
-        forward, left = c * dx + s * dy, -s * dx + c * dy
-        turn = math.remainder(now[2] - previous[2], math.tau)
+        forward, left, turn = Pose2D(*now).relative_to(Pose2D(*previous))
         c, s = math.cos(turn), math.sin(turn)
         ax, ay = self.axes
         x, y = ax.p - forward, ay.p - left

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tafel.representations.geometry import Pose2D
 from tafel.representations.team import TeamMates
 
 ROTATION_MM = 1000.0  # mm a radian of heading counts as when poses are compared
@@ -40,16 +41,13 @@ def fold(poses: np.ndarray, towards: np.ndarray) -> np.ndarray:
 
 def relative(start: tuple[float, float, float], now: tuple[float, float, float]) -> tuple[float, float, float]:
     """The motion from odometry pose ``start`` to ``now`` in ``start``'s frame (forward, left, turn)."""
-    c, s = math.cos(start[2]), math.sin(start[2])
-    dx, dy = now[0] - start[0], now[1] - start[1]
-    return c * dx + s * dy, -s * dx + c * dy, math.remainder(now[2] - start[2], math.tau)
+    forward, left, turn = Pose2D(*now).relative_to(Pose2D(*start))
+    return forward, left, turn
 
 
 def back(pose: np.ndarray, motion: tuple[float, float, float]) -> np.ndarray:
     """Where a robot now at field ``pose`` was before it made ``motion`` (from ``relative``)."""
-    heading = pose[2] - motion[2]
-    c, s = math.cos(heading), math.sin(heading)
-    return np.array([pose[0] - c * motion[0] + s * motion[1], pose[1] - s * motion[0] - c * motion[1], math.remainder(heading, math.tau)])
+    return np.array(tuple(Pose2D(*pose) * Pose2D(*motion).inverse()))
 
 
 def robust(normalized: float) -> float:
@@ -161,8 +159,7 @@ class SideBelief:
     def team_ball_evidence(self, estimate: np.ndarray, seen: tuple[float, float], team: tuple[float, float], std: float) -> float:
         """Log-likelihood ratio (estimate over twin) of a ball seen at ``seen`` (robot frame) when the team
         says it lies at ``team`` (field): from the twin the ball is at the point mirrored about the centre."""
-        c, s = math.cos(estimate[2]), math.sin(estimate[2])
-        x, y = estimate[0] + c * seen[0] - s * seen[1], estimate[1] + s * seen[0] + c * seen[1]
+        x, y = Pose2D(*estimate).to_global(*seen)
         return robust(math.hypot(x - team[0], y - team[1]) / std) - robust(math.hypot(-x - team[0], -y - team[1]) / std)
 
     def add_placement(self, estimate: np.ndarray, odometry: tuple[float, float, float], most: float, step: float, cap: float) -> None:

@@ -13,6 +13,7 @@ from tafel.modules.modeling.field_model import FIELD_MODEL, OWN_HALF
 from tafel.modules.modeling.mirror_hypotheses import SideBelief, fold, freshest_team_ball, twin
 from tafel.representations import field
 from tafel.representations.game import GameState
+from tafel.representations.geometry import Pose2D
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import KnownPose, RobotPose
 from tafel.representations.motion_control import FallState, Odometry
@@ -185,10 +186,7 @@ class SelfLocator(Module):
         self.best = None
         if previous is None:
             return
-        c, s = math.cos(previous[2]), math.sin(previous[2])
-        dx, dy = now[0] - previous[0], now[1] - previous[1]
-        forward, left = c * dx + s * dy, -s * dx + c * dy  # the step in the previous robot frame
-        turn = math.remainder(now[2] - previous[2], math.tau)
+        forward, left, turn = Pose2D(*now).relative_to(Pose2D(*previous))  # the step in the previous robot frame
         if self.estimate is not None:
             self.estimate = moved(self.estimate, forward, left, turn)
         if self.anchor is not None:
@@ -382,8 +380,7 @@ class SelfLocator(Module):
 
 def moved(pose: np.ndarray, forward: float, left: float, turn: float) -> np.ndarray:
     """A field pose (x, y, rotation) after a step given in its own frame."""
-    c, s = math.cos(pose[2]), math.sin(pose[2])
-    return np.array([pose[0] + c * forward - s * left, pose[1] + s * forward + c * left, math.remainder(pose[2] + turn, math.tau)])
+    return np.array(tuple(Pose2D(*pose) * Pose2D(forward, left, turn)))
 
 
 def robust(normalized: np.ndarray) -> np.ndarray:

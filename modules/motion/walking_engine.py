@@ -20,6 +20,7 @@ from tafel.debug import drawing, plot, request
 from tafel.debug.concepts import modify_fields
 from tafel.modules.motion.inverse_kinematics import apply_leg_angles, leg_angles, pose
 from tafel.modules.motion.stand_motion import stand_pose
+from tafel.representations.geometry import Pose2D
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import JOINT_COUNT, JOINT_INDEX, FsrData, InertialSensorData
 from tafel.representations.motion_control import Foot, MotionRequest, MotionSelection, MotionType, Odometry, WalkingEngineOutput
@@ -226,14 +227,11 @@ class WalkingEngine(Module):
         """Speed towards the walk_to target, kept in odometry coordinates while the request stays the same."""
         request, odometry, p = self.motion_request, self.odometry, self.parameters
         wanted = np.array([request.target_x, request.target_y, request.target_rotation])
+        here = odometry.as_pose2d()
         if self.target is None or not np.allclose(wanted, self.last_target):
-            c, s = math.cos(odometry.rotation), math.sin(odometry.rotation)
-            self.target = np.array([odometry.x + c * wanted[0] - s * wanted[1], odometry.y + s * wanted[0] + c * wanted[1],
-                                    odometry.rotation + wanted[2]])
+            self.target = np.array(tuple(here * Pose2D(*wanted)))
             self.last_target = wanted
-        dx, dy = self.target[0] - odometry.x, self.target[1] - odometry.y
-        c, s = math.cos(-odometry.rotation), math.sin(-odometry.rotation)
-        x, y = c * dx - s * dy, s * dx + c * dy
+        x, y = here.to_local(self.target[0], self.target[1])
         turn = math.remainder(self.target[2] - odometry.rotation, math.tau)
         if DRAW_STEPS:
             drawing("robot").robot_pose(float(self.target[0]), float(self.target[1]), float(self.target[2]), color="yellow")
@@ -304,9 +302,9 @@ class WalkingEngine(Module):
         """The torso moves against the support foot: its backward slide is the robot's forward motion."""
         odometry = self.odometry
         dx, dy, _ = (before - after) * self.parameters.odometry_scale
-        c, s = math.cos(odometry.rotation), math.sin(odometry.rotation)
-        odometry.x += c * dx - s * dy
-        odometry.y += s * dx + c * dy
+        step_x, step_y = odometry.as_pose2d().rotated(dx, dy)
+        odometry.x += step_x
+        odometry.y += step_y
 
     def rest(self) -> None:
         """Not selected and not walking: stand in the walk's own pose, ready to start."""
