@@ -62,7 +62,10 @@ def decode_game_state(data: bytes) -> GameState:
         values = _TEAM.unpack_from(data, _GAME.size + index * _TEAM.size)
         robots = [RobotInfo(_enum(Penalty, values[8 + 2 * i], f"team {index + 1} player {i + 1}'s penalty"),  # type: ignore[arg-type]
                             values[9 + 2 * i]) for i in range(MAX_PLAYERS)]
-        teams.append(TeamInfo(*values[:8], players=robots))
+        number, field_player_colour, goalkeeper_colour, goalkeeper, score, penalty_shot, single_shots, message_budget = values[:8]
+        teams.append(TeamInfo(team_number=number, field_player_colour=field_player_colour, goalkeeper_colour=goalkeeper_colour,
+                              goalkeeper=goalkeeper, score=score, penalty_shot=penalty_shot, single_shots=single_shots,
+                              message_budget=message_budget, players=robots))
     return GameState(packet_number=packet_number, players_per_team=players_per_team, competition_phase=competition_phase,
                      competition_type=competition_type, game_phase=_enum(GamePhase, game_phase, "gamePhase"),  # type: ignore[arg-type]
                      state=_enum(State, state, "state"), set_play=_enum(SetPlay, set_play, "setPlay"),  # type: ignore[arg-type]
