@@ -194,13 +194,13 @@ class SelfLocator(Module):
         self.side.walked(math.hypot(forward, left))
         n = len(self.particles)
         step = math.hypot(forward, left)
-        forward = forward + self.rng.normal(0.0, p.translation_noise * step + 1.0, n)
-        left = left + self.rng.normal(0.0, p.translation_noise * step + 1.0, n)
-        turn = turn + self.rng.normal(0.0, p.rotation_noise * abs(turn) + 0.0002 * step + 0.002, n)
+        forwards = forward + self.rng.normal(0.0, p.translation_noise * step + 1.0, n)  # each particle's step
+        lefts = left + self.rng.normal(0.0, p.translation_noise * step + 1.0, n)
+        turns = turn + self.rng.normal(0.0, p.rotation_noise * abs(turn) + 0.0002 * step + 0.002, n)
         heading = self.particles[:, 2]
-        self.particles[:, 0] += np.cos(heading) * forward - np.sin(heading) * left
-        self.particles[:, 1] += np.sin(heading) * forward + np.cos(heading) * left
-        self.particles[:, 2] = np.remainder(heading + turn + math.pi, math.tau) - math.pi
+        self.particles[:, 0] += np.cos(heading) * forwards - np.sin(heading) * lefts
+        self.particles[:, 1] += np.sin(heading) * forwards + np.cos(heading) * lefts
+        self.particles[:, 2] = np.remainder(heading + turns + math.pi, math.tau) - math.pi
 
     def start_at(self, pose: KnownPose) -> None:
         """Every particle at a pose the robot was told, a little spread; trusted and valid at once."""
@@ -335,6 +335,8 @@ class SelfLocator(Module):
         if self.anchor is not None:
             fell = self.frame_info.time_s - self.fell_at < 10.0
             stayed = side.stayed(self.estimate, self.anchor, p.continuity_distance, math.inf if fell else p.continuity_rotation)
+        if self.estimate is None:  # the caller publishes a pose first
+            return
             if stayed is None:
                 side.carried(placed_since=self.trusted is None)
                 self.anchor = None
@@ -358,6 +360,8 @@ class SelfLocator(Module):
         self.particles = twin(self.particles)
         self.estimate = twin(self.estimate)
         if self.best is not None:
+        if self.estimate is None:  # only after a pose was published (decide_side)
+            return
             self.best = twin(self.best)
         pose.x, pose.y, pose.rotation = float(self.estimate[0]), float(self.estimate[1]), float(self.estimate[2])
 

@@ -43,8 +43,9 @@ class MotionCombinator(Module):
         if not weights.any():
             weights = np.zeros(len(MotionType))
             weights[selection.active.value] = 1.0
-        sources = {MotionType.stand: self.body_joint_targets, MotionType.walk: self.walking_engine_output,
-                   MotionType.walk_to: self.walking_engine_output}
+        sources: dict[MotionType, BodyJointTargets | WalkingEngineOutput | KeyframeOutput] = {
+            MotionType.stand: self.body_joint_targets, MotionType.walk: self.walking_engine_output,
+            MotionType.walk_to: self.walking_engine_output}
         position = np.zeros(len(command.position))
         stiffness = np.zeros(len(command.stiffness))
         head_from_keyframe = 0.0

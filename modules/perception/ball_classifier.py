@@ -133,7 +133,7 @@ def train(rows: np.ndarray, labels: np.ndarray, hidden: int = 24, epochs: int = 
     positives = max(float(labels.sum()), 1.0)
     weight = np.where(labels == 1, (len(labels) - positives) / positives, 1.0).astype(np.float32)
     weight /= weight.sum()
-    params = [rng.normal(0.0, math.sqrt(2.0 / FEATURES), (FEATURES, hidden)).astype(np.float32), np.zeros(hidden, np.float32),
+    params: list[np.ndarray] = [rng.normal(0.0, math.sqrt(2.0 / FEATURES), (FEATURES, hidden)).astype(np.float32), np.zeros(hidden, np.float32),
               rng.normal(0.0, math.sqrt(1.0 / hidden), (hidden, 1)).astype(np.float32), np.zeros(1, np.float32)]
     moments = [np.zeros_like(q) for q in params]
     squares = [np.zeros_like(q) for q in params]

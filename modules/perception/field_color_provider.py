@@ -25,7 +25,7 @@ def green_mask(color: FieldColor, hsv: np.ndarray) -> np.ndarray:
     mask = cv2.inRange(hsv, (max(0.0, low), color.saturation_min, color.value_min), (min(179.0, high), 255, 255))
     if low < 0 or high > 179:  # the range wraps round red
         wrapped = (low + 180, 179.0) if low < 0 else (0.0, high - 180)
-        mask |= cv2.inRange(hsv, (wrapped[0], color.saturation_min, color.value_min), (wrapped[1], 255, 255))
+        mask = cv2.bitwise_or(mask, cv2.inRange(hsv, (wrapped[0], color.saturation_min, color.value_min), (wrapped[1], 255, 255)))
     return mask > 0
 
 
