@@ -177,7 +177,7 @@ def check_config(config: Mapping[str, Any], platform_sections: Iterable[str] = (
         if not (isinstance(value, list) and all(isinstance(v, str) for v in value)):
             raise ConfigError(f"{section}.{key} takes a list of representation names, e.g. [\"BallModel\"]; got {value!r}")
         for name in value if names is not None else ():
-            if name not in names:
+            if names is not None and name not in names:  # (the loop is empty when names is None)
                 raise ConfigError(f"{section}.{key}: no representation named {name!r}; {did_you_mean(name, names)}")
     debug = config.get("debug", {})
     aliases = debug.get("aliases", {})
