@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 import re
 import time
 from collections import defaultdict
@@ -284,3 +285,11 @@ def test_json_command_requests_say_what_to_send() -> None:
     for bad in ("{", "{}", '{"command": ""}', '{"command": 5}', '{"command": "ping", "x": 1}', "[]", "null"):
         with pytest.raises(ValueError, match=r'send \{"command": "COMMAND LINE"\}'):
             command_from_json(bad)
+
+
+def test_a_drawn_robot_pose_is_a_triangle_pointing_where_the_robot_faces() -> None:
+    from tafel.tools.viewers.foxglove_scene import _outline
+
+    # at (1000, 0) facing +y: the tip 150 mm ahead, the back corners 100 mm behind and 80 mm to either side
+    triangle = _outline("robot_pose", [1000.0, 0.0, math.pi / 2])
+    assert np.allclose(triangle, [(1080.0, -100.0), (1000.0, 150.0), (920.0, -100.0), (1080.0, -100.0)])

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from tafel.representations import field as pitch
+from tafel.representations.geometry import Pose2D
 
 #: mm of torso height above which an upright torso counts as standing (the NAO stands at about 330)
 STANDING_TORSO_MM = 250.0
@@ -74,9 +75,8 @@ def _ball_model_accurate(world: World, p: Mapping[str, Any]) -> bool:
     model = world.representation("BallModel", "cognition")
     if not model.valid:
         return False
-    (x, y, heading), (bx, by) = world.robot(), world.ball()
-    c, s = math.cos(heading), math.sin(heading)
-    seen_x, seen_y = x + c * model.x - s * model.y, y + s * model.x + c * model.y
+    robot, (bx, by) = world.robot(), world.ball()
+    seen_x, seen_y = Pose2D(*robot).to_global(model.x, model.y)
     return math.hypot(seen_x - bx, seen_y - by) <= p["within_mm"]
 
 

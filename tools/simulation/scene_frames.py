@@ -28,6 +28,7 @@ from tafel.modules.perception.line_detector import LineDetector
 from tafel.modules.perception.spl_ball_detector import SPLBallDetector
 from tafel.platforms.simulated import SimulatedRobotPlatform
 from tafel.representations import field as spl
+from tafel.representations.geometry import Pose2D
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, CameraMatrix, CameraMatrixBottom, CameraMatrixBuffer, CameraMatrixTop
 from tafel.representations.nao import BOTTOM_CAMERA, TOP_CAMERA
@@ -81,17 +82,16 @@ class SceneRenderer:
         angles[HEAD_YAW], angles[HEAD_PITCH] = head
         poses = link_poses(angles_by_name(angles), CAMERA_LINKS)
         torso_in_robot = robot_frame_from_torso(poses, 0.0, 0.0)
-        x, y, heading = robot_pose
-        c, s = math.cos(heading), math.sin(heading)
+        robot = Pose2D(*robot_pose)
+        heading = robot_pose[2]
         offset = torso_in_robot[:3, 3]  # the torso above the robot frame's origin, turned with the robot
-        torso_x, torso_y = x + c * offset[0] - s * offset[1], y + s * offset[0] + c * offset[1]
+        torso_x, torso_y = robot.to_global(offset[0], offset[1])
         p = self.platform
         p.pose_joints(angles)
         p.place_robot(np.array([torso_x, torso_y, offset[2]]) * 0.001,
                       np.array([math.cos(heading / 2), 0.0, 0.0, math.sin(heading / 2)]))
         p.move_ball(*ball)
-        bx, by = ball[0] - x, ball[1] - y
-        ball_robot = (c * bx + s * by, -s * bx + c * by)
+        ball_robot = robot.to_local(*ball)
         horizontal_fov, vertical_fov = p.fov()
         result = {}
         for name, mount in CAMERAS.items():

@@ -12,6 +12,7 @@ import numpy as np
 from foxglove import messages as fm
 
 from tafel.representations import field
+from tafel.representations.geometry import Pose2D
 
 M = 0.001  # mm -> m
 COLORS = {"black": (0, 0, 0), "white": (1, 1, 1), "red": (1, 0, 0), "green": (0, 0.6, 0), "blue": (0, 0, 1), "yellow": (1, 1, 0),
@@ -131,10 +132,8 @@ def _outline(kind: str, points: list[float]) -> list[tuple[float, float]]:
         x, y, r = points[:3]
         return [(x + r * math.cos(a), y + r * math.sin(a)) for a in np.linspace(0, math.tau, 25)]
     if kind == "robot_pose" and len(points) >= 3:
-        x, y, rotation = points[:3]
-        c, s = math.cos(rotation), math.sin(rotation)
-        return [(x - 100 * c + 80 * s, y - 100 * s - 80 * c), (x + 150 * c, y + 150 * s), (x - 100 * c - 80 * s, y - 100 * s + 80 * c),
-                (x - 100 * c + 80 * s, y - 100 * s - 80 * c)]
+        pose = Pose2D(*points[:3])  # a triangle pointing where the robot faces
+        return [pose.to_global(-100.0, -80.0), pose.to_global(150.0, 0.0), pose.to_global(-100.0, 80.0), pose.to_global(-100.0, -80.0)]
     return []
 
 
