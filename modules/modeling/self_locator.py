@@ -332,11 +332,11 @@ class SelfLocator(Module):
         gathered (then the side is open again), or did it slip or fall; what the placement and the
         team's ball say of the twins; turn to the twin when the evidence favours it."""
         p, side = self.parameters, self.side
+        if self.estimate is None:  # the caller publishes a pose first
+            return
         if self.anchor is not None:
             fell = self.frame_info.time_s - self.fell_at < 10.0
             stayed = side.stayed(self.estimate, self.anchor, p.continuity_distance, math.inf if fell else p.continuity_rotation)
-        if self.estimate is None:  # the caller publishes a pose first
-            return
             if stayed is None:
                 side.carried(placed_since=self.trusted is None)
                 self.anchor = None
@@ -357,11 +357,11 @@ class SelfLocator(Module):
 
     def turn_to_twin(self, pose: RobotPose) -> None:
         """Track the twin: every particle, the estimate and the pose turned about the centre spot."""
+        if self.estimate is None:  # only after a pose was published (decide_side)
+            return
         self.particles = twin(self.particles)
         self.estimate = twin(self.estimate)
         if self.best is not None:
-        if self.estimate is None:  # only after a pose was published (decide_side)
-            return
             self.best = twin(self.best)
         pose.x, pose.y, pose.rotation = float(self.estimate[0]), float(self.estimate[1]), float(self.estimate[2])
 
