@@ -29,12 +29,12 @@ from tafel.core.framework.parameters import ParameterError, make_parameters, par
 from tafel.core.framework.reload import ModuleReloader
 from tafel.core.framework.representation import fields_of
 from tafel.core.framework.validation import ValueCheckError, check_field, check_instance
+from tafel.core.framework.values import convert
 from tafel.core.logs.serialization import SerializationError, deserialize, serialize
 from tafel.debug.concepts import CANVASES, STATE, DebugState
 from tafel.debug.protocol import Command
 from tafel.debug.values import (
     CommandError,
-    _check_like,
     _coerce_like,
     _short,
     frame_number,
@@ -258,12 +258,7 @@ class ContextDebug:
         if not isinstance(getattr(rep, "image", None), np.ndarray) or rep.image.ndim != 3:
             raise CommandError(f"{name} holds no camera image; image:get takes a CameraImage such as CameraImageTop")
         text = argument(command, "quality", positional=False, required=False) or "80"
-        try:
-            quality = int(text)
-        except ValueError:
-            quality = 0
-        if not 1 <= quality <= 100:
-            raise CommandError(f"-quality takes a whole number from 1 to 100, got {text!r}")
+        quality = convert(text, int, where="-quality", bounds=(1, 100), text=True, error=CommandError)
         return jpeg_bytes(rep.image, quality)
 
     def cmd_representation_get(self, command: Command) -> bytes:
@@ -313,9 +308,7 @@ class ContextDebug:
             for name, raw in fields.items():
                 if name not in infos:
                     raise CommandError(f"{cls.__name__} has no field {name!r}; {did_you_mean(name, infos)}")
-                given = infos[name].type[raw] if infos[name].kind == "enum" and isinstance(raw, str) and raw in infos[name].type.__members__ \
-                    else raw
-                setattr(value, name, check_field(cls, name, given, f"{cls.__name__}.{name}"))
+                setattr(value, name, check_field(cls, name, raw, f"{cls.__name__}.{name}"))  # enums by name
         check_instance(value)
         self.overrides[cls.__name__] = value
         self._apply_overrides()
@@ -369,8 +362,7 @@ class ContextDebug:
 
     def cmd_modify_set(self, command: Command) -> str:
         found = self._named(command, self.state.modifies, "modify")
-        found.pinned_value = _check_like(found.value, _coerce_like(found.value, argument(command, "value", positional=False), found.name),
-                                         found.name)
+        found.pinned_value = _coerce_like(found.value, argument(command, "value", positional=False), found.name)
         found.pinned = True
         return f"{found.name} pinned to {_short(found.pinned_value)}"
 

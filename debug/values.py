@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import dataclasses
 import enum
-import json
 from typing import Any
 
 import numpy as np
@@ -13,7 +12,7 @@ import numpy as np
 from tafel.core.framework.errors import TafelError
 from tafel.core.framework.manager import ModuleManager
 from tafel.core.framework.representation import FieldInfo, fields_of
-from tafel.core.framework.validation import MAX_MAGNITUDE, check_number
+from tafel.core.framework.values import convert, refusal
 
 
 class CommandError(TafelError):
@@ -21,12 +20,8 @@ class CommandError(TafelError):
 
 
 def parse_bool(text: str, what: str) -> bool:
-    lowered = text.lower()
-    if lowered in ("on", "true", "1", "yes"):
-        return True
-    if lowered in ("off", "false", "0", "no"):
-        return False
-    raise CommandError(f"{what} takes on/off or true/false, got {text!r}")
+    """``on``/``off``, ``true``/``false``, ``yes``/``no``, ``1``/``0`` as a bool, else ``CommandError``."""
+    return bool(convert(text, bool, where=what, text=True, error=CommandError))
 
 
 #: arrays with more elements than this are summarized in JSON (an image is no list of 230 400 numbers)
@@ -94,70 +89,42 @@ def _short(value: Any) -> str:
 
 
 def _coerce_like(current: Any, text: str, what: str) -> Any:
-    """``text`` converted to the type of ``current`` (for modify values and single fields)."""
-    try:
-        if isinstance(current, bool):
-            return parse_bool(text, what)
-        if isinstance(current, int):
-            return int(text)
-        if isinstance(current, float):
-            return float(text)
-        if isinstance(current, enum.Enum):
-            return type(current)[text]
-        if isinstance(current, str) or current is None:
-            return text
-        if isinstance(current, (list, np.ndarray)):
-            values = json.loads(text)
-            return np.asarray(values, dtype=current.dtype) if isinstance(current, np.ndarray) else list(values)
-    except (ValueError, KeyError, json.JSONDecodeError):
-        pass
-    raise CommandError(f"{what} holds {type(current).__name__}; {text!r} is not one")
+    """``text`` read as a value of ``current``'s kind and checked (for modify values): numbers finite and
+    within their natural range, arrays of ``current``'s shape and dtype, lists as JSON."""
+    if isinstance(current, np.ndarray):
+        values = convert(text, list[Any], where=what, text=True, expected=f"a JSON array of finite numbers of shape {current.shape}",
+                         error=CommandError)
+        try:
+            array = np.asarray(values, dtype=current.dtype)
+        except (TypeError, ValueError, OverflowError):
+            raise refusal(what, f"a JSON array of numbers ({current.dtype})", text, CommandError) from None
+        if array.shape != current.shape:
+            raise refusal(what, f"an array of shape {current.shape}", text, CommandError)
+        if array.dtype.kind == "f" and array.size:
+            convert(array.ravel().tolist(), list[float], where=what, text=False, error=CommandError)  # finite, natural range
+        return array
+    if isinstance(current, list):
+        values = convert(text, list[Any], where=what, text=True, expected="a JSON array (of finite numbers) such as [1, 2]", error=CommandError)
+        for element in values:
+            if isinstance(element, (int, float)) and not isinstance(element, bool):
+                convert(element, type(element), where=what, text=False, error=CommandError)
+        return values
+    kind = str if current is None else type(current)
+    return convert(text, kind, where=what, text=kind is not str, error=CommandError)
 
 
 def parse_field_text(info: FieldInfo, text: str, where: str) -> Any:
     """The text of ``-value`` read as the field's kind (numbers, on/off, enum names, JSON arrays); checked later."""
-    try:
-        if info.kind == "bool":
-            return parse_bool(text, where)
-        if info.kind == "int":
-            return int(text)
-        if info.kind == "float":
-            return float(text)
-        if info.kind == "enum":
-            return info.type[text]
-        if info.kind == "str":
-            return text
-        if info.kind in ("ndarray", "list"):
-            values = json.loads(text)
-            if info.kind == "list" and info.element is not None and info.element.kind == "nested":
-                raise CommandError(f"{where} holds a list of {info.element.type.__name__}; set it with +data (protobuf bytes)")
-            return values
-    except KeyError:
-        raise CommandError(f"{where} takes one of {', '.join(m.name for m in info.type)}, got {text!r}") from None
-    except (ValueError, json.JSONDecodeError):
-        raise CommandError(f"{where} takes {'a JSON array such as [0.1, 0.2]' if info.kind in ('ndarray', 'list') else info.kind}, "
-                           f"got {text!r}") from None
+    if info.kind in ("bool", "int", "float", "enum", "str"):
+        kind = info.type if info.kind == "enum" else {"bool": bool, "int": int, "float": float, "str": str}[info.kind]
+        return convert(text, kind, where=where, text=kind is not str, error=CommandError)
+    if info.kind == "list" and info.element is not None and info.element.kind == "nested":
+        raise CommandError(f"{where} holds a list of {info.element.type.__name__}; set it with +data (protobuf bytes)")
+    if info.kind in ("ndarray", "list"):
+        numbers = info.kind == "ndarray" or (info.element is not None and info.element.kind in ("int", "float"))
+        return convert(text, list[Any], where=where, text=True, error=CommandError,
+                       expected="a JSON array of finite numbers such as [0.1, 0.2]" if numbers else 'a JSON array such as ["a", "b"]')
     raise CommandError(f"{where} is a {info.kind} field; set it with +data (protobuf bytes) or one of its fields (-field {where.split('.', 1)[-1]}.NAME)")
-
-
-def _check_like(current: Any, value: Any, what: str) -> Any:
-    """A pinned modify value must be of the published value's kind: finite numbers, the same array shape."""
-    if isinstance(current, float):
-        return check_number(value, what)
-    if isinstance(current, int) and not isinstance(current, bool):
-        return check_number(value, what, kind="int")  # 64 bits: a module may loop over it
-    if isinstance(current, np.ndarray):
-        if value.shape != current.shape:
-            raise CommandError(f"{what} is an array of shape {current.shape}; got shape {value.shape}")
-        if value.dtype.kind == "f" and not np.isfinite(value).all():
-            raise CommandError(f"{what} takes finite numbers; got {value.tolist()}")
-        if value.dtype.kind == "f" and value.size and np.abs(value).max() > MAX_MAGNITUDE:
-            raise CommandError(f"{what} takes numbers of at most {MAX_MAGNITUDE:g} in size; got {np.abs(value).max():g}")
-    if isinstance(current, list):
-        for element in value:
-            if isinstance(element, (int, float)) and not isinstance(element, bool):
-                check_number(element, what, kind="int" if isinstance(element, int) else "float")
-    return value
 
 
 def frame_number(manager: ModuleManager) -> int:

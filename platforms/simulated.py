@@ -13,11 +13,12 @@ import os
 import sys
 from collections import deque
 from collections.abc import Mapping
-from typing import Any, ClassVar
+from typing import Annotated, Any, ClassVar
 
 import numpy as np
 
 from tafel.core.framework.manager import Blackboard
+from tafel.core.framework.values import Range, convert, refusal
 from tafel.core.runtime.platform import Platform, PlatformOptionError, seed_number
 from tafel.platforms.actuators import ActuatorGuard
 from tafel.platforms.field_world import BALL_COLORS
@@ -46,14 +47,15 @@ BUTTON_SECONDS = 0.1  # how long sim:button holds the chest button
 LYING_HEIGHT = 0.12  # m of the torso above the ground when put down lying (it drops the last bit)
 
 
+def _carpet() -> tuple[Any, ...]:
+    """X and Y on the carpet, as element types with their ranges."""
+    return Annotated[float, Range(-CARPET_X, CARPET_X)], Annotated[float, Range(-CARPET_Y, CARPET_Y)]
+
+
 def parse_pair(text: str, what: str) -> tuple[float, float]:
-    try:
-        x, y = (float(v) for v in str(text).split(","))
-    except ValueError:
-        raise PlatformOptionError(f"{what} takes X,Y in mm, e.g. 1000,300; got {text!r}") from None
-    if not (math.isfinite(x) and math.isfinite(y) and abs(x) <= CARPET_X and abs(y) <= CARPET_Y):
-        raise PlatformOptionError(f"{what} takes X,Y in mm on the carpet (|X| <= {CARPET_X:g}, |Y| <= {CARPET_Y:g}); got {text!r}")
-    return x, y
+    """``X,Y`` in mm on the carpet (``--ball``)."""
+    on_carpet = f"X,Y in mm on the carpet (|X| <= {CARPET_X:g}, |Y| <= {CARPET_Y:g}), e.g. 1000,300"
+    return convert(text, tuple[_carpet()], where=what, expected=on_carpet, error=PlatformOptionError)
 
 
 #: mm/s of the fastest ball a scene may start with (a strong kick rolls off at about 5 m/s)
@@ -61,24 +63,18 @@ MAX_BALL_SPEED = 10000.0
 
 
 def parse_velocity(text: str) -> tuple[float, float]:
-    try:
-        vx, vy = (float(v) for v in str(text).split(","))
-    except ValueError:
-        raise PlatformOptionError(f"--ball-velocity takes VX,VY in mm/s, e.g. 500,0; got {text!r}") from None
-    if not (math.isfinite(vx) and math.isfinite(vy) and math.hypot(vx, vy) <= MAX_BALL_SPEED):
-        raise PlatformOptionError(f"--ball-velocity takes VX,VY in mm/s up to {MAX_BALL_SPEED:g} mm/s; got {text!r}")
+    """``--ball-velocity``: ``VX,VY`` in mm/s, at most ``MAX_BALL_SPEED`` fast."""
+    expected = f"VX,VY in mm/s, at most {MAX_BALL_SPEED:g} mm/s fast, e.g. 500,0"
+    vx, vy = convert(text, tuple[float, float], where="--ball-velocity", expected=expected, error=PlatformOptionError)
+    if math.hypot(vx, vy) > MAX_BALL_SPEED:
+        raise refusal("--ball-velocity", expected, text, PlatformOptionError)
     return vx, vy
 
 
 def parse_noise(value: Any) -> float:
     """``--sensor-noise``: a factor from 0 to 100 (None: 1, the NAO's noise)."""
-    try:
-        factor = 1.0 if value is None else float(value)
-    except (TypeError, ValueError):
-        factor = math.nan
-    if not (math.isfinite(factor) and 0.0 <= factor <= 100.0):
-        raise PlatformOptionError(f"--sensor-noise takes a factor from 0 to 100 (1: the NAO's noise, 0: none), got {value!r}")
-    return factor
+    return 1.0 if value is None else convert(value, float, where="--sensor-noise", bounds=(0.0, 100.0), error=PlatformOptionError,
+                                             expected="a factor from 0 to 100 (1: the NAO's noise, 0: none)")
 
 
 #: the default scene: the robot in its own half facing the opponent goal, the ball on the centre spot
@@ -87,23 +83,17 @@ DEFAULT_BALL = "0,0"
 
 
 def parse_pose(text: str) -> tuple[float, float, float]:
-    try:
-        x, y, rotation = (float(v) for v in str(text).split(","))
-    except ValueError:
-        raise PlatformOptionError(f"--start takes X,Y,ROT (mm, mm, rad), e.g. -1500,0,0; got {text!r}") from None
-    if not all(math.isfinite(v) for v in (x, y, rotation)) or abs(x) > CARPET_X or abs(y) > CARPET_Y:
-        raise PlatformOptionError(f"--start takes a pose on the carpet (|X| <= {CARPET_X:g}, |Y| <= {CARPET_Y:g}), got {text!r}")
+    """``--start``: ``X,Y,ROT`` (mm, mm, rad) on the carpet; the rotation within one turn."""
+    expected = f"X,Y,ROT (mm, mm, rad) on the carpet (|X| <= {CARPET_X:g}, |Y| <= {CARPET_Y:g}), e.g. -1500,0,0"
+    x, y, rotation = convert(text, tuple[(*_carpet(), float)], where="--start", expected=expected, error=PlatformOptionError)
     return x, y, math.remainder(rotation, math.tau)
 
 
 def parse_resolution(text: str) -> tuple[int, int]:
-    try:
-        width, height = (int(v) for v in str(text).lower().split("x"))
-    except ValueError:
-        raise PlatformOptionError(f"--resolution takes WIDTHxHEIGHT, e.g. 320x240; got {text!r}") from None
-    if not (16 <= width <= 4096 and 16 <= height <= 4096):
-        raise PlatformOptionError(f"--resolution {text} is out of range (16..4096 pixels a side)")
-    return width, height
+    """``--resolution``: ``WIDTHxHEIGHT``, 16 to 4096 pixels a side."""
+    side = Annotated[int, Range(16, 4096)]
+    return convert(str(text).lower(), tuple[side, side], where="--resolution", separator="x", error=PlatformOptionError,
+                   expected="WIDTHxHEIGHT with 16 to 4096 pixels a side, e.g. 320x240")
 
 
 def has_display() -> bool:
@@ -118,28 +108,15 @@ CARPET_Y = field.WIDTH / 2 + field.BORDER_STRIP
 
 def number(args: Mapping[str, Any], name: str, default: float = 0.0, limit: float = math.inf) -> float:
     """A finite numeric debug command argument within ``±limit``, with an error that names it."""
-    text = args.get(name, default)
-    try:
-        value = float(text)
-    except (TypeError, ValueError):
-        raise PlatformOptionError(f"-{name} takes a number, got {text!r}") from None
-    if not math.isfinite(value):
-        raise PlatformOptionError(f"-{name} takes a finite number, got {text!r}")
-    if abs(value) > limit:
-        raise PlatformOptionError(f"-{name} takes -{limit:g} to {limit:g} (mm from the centre spot: the carpet ends there), got {value:g}")
-    return value
+    return convert(args.get(name, default), float, where=f"-{name}", bounds=(-limit, limit) if math.isfinite(limit) else None,
+                   error=PlatformOptionError)
 
 
 def switch(args: Mapping[str, Any], name: str) -> bool:
     """An on/off debug command argument: ``-NAME on`` (or true, yes, 1), or the bare word ``NAME``."""
     if name not in args:
         return False
-    text = str(args[name]).lower()
-    if text in ("", "on", "true", "yes", "1"):
-        return True
-    if text in ("off", "false", "no", "0"):
-        return False
-    raise PlatformOptionError(f"-{name} takes on or off, got {args[name]!r}")
+    return args[name] == "" or convert(args[name], bool, where=f"-{name}", error=PlatformOptionError)
 
 
 class SimulatedRobotPlatform(NetworkedPlatform, Platform):
@@ -158,15 +135,14 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
 
     def __init__(self, options: Mapping[str, Any] | None = None) -> None:
         super().__init__(options)
-        self.seed = int(self.options.get("seed") or 0)
-        self.cameras = str(self.options.get("cameras", "on")).lower() not in ("off", "false", "0", "no")
+        self.seed = convert(self.options.get("seed") or 0, int, where="--seed", bounds=(0, 2**32 - 1), error=PlatformOptionError)
+        self.cameras = convert(self.options.get("cameras", "on"), bool, where="--cameras", error=PlatformOptionError)
         self.width, self.height = parse_resolution(self.options.get("resolution") or "320x240")
         self.initial_ball = parse_pair(self.options.get("ball") or DEFAULT_BALL, "--ball")
         self.initial_ball_velocity = parse_velocity(self.options.get("ball_velocity") or "0,0")
         self.sensor_noise = parse_noise(self.options.get("sensor_noise"))
-        self.ball_color = str(self.options.get("ball_color") or "spl").lower()
-        if self.ball_color not in BALL_COLORS:
-            raise PlatformOptionError(f"--ball-color takes {' or '.join(BALL_COLORS)}, got {self.options.get('ball_color')!r}")
+        self.ball_color = convert(self.options.get("ball_color") or "spl", str, where="--ball-color", choices=tuple(BALL_COLORS),
+                                  error=PlatformOptionError)
         self.initial_pose = parse_pose(self.options.get("start") or DEFAULT_START)
         self.viewer_requested = bool(self.options.get("viewer"))
         self.rng = np.random.default_rng(self.seed)
@@ -177,9 +153,8 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         self.push_steps = 0  # physics steps the current push still lasts
         self.time_ns = 0
         self.last_steps = 0  # physics steps of the last advance (benchmarks read it)
-        latency = float(self.options.get("camera_latency_ms") or 0.0)
-        if not (math.isfinite(latency) and 0.0 <= latency <= 1000.0):
-            raise PlatformOptionError(f"--camera-latency-ms takes 0 to 1000 ms, got {self.options.get('camera_latency_ms')!r}")
+        latency = convert(self.options.get("camera_latency_ms") or 0.0, float, where="--camera-latency-ms", bounds=(0.0, 1000.0),
+                          unit="ms", error=PlatformOptionError)
         self.camera_latency_ns = int(round(latency * 1e6))
         #: (time_ns, engine state) of the recent physics steps, while images arrive late
         self.history: deque[tuple[int, Any]] = deque()
@@ -462,9 +437,8 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         def robot(args: Mapping[str, Any]) -> str:
             x, y = number(args, "x", limit=CARPET_X), number(args, "y", limit=CARPET_Y)
             heading = math.remainder(number(args, "rotation"), math.tau)
-            lying = str(args.get("lying", ""))
-            if lying not in ("", "front", "back"):
-                raise PlatformOptionError(f"-lying takes front or back, got {lying!r}")
+            lying = args.get("lying") or ""
+            lying = lying and convert(lying, str, where="-lying", choices=("front", "back"), error=PlatformOptionError)
             reset = switch(args, "reset")
             self.move_robot(x, y, heading, lying)
             where = f"robot at x={x:.0f} y={y:.0f} mm, rotation {heading:.3f} rad" + (f", lying on its {lying}" if lying else "")

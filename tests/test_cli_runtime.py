@@ -70,7 +70,7 @@ def test_seconds_limit_uses_platform_time() -> None:
         (["run", "--platform", "dumy"], "unknown platform 'dumy': did you mean 'dummy'"),
         (["run", "--set", 'cognition.modules=["KalmanBallModeller"]'], "did you mean 'KalmanBallModeler'"),
         (["run", "--speed", "fast"], "--speed takes a factor from 0.001 to 1000 or 'max'"),
-        (["run", "--frames", "0"], "expected a number greater than zero"),
+        (["run", "--frames", "0"], "argument --frames: takes a whole number above 0, got '0'"),
         (["run", "--frames", "3", "--seconds", "2"], "not allowed with argument"),
         (["run", "--platform", "dummy", "--bogus"], "unrecognized arguments: --bogus; options of platform dummy: --seed"),
         (["run", "--set", "nonsense"], "--set takes KEY=VALUE"),
@@ -296,7 +296,7 @@ def test_a_taken_debug_port_is_an_error_not_a_silent_run_without_the_server() ->
 @pytest.mark.parametrize("port", ["70000", "-1", "http"])
 def test_a_debug_port_out_of_range_is_an_error(port: str) -> None:
     result = tafel("run", "--platform", "dummy", "--frames", "10", "--debug-port", port)
-    assert result.returncode == 2 and "a port is a whole number from 0 to 65535" in result.stderr
+    assert result.returncode == 2 and f"argument --debug-port: takes a port number from 0 to 65535 (0: any free one), got '{port}'" in result.stderr
 
 
 def test_a_requirement_nobody_provides_is_a_missing_provider_not_a_platform_gap() -> None:
@@ -314,16 +314,16 @@ def test_a_requirement_nobody_provides_is_a_missing_provider_not_a_platform_gap(
 
 
 @pytest.mark.parametrize(("setting", "message"), [
-    ("runtime.motion_hz=abc", "runtime.motion_hz takes a positive number of Hz, got 'abc'"),
-    ("runtime.motion_hz=nan", "runtime.motion_hz takes a positive number of Hz, got nan"),
-    ("runtime.cognition_hz=inf", "runtime.cognition_hz takes a positive number of Hz, got inf"),
-    ("runtime.motion_hz=10000", "above what the runtime supports (1000 Hz at the most)"),
-    ("runtime=5", "runtime must be a table of settings"),
-    ("runtime.shutdown_grace_s=abc", "runtime.shutdown_grace_s takes a positive number of seconds"),
+    ("runtime.motion_hz=abc", "runtime.motion_hz takes a finite number of Hz above 0 and at most 1000, got 'abc'"),
+    ("runtime.motion_hz=nan", "runtime.motion_hz takes a finite number of Hz above 0 and at most 1000, got nan"),
+    ("runtime.cognition_hz=inf", "runtime.cognition_hz takes a finite number of Hz above 0 and at most 1000, got inf"),
+    ("runtime.motion_hz=10000", "runtime.motion_hz takes a finite number of Hz above 0 and at most 1000, got 10000"),
+    ("runtime=5", "runtime takes a table of settings (runtime.motion_hz=100 and the like), got 5"),
+    ("runtime.shutdown_grace_s=abc", "runtime.shutdown_grace_s takes a finite number of seconds above 0, got 'abc'"),
     ("runtime.motion_hzz=100", "runtime.motion_hzz is not a setting; did you mean 'motion_hz'"),
     ("parameters.KalmanBallModler.friction=0.3", "unknown module 'KalmanBallModler': did you mean 'KalmanBallModeler'"),
     ("parameters.KalmanBallModeler.fricton=0.3", "KalmanBallModeler has no parameter 'fricton'; did you mean 'friction'"),
-    ("parameters.KalmanBallModeler.friction=abc", "parameter KalmanBallModeler.friction takes float, got 'abc'"),
+    ("parameters.KalmanBallModeler.friction=abc", "parameter KalmanBallModeler.friction takes a finite number of at most 1e+12 in size, got 'abc'"),
 ])
 def test_set_is_validated_with_advice(setting: str, message: str) -> None:
     result = dummy("--frames", "5", "--set", setting)

@@ -79,9 +79,9 @@ def test_missing_folder_is_an_error(tmp_path: Path) -> None:
 
 def test_context_section_checks_types() -> None:
     assert context_section({}, "cognition") == {"modules": [], "disabled": [], "providers": {}}
-    with pytest.raises(ConfigError, match="cognition.modules must be a list"):
+    with pytest.raises(ConfigError, match="cognition.modules takes a list of module names, got"):
         context_section({"cognition": {"modules": "A"}}, "cognition")
-    with pytest.raises(ConfigError, match="providers must map"):
+    with pytest.raises(ConfigError, match="providers takes a table of representation names to module names"):
         context_section({"motion": {"providers": {"X": 1}}}, "motion")
 
 

@@ -22,10 +22,10 @@ def refused(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
 
 
 @pytest.mark.parametrize(("setting", "message"), [
-    ("recording='x'", "recording must be a table ([recording] in a file), got 'x'"),
+    ("recording='x'", "recording takes a table ([recording] in a file), got 'x'"),
     ("recording.representations=5", "recording.representations takes a list of representation names"),
     ('recording.representations=["NoSuch"]', "recording.representations: no representation named 'NoSuch'"),
-    ("game=5", "game must be a table"),
+    ("game=5", "game takes a table ([game] in a file), got 5"),
     ("debug.aliases=5", "debug.aliases takes tables, one per alias"),
     ("a.b.c=1", "[a] is not a section of the configuration"),
     ("parameter.HeadMotion.x=1", "[parameter] is not a section of the configuration; did you mean 'parameters'"),
@@ -35,7 +35,7 @@ def refused(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
     ("x=" + "9" * 5000, "a number of 5000 characters; whole numbers in configuration fit 64 bits"),
     ("x=" + "[" * 5000 + "]" * 5000, "nested too deeply"),
     (".".join(["a"] * 3000) + "=1", "a key of 3000 parts; configuration keys have at most 8"),
-    ("runtime.cognition_hz=" + str(2**70), "outside 64 bits"),
+    ("runtime.cognition_hz=" + str(2**70), "runtime.cognition_hz takes a whole number that fits in 64 bits, got a number of about 22 digits"),
     ('parameters.GameStateProvider.start_state="bogus"', "takes one of"),
 ])
 def test_a_bad_setting_is_one_clear_error(setting: str, message: str, capsys: pytest.CaptureFixture[str]) -> None:

@@ -208,7 +208,7 @@ def test_a_refused_parameter_answers_with_its_value_and_says_why(clients: tuple[
     assert answer == {"/SoccerBehavior/search_turn": pytest.approx(before)}
     status = client.wait_for(lambda: next((r for r in client.replies if r.get("op") == "status"), None))
     assert status["level"] == 1  # a warning, shown by Foxglove and Lichtblick
-    assert "/SoccerBehavior/search_turn" in status["message"] and "takes 0 to 2" in status["message"], status
+    assert "/SoccerBehavior/search_turn" in status["message"] and "takes a finite number from 0 to 2, got 1e+09" in status["message"], status
     client.replies.clear()
     assert client.set_parameters({"/NoSuch": 1.0}) == {}
     status = client.wait_for(lambda: next((r for r in client.replies if r.get("op") == "status"), None))

@@ -390,7 +390,7 @@ def test_parameters_are_typed_and_checked() -> None:
     assert manager.module("Tunable").parameters.active is False
     with pytest.raises(ParameterError, match="Tunable has no parameter 'gian'; did you mean 'gain'"):
         ModuleManager([Tunable], parameters={"Tunable": {"gian": 1}})
-    with pytest.raises(ParameterError, match="Tunable.steps takes int, got 'many'"):
+    with pytest.raises(ParameterError, match="Tunable.steps takes a whole number that fits in 64 bits, got 'many'"):
         ModuleManager([Tunable], parameters={"Tunable": {"steps": "many"}})
     with pytest.raises(UnknownModuleError):
         ModuleManager([Tunable], parameters={"Tunabel": {"gain": 1}})

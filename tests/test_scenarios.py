@@ -86,7 +86,7 @@ def test_a_good_file_gives_every_value(tmp_path: Path) -> None:
     (("position = [1000.0, 0.0]", "position = [0.0, -9000.0]"), 10, "position in [ball] takes [x_mm, y_mm], two numbers on the carpet"),
     (('set = ["parameters.KalmanBallModeler.friction=0.4"]', 'set = ["parameter.KalmanBallModeler.friction=0.4"]'), 4,
      "set: [parameter] is not a section of the configuration; did you mean 'parameters'"),
-    (('set = ["parameters.KalmanBallModeler.friction=0.4"]', 'set = ["game=5"]'), 4, "set: game must be a table"),
+    (('set = ["parameters.KalmanBallModeler.friction=0.4"]', 'set = ["game=5"]'), 4, "set: game takes a table ([game] in a file), got 5"),
     (("start = [0.0, 0.0, 0.0]", "start = [0.0, 0.0]"), 7, "start in [[robots]] number 1 takes [x_mm, y_mm, rotation_deg], three numbers"),
     (("within_mm = 400.0", 'within_mm = "near"'), 18, "within_mm in [[success]] number 1 takes a number, got 'near'"),
     (("robot_x_mm = 100.0", "robot_x_mn = 100.0"), 13, "[perturbation] has no key 'robot_x_mn'; did you mean 'robot_x_mm'"),

@@ -265,8 +265,8 @@ def test_a_ball_can_start_rolling_and_the_sensor_noise_can_be_scaled(engine: str
 
 
 @pytest.mark.parametrize(("option", "value", "message"), [
-    ("ball_velocity", "fast", "--ball-velocity takes VX,VY in mm/s, e.g. 500,0; got 'fast'"),
-    ("ball_velocity", "20000,0", "--ball-velocity takes VX,VY in mm/s up to 10000 mm/s; got '20000,0'"),
+    ("ball_velocity", "fast", "--ball-velocity takes VX,VY in mm/s, at most 10000 mm/s fast, e.g. 500,0, got 'fast'"),
+    ("ball_velocity", "20000,0", "--ball-velocity takes VX,VY in mm/s, at most 10000 mm/s fast, e.g. 500,0, got '20000,0'"),
     ("sensor_noise", "nan", "--sensor-noise takes a factor from 0 to 100 (1: the NAO's noise, 0: none), got 'nan'"),
     ("sensor_noise", "-1", "--sensor-noise takes a factor from 0 to 100"),
 ])
@@ -385,7 +385,7 @@ def test_move_robot_explains_the_mirrored_pose_and_resets_the_localization_when_
         sim.run(3.0)  # and it stays there: continuity, not the own half
         distance, angle = error()
         assert distance < 300.0 and angle < 0.2, (distance, angle)
-        with pytest.raises(PlatformOptionError, match="-reset takes on or off, got 'maybe'"):
+        with pytest.raises(PlatformOptionError, match="-reset takes on/off or true/false, got 'maybe'"):
             move({"x": "0", "reset": "maybe"})
     finally:
         sim.close()

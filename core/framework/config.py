@@ -40,6 +40,7 @@ import tomlkit
 
 from tafel.core.framework.errors import TafelError
 from tafel.core.framework.naming import did_you_mean
+from tafel.core.framework.values import INT_RANGE, Range, convert, refusal
 
 CONTEXTS = ("cognition", "motion")
 PRIVATE_FILE = "private/private.toml"
@@ -101,7 +102,7 @@ def merge(base: dict[str, Any], layer: Mapping[str, Any]) -> dict[str, Any]:
 #: levels of tables and lists configuration may have (parameters.Module.name = [[1, 2]] has four)
 MAX_DEPTH = 8
 #: the largest magnitude of a whole number in configuration (a signed 64-bit integer)
-MAX_INT = 2**63 - 1
+MAX_INT = INT_RANGE[1]
 
 
 def parse_override(text: str) -> tuple[list[str], Any]:
@@ -134,8 +135,8 @@ def check_value(value: Any, where: str, depth: int = 0) -> None:
     """Values configuration can hold: at most ``MAX_DEPTH`` levels deep, whole numbers within 64 bits."""
     if depth > MAX_DEPTH:
         raise ConfigError(f"{where}: nested more than {MAX_DEPTH} levels deep; configuration needs a few levels at most")
-    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > MAX_INT:
-        raise ConfigError(f"{where}: the whole number {_short(str(value), 30)} is outside 64 bits (at most {MAX_INT})")
+    if isinstance(value, int) and not isinstance(value, bool):
+        convert(value, int, where=where, text=False, error=ConfigError)  # a TOML integer fits 64 bits; Python's need not
     children = value.values() if isinstance(value, Mapping) else value if isinstance(value, list) else ()
     for child in children:
         check_value(child, where, depth + 1)
@@ -163,7 +164,7 @@ def check_config(config: Mapping[str, Any], platform_sections: Iterable[str] = (
             raise ConfigError(f"[{key}] is not a section of the configuration; {did_you_mean(key, known)}; the sections are "
                               + ", ".join(f"{name} ({what})" for name, what in known.items()))
         if not isinstance(value, Mapping):
-            raise ConfigError(f"{key} must be a table ([{key}] in a file), got {value!r}")
+            raise refusal(key, f"a table ([{key}] in a file)", value, ConfigError)
         check_value(value, f"[{key}]", depth=1)
     names = set(representations) if representations is not None else None
     for section, key in (("recording", "representations"), ("status", "show")):
@@ -173,16 +174,15 @@ def check_config(config: Mapping[str, Any], platform_sections: Iterable[str] = (
             raise ConfigError(f"[{section}] {unknown[0]} is not a setting; [{section}] has only {key}")
         if key not in table:
             continue
-        value = table[key]
-        if not (isinstance(value, list) and all(isinstance(v, str) for v in value)):
-            raise ConfigError(f"{section}.{key} takes a list of representation names, e.g. [\"BallModel\"]; got {value!r}")
+        value = convert(table[key], list[str], where=f"{section}.{key}", text=False, error=ConfigError,
+                        expected='a list of representation names, e.g. ["BallModel"]')
         for name in value if names is not None else ():
             if names is not None and name not in names:  # (the loop is empty when names is None)
                 raise ConfigError(f"{section}.{key}: no representation named {name!r}; {did_you_mean(name, names)}")
     debug = config.get("debug", {})
     aliases = debug.get("aliases", {})
-    if not isinstance(aliases, Mapping) or not all(isinstance(v, Mapping) for v in aliases.values()):
-        raise ConfigError(f"debug.aliases takes tables, one per alias ([debug.aliases.\"motion:walk\"] with command = ...); got {aliases!r}")
+    convert(aliases, dict[str, dict[str, Any]], where="debug.aliases", text=False, error=ConfigError,
+            expected='tables, one per alias ([debug.aliases."motion:walk"] with command = ...)')
     for section in ("cognition", "motion"):
         context_section(config, section)
 
@@ -232,10 +232,14 @@ def load_config(
 
 #: the rates (Hz) a context may run at: above this no platform keeps up and no timer is that fine
 MAX_RATE_HZ = 1000.0
-#: [runtime] key -> (what it is, check)
-RUNTIME_KEYS: dict[str, str] = {
-    "cognition_hz": "rate", "motion_hz": "rate", "stall_timeout_s": "seconds", "shutdown_grace_s": "seconds", "stuck_timeout_s": "seconds",
-    "default_platform": "name",
+#: a rate of a context: above 0 Hz, at most ``MAX_RATE_HZ``
+RATE = Range(0.0, MAX_RATE_HZ, low_open=True)
+#: a time in seconds: above 0
+SECONDS = Range(0.0, low_open=True)
+#: [runtime] key -> (its type, its range, its unit)
+RUNTIME_KEYS: dict[str, tuple[type, Range | None, str]] = {
+    "cognition_hz": (float, RATE, "Hz"), "motion_hz": (float, RATE, "Hz"), "stall_timeout_s": (float, SECONDS, "seconds"),
+    "shutdown_grace_s": (float, SECONDS, "seconds"), "stuck_timeout_s": (float, SECONDS, "seconds"), "default_platform": (str, None, ""),
 }
 
 
@@ -243,20 +247,15 @@ def check_runtime(config: Mapping[str, Any]) -> None:
     """``[runtime]`` holds only known keys, each of its kind; ``ConfigError`` with what would be right."""
     runtime = config.get("runtime", {})
     if not isinstance(runtime, Mapping):
-        raise ConfigError(f"runtime must be a table of settings (runtime.motion_hz=100 and the like), got {runtime!r}")
+        raise refusal("runtime", "a table of settings (runtime.motion_hz=100 and the like)", runtime, ConfigError)
     for key, value in runtime.items():
-        kind = RUNTIME_KEYS.get(key)
-        if kind is None:
+        if key not in RUNTIME_KEYS:
             raise ConfigError(f"runtime.{key} is not a setting; {did_you_mean(key, RUNTIME_KEYS)}; "
                               f"the settings are {', '.join(sorted(RUNTIME_KEYS))}")
-        if kind == "name":
-            if not isinstance(value, str) or not value:
-                raise ConfigError(f"runtime.{key} takes a name, got {value!r}")
-            continue
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-            raise ConfigError(f"runtime.{key} takes a positive number of {'Hz' if kind == 'rate' else 'seconds'}, got {value!r}")
-        if kind == "rate" and value > MAX_RATE_HZ:
-            raise ConfigError(f"runtime.{key} = {value:g} Hz is above what the runtime supports ({MAX_RATE_HZ:g} Hz at the most)")
+        kind, bounds, unit = RUNTIME_KEYS[key]
+        if kind is str and value == "":
+            raise refusal(f"runtime.{key}", "a name", value, ConfigError)
+        convert(value, kind, where=f"runtime.{key}", bounds=bounds, unit=unit, text=False, error=ConfigError)
 
 
 #: the settings of a ``[cognition]`` or ``[motion]`` table
@@ -277,14 +276,11 @@ def apply_module_edits(config: dict[str, Any], where: str) -> dict[str, Any]:
         edits = {key: section.pop(key) for key in ("remove", "add") if key in section}
         if not edits:
             continue
-        modules = section.get("modules", [])
-        if not isinstance(modules, list):
-            raise ConfigError(f"{where}: [{context}] modules must be a list of module names to {' and '.join(edits)} modules")
-        modules = list(modules)
+        modules = convert(section.get("modules", []), list[Any], where=f"{where}: [{context}] modules", text=False,
+                          expected=f"a list of module names to {' and '.join(edits)} modules", error=ConfigError)
         for key, names in edits.items():
-            if not (isinstance(names, list) and all(isinstance(n, str) for n in names)):
-                raise ConfigError(f"{where}: [{context}] {key} takes a list of module names, e.g. {key} = [\"SimpleBallModeler\"]; "
-                                  f"got {names!r}")
+            names = convert(names, list[str], where=f"{where}: [{context}] {key}", text=False, error=ConfigError,
+                            expected=f'a list of module names, e.g. {key} = ["SimpleBallModeler"]')
             for name in names:
                 if key == "add" and name not in modules:
                     modules.append(name)
@@ -322,17 +318,12 @@ def context_section(config: Mapping[str, Any], context: str) -> dict[str, Any]:
     """The ``[cognition]`` or ``[motion]`` table with checked types."""
     section = config.get(context, {})
     if not isinstance(section, Mapping):
-        raise ConfigError(f"[{context}] must be a table")
-    modules = section.get("modules", [])
-    disabled = section.get("disabled", [])
-    providers = section.get("providers", {})
-    if not (isinstance(modules, list) and all(isinstance(m, str) for m in modules)):
-        raise ConfigError(f"{context}.modules must be a list of module names")
-    if not (isinstance(disabled, list) and all(isinstance(m, str) for m in disabled)):
-        raise ConfigError(f"{context}.disabled must be a list of module names")
-    if not (isinstance(providers, Mapping) and all(isinstance(v, str) for v in providers.values())):
-        raise ConfigError(f"{context}.providers must map representation names to module names")
-    return {"modules": list(modules), "disabled": list(disabled), "providers": dict(providers)}
+        raise refusal(f"[{context}]", "a table", section, ConfigError)
+    modules, disabled = (convert(section.get(key, []), list[str], where=f"{context}.{key}", text=False, error=ConfigError,
+                                 expected="a list of module names") for key in ("modules", "disabled"))
+    providers = convert(section.get("providers", {}), dict[str, str], where=f"{context}.providers", text=False, error=ConfigError,
+                        expected="a table of representation names to module names")
+    return {"modules": modules, "disabled": disabled, "providers": providers}
 
 
 def store_private(config_dir: Path, path: list[str], value: Any) -> Path:

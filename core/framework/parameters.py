@@ -26,7 +26,8 @@ from typing import Any
 
 from tafel.core.framework.errors import TafelError
 from tafel.core.framework.naming import did_you_mean
-from tafel.core.framework.validation import ValueCheckError, check_number, declared_range
+from tafel.core.framework.validation import declared_range
+from tafel.core.framework.values import convert, refusal
 
 
 class ParameterError(TafelError, ValueError):
@@ -60,53 +61,10 @@ def parameters_class(module: type) -> type | None:
 
 
 def coerce(module_name: str, field: dataclasses.Field, hint: Any, value: Any) -> Any:
-    """``value`` converted to the field's type, or a ``ParameterError`` saying what would fit."""
-    where = f"{module_name}.{field.name}"
-    try:
-        if hint is bool:
-            if isinstance(value, str) and value.lower() in ("true", "false", "1", "0", "on", "off"):
-                return value.lower() in ("true", "1", "on")
-            if isinstance(value, bool):
-                return value
-            raise ValueError
-        if hint is int:
-            if isinstance(value, bool):
-                raise ValueError
-            if isinstance(value, float) and not value.is_integer():
-                raise ValueError
-            return _within(where, field, int(value), "int")
-        if hint is float:
-            if isinstance(value, bool):
-                raise ValueError
-            return _within(where, field, float(value), "float")
-        if hint is str:
-            return _choice(where, field, str(value)) if CHOICES_META in field.metadata else str(value)
-        if isinstance(hint, type) and issubclass(hint, enum.Enum):
-            if isinstance(value, hint):
-                return value
-            return hint[str(value)]
-        if typing.get_origin(hint) is list:
-            (element,) = typing.get_args(hint)
-            if isinstance(value, str):
-                value = [v for v in value.split(",") if v.strip()]
-            return [coerce(module_name, field, element, v) for v in value]
-    except ParameterError:
-        raise
-    except (ValueError, TypeError, KeyError):
-        expected = getattr(hint, "__name__", str(hint))
-        if isinstance(hint, type) and issubclass(hint, enum.Enum):
-            expected += " (" + ", ".join(m.name for m in hint) + ")"
-        raise ParameterError(f"parameter {where} takes {expected}, got {value!r}") from None
-    return value
-
-
-def _choice(where: str, field: dataclasses.Field, value: str) -> str:
-    """``value`` as one of the field's options (case does not matter), or ``ParameterError`` listing them."""
-    options = field.metadata[CHOICES_META]
-    for option in options:
-        if value.lower() == option.lower():
-            return option
-    raise ParameterError(f"parameter {where} takes one of {', '.join(options)}, got {value!r:.60}")
+    """``value`` converted to the field's type and checked against its range and choices
+    (``tafel.core.framework.values.convert``), or a ``ParameterError`` saying what would fit."""
+    return convert(value, hint, where=f"parameter {module_name}.{field.name}", bounds=declared_range(field),
+                   choices=field.metadata.get(CHOICES_META), error=ParameterError)
 
 
 def _client_folder(where: str, field: dataclasses.Field, value: str, configured: str | None) -> str:
@@ -122,17 +80,9 @@ def _client_folder(where: str, field: dataclasses.Field, value: str, configured:
         inside = False
     if not inside:
         allowed = " or ".join(str(root.resolve()) for root in roots)
-        raise ParameterError(f"parameter {where} takes a folder inside {allowed} (configuration may name another one), "
-                             f"got {value!r:.80}")
+        raise refusal(f"parameter {where}", f"a folder inside {allowed} (configuration may name another one)", value,
+                      ParameterError)
     return str(path)
-
-
-def _within(where: str, field: dataclasses.Field, number: Any, kind: str) -> Any:
-    """``number`` if it is finite and in the field's declared range (``bounded`` or ``metadata={"range": ...}``)."""
-    try:
-        return check_number(number, f"parameter {where}", kind=kind, bounds=declared_range(field))
-    except ValueCheckError as exc:
-        raise ParameterError(str(exc)) from None
 
 
 def make_parameters(module: type, values: Mapping[str, Any] | None = None) -> Any:

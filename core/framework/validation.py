@@ -17,26 +17,16 @@ the writer views.
 from __future__ import annotations
 
 import dataclasses
-import math
 from typing import Any
 
 import numpy as np
 
 from tafel.core.framework.access import ArrayFieldError, check_array
-from tafel.core.framework.errors import TafelError
 from tafel.core.framework.representation import RANGE_META, FieldInfo, fields_of
+from tafel.core.framework.values import INT_RANGE, MAX_MAGNITUDE, ValueCheckError, convert, natural_range, refusal
 
 __all__ = ["INT_RANGE", "MAX_MAGNITUDE", "ValueCheckError", "check_field", "check_instance", "check_number", "declared_range",
            "natural_range"]
-
-#: the range of a whole number without a declared one: what a 64-bit signed integer holds (logs store int64)
-INT_RANGE = (-(2**63), 2**63 - 1)
-#: the largest size of any other number without a declared range
-MAX_MAGNITUDE = 1e12
-
-
-class ValueCheckError(TafelError, ValueError):
-    """A value from outside that does not fit its field; the message names the field and what fits."""
 
 
 def declared_range(field: dataclasses.Field | None) -> tuple[float, float] | None:
@@ -47,44 +37,10 @@ def declared_range(field: dataclasses.Field | None) -> tuple[float, float] | Non
     return None if bounds is None else (float(bounds[0]), float(bounds[1]))
 
 
-def natural_range(kind: str) -> tuple[float, float]:
-    """The range of a number whose field declares none: 64 bits for whole numbers, ``MAX_MAGNITUDE`` otherwise."""
-    return INT_RANGE if kind == "int" else (-MAX_MAGNITUDE, MAX_MAGNITUDE)
-
-
-def _text(number: Any) -> str:
-    """A number for a message: short, whatever its size (a 309-digit integer is not printed whole)."""
-    if isinstance(number, int) and abs(number) >= 10**20:
-        digits = int(abs(number).bit_length() * math.log10(2)) + 1  # str() of a huge int is slow, or refused
-        return f"{'-' if number < 0 else ''}a number of about {digits} digits"
-    return str(number) if isinstance(number, int) else f"{number:g}"
-
-
 def check_number(value: Any, where: str, *, kind: str = "float", bounds: tuple[float, float] | None = None) -> Any:
     """``value`` as a finite ``float`` (or ``int``) within ``bounds``, or without them within the type's
     natural range (``natural_range``); otherwise ``ValueCheckError``."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ValueCheckError(f"{where} takes {'a whole number' if kind == 'int' else 'a number'}, got {value!r:.60}")
-    if kind == "int":
-        if isinstance(value, (float, np.floating)) and not float(value).is_integer():
-            raise ValueCheckError(f"{where} takes a whole number, got {value!r}")
-        number: Any = int(value)
-    else:
-        try:
-            number = float(value)
-        except OverflowError:  # a whole number beyond any float
-            raise ValueCheckError(f"{where} takes a finite number, got {_text(int(value))}") from None
-        if not math.isfinite(number):
-            raise ValueCheckError(f"{where} takes a finite number, got {number}")
-    if bounds is not None:
-        if not bounds[0] <= number <= bounds[1]:
-            raise ValueCheckError(f"{where} takes {bounds[0]:g} to {bounds[1]:g}, got {_text(number)}")
-        return number
-    low, high = natural_range(kind)
-    if not low <= number <= high:
-        what = "a whole number that fits in 64 bits" if kind == "int" else f"a number of at most {MAX_MAGNITUDE:g} in size"
-        raise ValueCheckError(f"{where} takes {what} (it declares no narrower range), got {_text(number)}")
-    return number
+    return convert(value, int if kind == "int" else float, where=where, bounds=bounds, text=False)
 
 
 def check_field(owner: type, name: str, value: Any, where: str = "") -> Any:
@@ -106,32 +62,23 @@ def check_instance(instance: Any, where: str = "") -> None:
         object.__setattr__(instance, info.name, value)
 
 
+#: the Python type of each scalar kind of field
+_SCALARS = {"float": float, "int": int, "bool": bool, "str": str, "bytes": bytes}
+
+
 def _check(info: FieldInfo, value: Any, where: str) -> Any:
     bounds = info.range
     kind = info.kind
-    if kind in ("float", "int"):
-        return check_number(value, where, kind=kind, bounds=bounds)
-    if kind == "bool":
-        if not isinstance(value, (bool, np.bool_)):
-            raise ValueCheckError(f"{where} takes true or false, got {value!r}")
-        return bool(value)
-    if kind in ("str", "bytes"):
-        if not isinstance(value, info.type):
-            raise ValueCheckError(f"{where} takes {kind}, got {type(value).__name__}")
-        return value
-    if kind == "enum":
-        if isinstance(value, info.type):
-            return value
-        names = ", ".join(m.name for m in info.type)
-        raise ValueCheckError(f"{where} takes one of {names}, got {value!r}")
+    if kind in _SCALARS or kind == "enum":
+        return convert(value, _SCALARS.get(kind, info.type), where=where, bounds=bounds, text=False)
     if kind == "nested":
         if not isinstance(value, info.type):
-            raise ValueCheckError(f"{where} takes a {info.type.__name__}, got {type(value).__name__}")
+            raise refusal(where, f"a {info.type.__name__}", value)
         check_instance(value, where)
         return value
     if kind == "list":
         if not isinstance(value, list):
-            raise ValueCheckError(f"{where} takes a list, got {type(value).__name__}")
+            raise refusal(where, "a list", value)
         assert info.element is not None
         return [_check(info.element, element, f"{where}[{i}]") for i, element in enumerate(value)]
     return _check_array(info, value, where, bounds)
@@ -147,16 +94,23 @@ def _check_array(info: FieldInfo, value: Any, where: str, bounds: tuple[float, f
     except ArrayFieldError:
         shape = "x".join("any" if n is None else str(n) for n in spec.shape)
         got = np.asarray(value)
-        raise ValueCheckError(f"{where} takes an array of shape {shape} ({spec.dtype}); got shape "
-                              f"{'x'.join(map(str, got.shape)) or 'scalar'} ({got.dtype})") from None
+        raise refusal(where, f"an array of shape {shape} ({spec.dtype})",
+                      _Said(f"shape {'x'.join(map(str, got.shape)) or 'scalar'} ({got.dtype})")) from None
     except (TypeError, ValueError):
-        raise ValueCheckError(f"{where} takes an array of numbers, got {value!r:.60}") from None
+        raise refusal(where, "an array of numbers", value) from None
     if array.dtype.kind == "f" and not np.isfinite(array).all():
         bad = int(np.flatnonzero(~np.isfinite(array))[0])
-        raise ValueCheckError(f"{where} takes finite numbers; element {bad} is {array.flat[bad]}")
+        raise refusal(where, "finite numbers", _Said(f"{array.flat[bad]} at element {bad}"))
     if bounds is None and array.dtype.kind == "f":  # whole-number dtypes hold their own range
         bounds = natural_range("float")
     if bounds is not None and array.size and (array.min() < bounds[0] or array.max() > bounds[1]):
-        raise ValueCheckError(f"{where} takes values from {bounds[0]:g} to {bounds[1]:g}; got {array.min():g} to {array.max():g}")
+        raise refusal(where, f"values from {bounds[0]:g} to {bounds[1]:g}", _Said(f"{array.min():g} to {array.max():g}"))
     return array
+
+
+class _Said(str):
+    """Words about a value (its shape, its range) for ``refusal``, shown as they are."""
+
+    def __repr__(self) -> str:
+        return str(self)
 

@@ -25,6 +25,7 @@ from typing import Any, ClassVar
 from tafel.core.framework.errors import TafelError, UnknownModuleError
 from tafel.core.framework.manager import Blackboard
 from tafel.core.framework.naming import did_you_mean
+from tafel.core.framework.values import convert
 
 ENTRY_POINT_GROUP = "tafel.platforms"
 
@@ -43,13 +44,7 @@ class EndOfData(TafelError):
 
 def seed_number(text: str) -> int:
     """``--seed``: a whole number from 0 to 2**32 - 1 (what numpy's generators accept)."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"--seed takes a whole number from 0 to 4294967295, got {text!r}") from None
-    if not 0 <= value < 2**32:
-        raise argparse.ArgumentTypeError(f"--seed takes a whole number from 0 to 4294967295, got {value}")
-    return value
+    return convert(text, int, where="--seed", bounds=(0, 2**32 - 1), text=True, error=argparse.ArgumentTypeError)
 
 
 class Platform:

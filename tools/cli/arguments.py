@@ -9,7 +9,6 @@ standard library and the tools' modules of constants (``launch/defaults.py``, ``
 from __future__ import annotations
 
 import argparse
-import math
 import re
 from pathlib import Path
 from typing import Any
@@ -25,40 +24,30 @@ def parse_speed(text: str) -> float | None:
     """``--speed``: a factor against the wall clock, or ``max`` (None: as fast as possible)."""
     if text == "max":
         return None
+    from tafel.core.framework.values import convert  # when a value is read, not at import: tafel --help stays light
+
     low, high = SPEED_RANGE
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not low <= value <= high:
-        raise argparse.ArgumentTypeError(f"--speed takes a factor from {low:g} to {high:g} or 'max', got {text!r}")
-    return value
+    return convert(text, float, where="--speed", bounds=SPEED_RANGE, text=True, expected=f"a factor from {low:g} to {high:g} or 'max'",
+                   error=argparse.ArgumentTypeError)
 
 
 def positive(kind: type) -> Any:
     """An argparse type accepting numbers of ``kind`` greater than zero."""
 
     def parse(text: str) -> Any:
-        try:
-            value = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected a {'whole ' if kind is int else ''}number, got {text!r}") from None
-        if not math.isfinite(value) or value <= 0:
-            raise argparse.ArgumentTypeError(f"expected a number greater than zero, got {text}")
-        return value
+        from tafel.core.framework.values import Range, convert
+
+        return convert(text, kind, where="", bounds=Range(0, low_open=True), text=True, error=argparse.ArgumentTypeError)
 
     return parse
 
 
 def port_number(text: str) -> int:
     """A TCP port: 0 (any free one) to 65535."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"a port is a whole number from 0 to 65535, got {text!r}") from None
-    if not 0 <= value <= 65535:
-        raise argparse.ArgumentTypeError(f"a port is a whole number from 0 to 65535 (0: any free one), got {value}")
-    return value
+    from tafel.core.framework.values import convert
+
+    return convert(text, int, where="", bounds=(0, 65535), text=True, expected="a port number from 0 to 65535 (0: any free one)",
+                   error=argparse.ArgumentTypeError)
 
 
 def add_module_path_argument(parser: argparse.ArgumentParser) -> None:
@@ -196,13 +185,10 @@ def add_console_command(commands: Any) -> None:
 
 def team_number(text: str) -> int:
     """A GameController team number: 1 to 254."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if not 1 <= value <= 254:
-        raise argparse.ArgumentTypeError(f"a team number is a whole number from 1 to 254 (the GameController's), got {text!r}")
-    return value
+    from tafel.core.framework.values import convert
+
+    return convert(text, int, where="", bounds=(1, 254), text=True, expected="a team number from 1 to 254 (the GameController's)",
+                   error=argparse.ArgumentTypeError)
 
 
 def add_team_command(commands: Any) -> None:
