@@ -31,7 +31,8 @@ from tafel.core.framework.representation import fields_of
 from tafel.core.framework.validation import ValueCheckError, check_field, check_instance
 from tafel.core.framework.values import convert
 from tafel.core.logs.serialization import SerializationError, deserialize, serialize
-from tafel.debug.concepts import CANVASES, STATE, DebugState
+from tafel.debug.concepts import CANVASES, DebugState
+from tafel.debug.outputs import debug_state
 from tafel.debug.protocol import Command
 from tafel.debug.values import (
     CommandError,
@@ -131,11 +132,10 @@ def wants_json(command: Command) -> bool:
 class ContextDebug:
     """Answers debug commands about one context; call ``execute`` between that context's frames."""
 
-    def __init__(self, context: str, manager: ModuleManager, *, state: DebugState = STATE,
-                 rate: Callable[[], float] | None = None) -> None:
+    def __init__(self, context: str, manager: ModuleManager, *, rate: Callable[[], float] | None = None) -> None:
         self.context = context
         self.manager = manager
-        self.state = state
+        self.state: DebugState = debug_state(manager)  # the context's own debug outputs
         self.rate = rate or (lambda: 0.0)
         self.handlers: dict[str, Callable[[Command], str | bytes]] = {
             name: getattr(self, "cmd_" + name.replace(":", "_")) for name in SPECS
@@ -323,23 +323,15 @@ class ContextDebug:
         return f"{name} released in {self.context}"
 
     # --------------------------------------------------------------------- debug concepts
-    def _mine(self, items: Mapping[str, Any]) -> dict[str, Any]:
-        """The entries used in this context, or declared (at import) in a file of one of its modules."""
-        files = {cls.__module__ for cls in self.manager.module_classes}
-        return {
-            name: item for name, item in items.items()
-            if item.context == self.context or (not item.context and getattr(item, "origin", "") in files)
-        }
-
     def _named(self, command: Command, items: Mapping[str, Any], kind: str) -> Any:
+        """The entry ``-name`` of this context (its modules' declarations, or used in its frames)."""
         name = argument(command, "name")
-        mine = self._mine(items)
-        if name not in mine:
-            raise NotHere(kind, name, mine)
-        return mine[name]
+        if name not in items:
+            raise NotHere(kind, name, items)
+        return items[name]
 
     def cmd_debug_request_list(self, command: Command) -> str:
-        requests = self._mine(self.state.requests)
+        requests = self.state.requests
         if wants_json(command):
             return json.dumps([{"name": name, "on": r.on, "description": r.description} for name, r in sorted(requests.items())])
         return "\n".join(f"  {'on ' if r.on else 'off'} {name}  {r.description}" for name, r in sorted(requests.items())) or "  (none yet)"
@@ -350,7 +342,7 @@ class ContextDebug:
         return f"{found.name} {'on' if found.on else 'off'}"
 
     def cmd_modify_list(self, command: Command) -> str:
-        modifies = self._mine(self.state.modifies)
+        modifies = self.state.modifies
         if wants_json(command):
             return json.dumps([{"name": name, "value": json_value(m.value), "pinned": m.pinned,
                                 "pinned_value": json_value(m.pinned_value) if m.pinned else None}
@@ -378,7 +370,7 @@ class ContextDebug:
         lines.append(f"  {'module':<32} {'last':>9} {'mean':>9} {'max':>9} {'p95':>9}  (us)")
         for name, timing in self.manager.timings().items():
             lines.append(f"  {name:<32} {timing.last_us:9.1f} {timing.mean_us:9.1f} {timing.max_us:9.1f} {self.manager.p95_us(name):9.1f}")
-        for name, watch in sorted(self._mine(self.state.stopwatches).items()):
+        for name, watch in sorted(self.state.stopwatches.items()):
             times = [t / 1000 for t in watch.times_ns]
             if times:
                 p95 = sorted(times)[int(0.95 * (len(times) - 1))]
@@ -388,7 +380,7 @@ class ContextDebug:
     def _stopwatches(self) -> dict[str, Any]:
         rows = [{"name": name, "last_us": t.last_us, "mean_us": t.mean_us, "max_us": t.max_us, "p95_us": self.manager.p95_us(name)}
                 for name, t in self.manager.timings().items()]
-        for name, watch in sorted(self._mine(self.state.stopwatches).items()):
+        for name, watch in sorted(self.state.stopwatches.items()):
             times = sorted(t / 1000 for t in watch.times_ns)
             if times:
                 rows.append({"name": name, "last_us": watch.times_ns[-1] / 1000, "mean_us": statistics.fmean(times),
@@ -396,16 +388,16 @@ class ContextDebug:
         return {"rate_hz": self.rate(), "frame": self.manager.frame, "stopwatches": rows}
 
     def cmd_plot_get(self, command: Command) -> str:
-        plots = self._mine(self.state.plots)
-        if not argument(command, "name", required=False):
-            return "\n".join(f"{name} ({len(p.values)} values, {self.context})" for name, p in sorted(plots.items()))
+        plots = self.state.plots
+        if not argument(command, "name", required=False):  # the plots with values (declared ones list in tafel modules)
+            return "\n".join(f"{name} ({len(p.values)} values, {self.context})" for name, p in sorted(plots.items()) if p.values)
         found = self._named(command, self.state.plots, "plot")
         count = int(argument(command, "count", positional=False, required=False) or len(found.values))
         return "\n".join(f"{frame} {value:.6g}" for frame, value in list(found.values)[-count:])
 
     def cmd_drawings_get(self, command: Command) -> str:
         canvas = argument(command, "canvas", required=False)
-        drawings = self.state.drawings_last.get(self.context, [])
+        drawings = self.state.drawings_last
         known = list(dict.fromkeys([*CANVASES, *(d["canvas"] for d in drawings)]))
         if canvas and canvas not in known:
             raise CommandError(f"there is no canvas {canvas!r}; {did_you_mean(canvas, known)}; the canvases are {', '.join(known)}")

@@ -1,236 +1,292 @@
-"""Debug concepts for module authors: Pythonic counterparts of the NaoTH debug macros.
+"""What a context's debug outputs hold while the program runs: one ``DebugState`` per context.
 
-    from tafel.debug import drawing, modify, plot, request, stopwatch
+Modules declare their outputs on the class (``tafel.debug.outputs``: ``DebugRequest``, ``Plot``,
+``Stopwatch``, ``ModifyValue``, ``ModifyParameters``); the manager that runs a module gives each
+declaration this context's entry of its name (``RequestSwitch``, ``PlotSeries``, ...), so two contexts,
+two programs or two tests never share one, and a module loaded again (hot reload) keeps its switches
+and pins. The debug commands (``ContextDebug``) and the frame hooks reach the state through the manager
+(``manager.debug``). Drawings go on the canvases of ``Canvas``.
 
-    DRAW_PERCEPT = request("BallDetector:draw_percept", "circle around the ball in the image")
-
-    def execute(self) -> None:
-        threshold = modify("BallDetector:min_radius", 3.0)      # can be pinned over telnet
-        with stopwatch("BallDetector:segmentation"):
-            mask = ...
-        plot("BallDetector:radius", radius)
-        if DRAW_PERCEPT:                                         # off by default, toggled at run time
-            drawing("image:top").circle(x, y, radius, color="orange")
-
-Everything is cheap when switched off: a request is one attribute check; an unpinned ``modify``
-returns its argument after noting it; plots and stopwatches keep short ring buffers. The state is per
-process (the debug server reads it between frames); each entry remembers the context it was used in.
+Everything is cheap when nobody looks: a request is an attribute read and ``__bool__``; drawings are
+only made under a request that is on; plots and stopwatches keep short ring buffers.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import enum
 import math
-import sys
+import threading
 import time
 from collections import deque
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 from tafel.core import representation
 from tafel.core.framework.representation import RANGE_META
-from tafel.core.testing import RESET_HOOKS
 
 HISTORY = 300  # values kept per plot and per stopwatch
 
 
-class DebugRequest:
-    """A named switch for a code path; ``if DRAW:`` or ``if DRAW.on:``."""
+class Canvas(str, enum.Enum):
+    """Where drawings go: the field (mm, field frame), around the robot (mm, robot frame: the views place
+    it at the robot's pose), each camera's image (px). A ``str`` enum: ``"field"`` works too."""
 
-    __slots__ = ("name", "description", "on", "context", "origin")
+    FIELD = "field"
+    ROBOT = "robot"
+    IMAGE_TOP = "image:top"
+    IMAGE_BOTTOM = "image:bottom"
 
-    def __init__(self, name: str, description: str = "", context: str = "", origin: str = "") -> None:
-        self.name, self.description, self.on, self.context = name, description, False, context
-        #: the Python module that declared it, when no context was running yet (declared at import)
-        self.origin = origin
+    @classmethod
+    def of(cls, name: Canvas | str) -> Canvas:
+        """The canvas ``name``; another name is a ``ValueError`` naming the canvases (a typo would draw
+        where no view ever looks)."""
+        try:
+            return cls(name)
+        except ValueError:
+            raise ValueError(f"no drawing canvas {name!r}; the canvases are {', '.join(CANVASES)}") from None
+
+    @classmethod
+    def image(cls, camera: Any) -> Canvas:
+        """The image canvas of a camera (``"top"``, ``"bottom"`` or a ``Camera``)."""
+        return cls.of(f"image:{getattr(camera, 'value', camera)}")
+
+
+#: the canvases every viewer knows, as names
+CANVASES = tuple(c.value for c in Canvas)
+
+
+class Painter:
+    """Drawing primitives on one canvas of the current frame of a context."""
+
+    __slots__ = ("canvas", "state")
+
+    def __init__(self, canvas: Canvas, state: DebugState) -> None:
+        self.canvas, self.state = canvas.value, state
+
+    def _add(self, kind: str, points: list[float], color: str, width: float, text: str = "") -> Painter:
+        self.state.drawings_now.append(
+            {"canvas": self.canvas, "kind": kind, "points": [float(p) for p in points], "color": color, "width": float(width), "text": text}
+        )
+        return self
+
+    def line(self, x1: float, y1: float, x2: float, y2: float, *, color: str = "black", width: float = 1.0) -> Painter:
+        return self._add("line", [x1, y1, x2, y2], color, width)
+
+    def circle(self, x: float, y: float, radius: float, *, color: str = "black", width: float = 1.0) -> Painter:
+        return self._add("circle", [x, y, radius], color, width)
+
+    def rectangle(self, x1: float, y1: float, x2: float, y2: float, *, color: str = "black", width: float = 1.0) -> Painter:
+        return self._add("rectangle", [x1, y1, x2, y2], color, width)
+
+    def text(self, x: float, y: float, text: str, *, color: str = "black", size: float = 12.0) -> Painter:
+        return self._add("text", [x, y], color, size, text)
+
+    def robot_pose(self, x: float, y: float, rotation: float, *, color: str = "blue", width: float = 1.0) -> Painter:
+        """A robot at (x, y) mm looking along ``rotation`` rad."""
+        return self._add("robot_pose", [x, y, rotation], color, width)
+
+
+class _NoPainter(Painter):
+    """What a request that is off draws with: nothing."""
+
+    def __init__(self) -> None:
+        self.canvas, self.state = "", None  # type: ignore[assignment]
+
+    def _add(self, kind: str, points: list[float], color: str, width: float, text: str = "") -> Painter:
+        return self
+
+
+NO_PAINTER = _NoPainter()
+
+
+# ----------------------------------------------------------------------- one context's entries
+class RequestSwitch:
+    """A debug request of a context: ``if self.draw:``; its drawings: ``self.draw.canvas(Canvas.FIELD)``."""
+
+    __slots__ = ("name", "description", "on", "state")
+
+    def __init__(self, name: str, description: str, state: DebugState) -> None:
+        self.name, self.description, self.on, self.state = name, description, False, state
 
     def __bool__(self) -> bool:
         return self.on
 
+    def canvas(self, canvas: Canvas | str) -> Painter:
+        """A canvas of this frame to draw on; while the request is off, one that draws nothing."""
+        if not self.on:
+            return NO_PAINTER
+        return self.state.painter(canvas)
+
     def __repr__(self) -> str:
-        return f"DebugRequest({self.name!r}, on={self.on})"
+        return f"RequestSwitch({self.name!r}, on={self.on})"
 
 
-@dataclass
-class Modify:
-    """A value the code publishes; pinned, the code gets ``pinned_value`` instead."""
-
-    name: str
-    value: Any = None
-    pinned: bool = False
-    pinned_value: Any = None
-    context: str = ""
+_KEEP: Any = object()  # ModifyEntry() without a value: the one it has
 
 
-@dataclass
-class Stopwatch:
-    """A named timed section; ``with stopwatch("name"):``."""
+class ModifyEntry:
+    """A value the code publishes; pinned by a debug client, the code gets ``pinned_value`` instead.
 
-    name: str
-    context: str = ""
-    times_ns: deque = field(default_factory=lambda: deque(maxlen=HISTORY))
-    _start: int = 0
+    ``self.gain()`` is the declared (or last published) value, or the pinned one; ``self.gain(x)``
+    publishes ``x`` and returns it, or the pinned value."""
 
-    def __enter__(self) -> Stopwatch:
+    __slots__ = ("name", "description", "value", "pinned", "pinned_value")
+
+    def __init__(self, name: str, description: str = "", value: Any = None) -> None:
+        self.name, self.description, self.value = name, description, value
+        self.pinned, self.pinned_value = False, None
+
+    def __call__(self, value: Any = _KEEP) -> Any:
+        if value is not _KEEP:
+            self.value = value
+        return self.pinned_value if self.pinned else self.value
+
+
+class StopwatchTimes:
+    """A named timed section of a context: ``with self.segmentation:``."""
+
+    __slots__ = ("name", "description", "times_ns", "_start")
+
+    def __init__(self, name: str, description: str = "") -> None:
+        self.name, self.description = name, description
+        self.times_ns: deque[int] = deque(maxlen=HISTORY)
+        self._start = 0
+
+    def __enter__(self) -> StopwatchTimes:
         self._start = time.perf_counter_ns()
         return self
 
     def __exit__(self, *exc: Any) -> None:
         self.times_ns.append(time.perf_counter_ns() - self._start)
-        self.context = STATE.context or self.context
 
 
-@dataclass
-class Plot:
-    name: str
-    context: str = ""
-    values: deque = field(default_factory=lambda: deque(maxlen=HISTORY))  # (frame, value)
+class PlotSeries:
+    """A plot of a context: ``self.radius.add(r)`` once a frame; ``values`` holds (frame, value)."""
+
+    __slots__ = ("name", "description", "values", "frames")
+
+    def __init__(self, name: str, description: str, frames: Any) -> None:
+        self.name, self.description = name, description
+        self.values: deque[tuple[int, float]] = deque(maxlen=HISTORY)
+        self.frames = frames  # what counts the context's frames (its manager)
+
+    def add(self, value: float) -> None:
+        self.values.append((self.frames.frame, float(value)))
 
 
-class Canvas:
-    """Drawing primitives for one canvas of the current frame (``field`` in mm, ``image:<camera>`` in px)."""
+class TunedParameters:
+    """Fields of a module's parameters published as modify values ``PREFIX:NAME`` (all of one context)."""
 
-    __slots__ = ("name",)
+    __slots__ = ("entries",)
 
-    def __init__(self, name: str) -> None:
-        if name not in CANVASES:  # a typo would draw where no view ever looks
-            raise ValueError(f"no drawing canvas {name!r}; the canvases are {', '.join(CANVASES)}")
-        self.name = name
+    def __init__(self, entries: dict[str, ModifyEntry]) -> None:
+        self.entries = entries
 
-    def _add(self, kind: str, points: list[float], color: str, width: float, text: str = "") -> Canvas:
-        STATE.drawings_now.setdefault(STATE.context, []).append(
-            {"canvas": self.name, "kind": kind, "points": [float(p) for p in points], "color": color, "width": float(width), "text": text}
-        )
-        return self
+    def apply(self, values: Any) -> Any:
+        """``values`` itself while nothing is pinned, else a copy with the pinned values, each clamped into
+        the range its field declares (``bounded``), so that a value tried live cannot leave it."""
+        pinned: dict[str, Any] = {}
+        declared = None
+        for name, entry in self.entries.items():
+            current = getattr(values, name)
+            entry.value = current
+            if entry.pinned and entry.pinned_value != current:
+                declared = declared or {item.name: item for item in dataclasses.fields(values)}
+                low, high = declared[name].metadata.get(RANGE_META, (-math.inf, math.inf))
+                pinned[name] = type(current)(min(max(entry.pinned_value, low), high))
+        return dataclasses.replace(values, **pinned) if pinned else values
 
-    def line(self, x1: float, y1: float, x2: float, y2: float, *, color: str = "black", width: float = 1.0) -> Canvas:
-        return self._add("line", [x1, y1, x2, y2], color, width)
 
-    def circle(self, x: float, y: float, radius: float, *, color: str = "black", width: float = 1.0) -> Canvas:
-        return self._add("circle", [x, y, radius], color, width)
+#: the state whose context runs a frame in this thread now (for the deprecated free functions only)
+RUNNING = threading.local()
 
-    def rectangle(self, x1: float, y1: float, x2: float, y2: float, *, color: str = "black", width: float = 1.0) -> Canvas:
-        return self._add("rectangle", [x1, y1, x2, y2], color, width)
 
-    def text(self, x: float, y: float, text: str, *, color: str = "black", size: float = 12.0) -> Canvas:
-        return self._add("text", [x, y], color, size, text)
-
-    def robot_pose(self, x: float, y: float, rotation: float, *, color: str = "blue", width: float = 1.0) -> Canvas:
-        """A robot at (x, y) mm looking along ``rotation`` rad."""
-        return self._add("robot_pose", [x, y, rotation], color, width)
+class _Frames:
+    frame = 0
 
 
 class DebugState:
-    """Everything the debug concepts collect in this process."""
+    """The debug outputs of one context: its requests, modify values, stopwatches, plots and drawings.
 
-    def __init__(self) -> None:
-        self.context = ""
-        self.frame: dict[str, int] = {}
-        self.requests: dict[str, DebugRequest] = {}
-        self.modifies: dict[str, Modify] = {}
-        self.stopwatches: dict[str, Stopwatch] = {}
-        self.plots: dict[str, Plot] = {}
-        self.drawings_now: dict[str, list[dict[str, Any]]] = {}
-        self.drawings_last: dict[str, list[dict[str, Any]]] = {}
+    Made by ``outputs.debug_state(manager)`` (kept as ``manager.debug``), it follows the manager's
+    frames: a frame's drawings go to ``drawings_now`` and are ``drawings_last`` after it."""
 
-    def begin_frame(self, context: str, frame: int) -> None:
-        """Called before each frame of ``context`` (the runtime's frame hooks)."""
-        self.context = context
-        self.frame[context] = frame
-        self.drawings_now[context] = []
+    def __init__(self, manager: Any = None) -> None:
+        self.manager = manager
+        self.frames = manager if manager is not None else _Frames()
+        self.requests: dict[str, RequestSwitch] = {}
+        self.modifies: dict[str, ModifyEntry] = {}
+        self.stopwatches: dict[str, StopwatchTimes] = {}
+        self.plots: dict[str, PlotSeries] = {}
+        #: full name -> the module class that declared it (for listings)
+        self.owners: dict[str, str] = {}
+        self.drawings_now: list[dict[str, Any]] = []
+        self.drawings_last: list[dict[str, Any]] = []
+        self._painters: dict[str, Painter] = {c: Painter(c, self) for c in Canvas}
+        if manager is not None:
+            manager.before_frame.append(self.begin_frame)
+            manager.after_frame.append(self.end_frame)
 
-    def end_frame(self, context: str) -> None:
-        self.drawings_last[context] = self.drawings_now.get(context, [])
-        self.drawings_now[context] = []
+    @property
+    def frame(self) -> int:
+        return int(self.frames.frame)
 
+    def begin_frame(self) -> None:
+        self.drawings_now = []
+        RUNNING.state = self
 
-    def reset(self) -> None:
-        """As in a fresh process, for tests: requests off, pins released, no times, values or drawings.
+    def end_frame(self) -> None:
+        self.drawings_last = self.drawings_now
+        self.drawings_now = []
+        RUNNING.state = None
 
-        Requests and modify values stay registered (modules hold them from import time); only their
-        state goes back to the start.
-        """
-        for found in self.requests.values():
-            found.on = False
-        for pinned in self.modifies.values():
-            pinned.pinned, pinned.pinned_value = False, None
-        for watch in self.stopwatches.values():
-            watch.times_ns.clear()
-        for series in self.plots.values():
-            series.values.clear()
-        self.context = ""
-        self.frame.clear()
-        self.drawings_now.clear()
-        self.drawings_last.clear()
+    def painter(self, canvas: Canvas | str) -> Painter:
+        found = self._painters.get(canvas)
+        return found if found is not None else self._painters[Canvas.of(canvas)]
 
+    # -------------------------------------------------- entries by name (get or make)
+    def request(self, name: str, description: str = "", owner: str = "") -> RequestSwitch:
+        found = self.requests.get(name)
+        if found is None:
+            found = self.requests[name] = RequestSwitch(name, description, self)
+        elif description and not found.description:
+            found.description = description
+        self.owners.setdefault(name, owner)
+        return found
 
-STATE = DebugState()
-RESET_HOOKS.append(STATE.reset)  # the pytest plugin resets it after every test; core never imports debug
+    def modify(self, name: str, value: Any = None, description: str = "", owner: str = "") -> ModifyEntry:
+        found = self.modifies.get(name)
+        if found is None:
+            found = self.modifies[name] = ModifyEntry(name, description, value)
+        elif found.value is None:
+            found.value = value
+        self.owners.setdefault(name, owner)
+        return found
 
+    def stopwatch(self, name: str, description: str = "", owner: str = "") -> StopwatchTimes:
+        found = self.stopwatches.get(name)
+        if found is None:
+            found = self.stopwatches[name] = StopwatchTimes(name, description)
+        self.owners.setdefault(name, owner)
+        return found
 
-def request(name: str, description: str = "") -> DebugRequest:
-    """The debug request ``name`` (created switched off on first use)."""
-    found = STATE.requests.get(name)
-    if found is None:
-        origin = "" if STATE.context else sys._getframe(1).f_globals.get("__name__", "")
-        found = STATE.requests[name] = DebugRequest(name, description, STATE.context, origin)
-    elif description and not found.description:
-        found.description = description
-    return found
+    def plot(self, name: str, description: str = "", owner: str = "") -> PlotSeries:
+        found = self.plots.get(name)
+        if found is None:
+            found = self.plots[name] = PlotSeries(name, description, self.frames)
+        self.owners.setdefault(name, owner)
+        return found
 
+    # -------------------------------------------------- what tests and tools read
+    def drawings(self, canvas: Canvas | str | None = None) -> list[dict[str, Any]]:
+        """The last frame's drawings (all, or those on one canvas)."""
+        wanted = None if canvas is None else Canvas.of(canvas).value
+        return [d for d in self.drawings_last if wanted is None or d["canvas"] == wanted]
 
-def modify(name: str, value: Any) -> Any:
-    """Publish ``value`` under ``name``; returns the pinned value instead while one is set."""
-    found = STATE.modifies.get(name)
-    if found is None:
-        found = STATE.modifies[name] = Modify(name, context=STATE.context)
-    found.context = STATE.context or found.context  # first used outside a frame (a test): the context it runs in
-    found.value = value
-    return found.pinned_value if found.pinned else value
-
-
-def modify_fields(prefix: str, values: Any, names: tuple[str, ...]) -> Any:
-    """Publish fields of a dataclass (a module's parameters) as ``modify`` values ``prefix:name``.
-
-    Returns ``values`` itself while nothing is pinned, else a copy with the pinned values, each clamped
-    into the range its field declares (``bounded``), so that a value tried live cannot leave it."""
-    pinned: dict[str, Any] = {}
-    declared = {item.name: item for item in dataclasses.fields(values)}
-    for name in names:
-        current = getattr(values, name)
-        wanted = modify(f"{prefix}:{name}", current)
-        if wanted != current:
-            low, high = declared[name].metadata.get(RANGE_META, (-math.inf, math.inf))
-            pinned[name] = type(current)(min(max(wanted, low), high))
-    return dataclasses.replace(values, **pinned) if pinned else values
-
-
-def stopwatch(name: str) -> Stopwatch:
-    """The stopwatch ``name``, for ``with stopwatch(name):``."""
-    found = STATE.stopwatches.get(name)
-    if found is None:
-        found = STATE.stopwatches[name] = Stopwatch(name, STATE.context)
-    return found
-
-
-def plot(name: str, value: float) -> None:
-    """Add this frame's value to the series ``name``."""
-    found = STATE.plots.get(name)
-    if found is None:
-        found = STATE.plots[name] = Plot(name, STATE.context)
-    found.values.append((STATE.frame.get(STATE.context, 0), float(value)))
-
-
-#: the canvases every viewer knows: the field (mm, field frame) and both images (px)
-#: where drawings go: the field (mm, field frame), around the robot (mm, robot frame: the view places it at
-#: the robot's pose), each camera's image (px)
-CANVASES = ("field", "robot", "image:top", "image:bottom")
-
-
-def drawing(canvas: str = "field") -> Canvas:
-    """A canvas of the current frame: ``field`` (mm, field frame), ``robot`` (mm, robot frame) or
-    ``image:top`` / ``image:bottom`` (px); another name is a ``ValueError`` naming the canvases."""
-    return Canvas(canvas)
+    def plot_values(self, name: str) -> list[float]:
+        """The recent values of the plot ``name``, oldest first."""
+        return [value for _, value in self.plots[name].values]
 
 
 # --------------------------------------------------------------- debug data as representations (logs)
@@ -278,13 +334,13 @@ class ModuleTimes:
     milliseconds: list[float] = field(default_factory=list)
 
 
-def frame_debug_data(context: str) -> tuple[DebugDrawings, DebugPlots]:
-    """This context's last frame of drawings and plots as representations."""
-    drawings = DebugDrawings([DebugDrawingPrimitive(**d) for d in STATE.drawings_last.get(context, [])])
-    frame = STATE.frame.get(context, 0)
+def frame_debug_data(state: DebugState) -> tuple[DebugDrawings, DebugPlots]:
+    """A context's last frame of drawings and plots as representations."""
+    drawings = DebugDrawings([DebugDrawingPrimitive(**d) for d in state.drawings_last])
+    frame = state.frame
     names, values = [], []
-    for plot_ in STATE.plots.values():
-        if plot_.context == context and plot_.values and plot_.values[-1][0] == frame:
-            names.append(plot_.name)
-            values.append(plot_.values[-1][1])
+    for series in state.plots.values():
+        if series.values and series.values[-1][0] == frame:
+            names.append(series.name)
+            values.append(series.values[-1][1])
     return drawings, DebugPlots(names, values)

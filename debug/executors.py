@@ -19,7 +19,8 @@ from tafel.core.framework.errors import TafelError
 from tafel.core.framework.manager import ModuleManager
 from tafel.core.runtime import ContextRunner
 from tafel.debug.commands import CommandError, ContextDebug
-from tafel.debug.concepts import STATE, DebugDrawings, DebugPlots, ModuleTimes, frame_debug_data
+from tafel.debug.concepts import DebugDrawings, DebugPlots, ModuleTimes, frame_debug_data
+from tafel.debug.outputs import debug_state
 from tafel.debug.protocol import Command
 from tafel.debug.router import Executor
 
@@ -47,17 +48,16 @@ class RateMeter:
 
 
 def instrument(context: str, manager: ModuleManager, meter: RateMeter) -> None:
-    """Frame hooks: tell the debug concepts which context runs, keep its drawings and plots per frame."""
-    manager.before_frame.append(lambda: STATE.begin_frame(context, manager.frame + 1))
-
+    """Frame hooks: count the loop's rate, put the frame's drawings, plots and module times on the blackboard
+    where something reads them (the context's ``DebugState`` keeps its own frame hooks)."""
+    state = debug_state(manager)
     fed = set(manager.external)  # replaying a log feeds recorded debug data: it is shown as recorded
 
     def after() -> None:
-        STATE.end_frame(context)
         meter.tick()
         filled = [rep for rep in DEBUG_REPRESENTATIONS if rep in manager.blackboard and rep not in fed]
         if DebugDrawings in filled or DebugPlots in filled:
-            drawings, plots = frame_debug_data(context)
+            drawings, plots = frame_debug_data(state)
             if DebugDrawings in filled:
                 manager.blackboard.set(drawings)
             if DebugPlots in filled:

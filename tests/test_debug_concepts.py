@@ -13,13 +13,13 @@ import pytest
 from tafel.core import ModuleManager
 from tafel.core.testing import ModuleHarness
 from tafel.debug.commands import ContextDebug
-from tafel.debug.concepts import STATE, frame_debug_data
+from tafel.debug.concepts import frame_debug_data
 from tafel.debug.executors import RateMeter, instrument
 from tafel.debug.protocol import parse
 from tafel.debug.values import pretty
 from tafel.representations.infrastructure import FrameInfo
 from tafel.tools.viewers.console import Completer
-from tests.support.debug_user import DRAW, DebugUser, DebugUserOutput
+from tests.support.debug_user import DebugUser, DebugUserOutput
 from tests.test_debug_server import Program
 
 
@@ -37,18 +37,15 @@ def run_frames(manager: ModuleManager, frames: int) -> None:
 
 
 def test_requests_are_off_until_switched_on(instrumented: ModuleManager) -> None:
-    DRAW.on = False
+    state = instrumented.debug
     run_frames(instrumented, 2)
-    assert STATE.drawings_last["cognition"] == []
-    DRAW.on = True
-    try:
-        run_frames(instrumented, 1)
-        kinds = [(d["canvas"], d["kind"]) for d in STATE.drawings_last["cognition"]]
-        assert kinds == [("field", "circle"), ("image:top", "text")]
-        drawings, _ = frame_debug_data("cognition")
-        assert drawings.primitives[0].points == [100.0, 200.0, 50.0]
-    finally:
-        DRAW.on = False
+    assert state.drawings_last == []
+    state.requests["DebugUser:draw"].on = True
+    run_frames(instrumented, 1)
+    kinds = [(d["canvas"], d["kind"]) for d in state.drawings_last]
+    assert kinds == [("field", "circle"), ("image:top", "text")]
+    drawings, _ = frame_debug_data(state)
+    assert drawings.primitives[0].points == [100.0, 200.0, 50.0]
 
 
 def test_modify_publishes_and_can_be_pinned(instrumented: ModuleManager) -> None:
@@ -65,9 +62,10 @@ def test_modify_publishes_and_can_be_pinned(instrumented: ModuleManager) -> None
 
 def test_plots_and_stopwatches_collect_per_frame(instrumented: ModuleManager) -> None:
     run_frames(instrumented, 4)
-    assert list(STATE.plots["DebugUser:frame"].values)[-4:] == [(1, 1.0), (2, 2.0), (3, 3.0), (4, 4.0)]
-    assert len(STATE.stopwatches["DebugUser:work"].times_ns) >= 4
-    _, plots = frame_debug_data("cognition")
+    state = instrumented.debug
+    assert list(state.plots["DebugUser:frame"].values)[-4:] == [(1, 1.0), (2, 2.0), (3, 3.0), (4, 4.0)]
+    assert len(state.stopwatches["DebugUser:work"].times_ns) >= 4
+    _, plots = frame_debug_data(state)
     assert "DebugUser:frame" in plots.names and plots.values[plots.names.index("DebugUser:frame")] == 4.0
 
 
@@ -194,11 +192,14 @@ def test_a_wrong_canvas_or_camera_name_is_an_error_not_a_silent_fallback() -> No
     no view looks."""
     import numpy as np
 
-    from tafel.debug.concepts import drawing
+    from tafel.debug import Canvas
     from tafel.representations.perception import Camera, SegmentedImage
 
     with pytest.raises(ValueError, match="no drawing canvas 'feild'; the canvases are field, robot, image:top, image:bottom"):
-        drawing("feild")
+        Canvas.of("feild")
+    with pytest.raises(ValueError, match="no drawing canvas 'image:Top'"):
+        Canvas.image("Top")
+    assert Canvas.image(Camera.bottom) is Canvas.IMAGE_BOTTOM and Canvas.of("robot") is Canvas.ROBOT
     image = SegmentedImage(top_hsv=np.ones((2, 2, 3), np.uint8), bottom_hsv=np.zeros((2, 2, 3), np.uint8))
     with pytest.raises(ValueError, match="no camera 'Top': the cameras are 'top' and 'bottom'"):
         image.hsv("Top")

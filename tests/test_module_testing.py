@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from tafel.core import Module, bounded, provides, representation, requires, uses
 from tafel.core.framework.representation import fields_of
 from tafel.core.testing import ModuleHarness, assert_close, differences, replay_module, strategy_for
-from tafel.debug.concepts import STATE, modify, request
+from tafel.debug import Canvas, DebugRequest, ModifyValue, Plot
 from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler
 from tafel.modules.modeling.simple_ball_modeler import SimpleBallModeler
 from tafel.modules.motion.head_motion import HeadMotion
@@ -162,20 +162,47 @@ def test_an_override_for_a_field_that_does_not_exist_is_an_error() -> None:
     assert dict((f.name, f.range) for f in fields_of(MtSpeed))["distance"] == (0.0, 9000.0)
 
 
+@requires(FrameInfo)
+@provides(MtPosition)
+class MtLeaky(Module):
+    """Declares debug outputs a test switches on and pins."""
+
+    draw = DebugRequest("a request a test switches on")
+    gain = ModifyValue(1.0, "the factor of x")
+    x = Plot("the x it wrote")
+
+    def execute(self) -> None:
+        self.mt_position.x = self.gain() * self.frame_info.frame_number
+        self.x.add(self.mt_position.x)
+        if self.draw:
+            self.draw.canvas(Canvas.FIELD).circle(self.mt_position.x, 0.0, 10.0)
+
+
 # Two tests in this order: the first leaves a pin and a switched-on request, the second must not see them.
-LEAKY = request("MtLeaky:draw", "a request a test switches on")
-
-
 def test_isolation_part_one_leaves_debug_state_behind() -> None:
-    LEAKY.on = True
-    modify("MtLeaky:gain", 1.0)
-    STATE.modifies["MtLeaky:gain"].pinned, STATE.modifies["MtLeaky:gain"].pinned_value = True, 5.0
-    assert modify("MtLeaky:gain", 1.0) == 5.0
+    harness = ModuleHarness(MtLeaky)
+    harness.debug.requests["MtLeaky:draw"].on = True
+    harness.debug.modifies["MtLeaky:gain"].pinned, harness.debug.modifies["MtLeaky:gain"].pinned_value = True, 5.0
+    assert harness.execute(frames=2)[MtPosition].x == 10.0
 
 
 def test_isolation_part_two_starts_clean() -> None:
-    assert LEAKY.on is False
-    assert modify("MtLeaky:gain", 1.0) == 1.0
+    harness = ModuleHarness(MtLeaky)
+    assert harness.debug.requests["MtLeaky:draw"].on is False
+    assert harness.execute(frames=2)[MtPosition].x == 2.0
+    assert harness.debug.drawings() == []
+
+
+def test_the_harness_shows_the_modules_drawings_and_plots() -> None:
+    harness = ModuleHarness(MtLeaky)
+    harness.execute(frames=3)
+    assert harness.debug.plot_values("MtLeaky:x") == [1.0, 2.0, 3.0]
+    harness.module.draw.on = True  # the module's own switch: the harness's context's entry
+    harness.execute(frames=1)
+    assert harness.debug.drawings(Canvas.FIELD) == [
+        {"canvas": "field", "kind": "circle", "points": [4.0, 0.0, 10.0], "color": "black", "width": 1.0, "text": ""}]
+    assert harness.debug.drawings("image:top") == []
+    assert ModuleHarness(MtLeaky).debug.requests["MtLeaky:draw"].on is False  # another harness: its own
 
 
 # ------------------------------------------------------------------------------ recorded situations

@@ -155,6 +155,9 @@ class ModuleManager:
         #: called before and after each frame (for example debug commands between frames)
         self.before_frame: list[Callable[[], None]] = []
         self.after_frame: list[Callable[[], None]] = []
+        #: this context's debug outputs (``tafel.debug``'s ``DebugState``), made by the first module that
+        #: declares some; core never looks inside
+        self.debug: Any = None
         self._modules = list(modules)
         self._by_name = module_names(self._modules)
         # the module set is fixed for the manager's life: its declarations are read once (tools ask often)
@@ -461,6 +464,9 @@ class ModuleManager:
             object.__setattr__(instance, snake_case(rep.__name__), writer_view(target, mark, slot.undo, cls.__name__))
             slot.write_marks.append((rep.__name__, mark))
         object.__setattr__(instance, "parameters", make_parameters(cls, self._parameters.get(cls.__name__)))
+        attach = getattr(cls, "__tafel_attach__", None)
+        if attach is not None:  # class-level declarations that take this context's values (tafel.debug's outputs)
+            attach(instance, self)
         try:
             cls.__init__(instance)
         except Exception as exc:

@@ -70,6 +70,13 @@ class ModuleHarness:
         return self.manager.module(self.module_class.__name__)
 
     @property
+    def debug(self) -> Any:
+        """The module's debug outputs in this harness (``tafel.debug.DebugState``; None when it declares
+        none): ``drawings(canvas)`` of the last frame, ``plot_values(name)``, ``requests[name].on = True``,
+        ``modifies[name]``, ``stopwatches[name]``. Each harness has its own: nothing leaks between tests."""
+        return self.manager.debug
+
+    @property
     def time_s(self) -> float:
         """The time of the last frame executed (s)."""
         return self.time_ns * 1e-9

@@ -1,8 +1,9 @@
 """The pytest plugin of Tafel (entry point ``pytest11``).
 
-Fixtures: ``run_module``, ``module_harness``, ``replay_module``, ``log_slice``, ``assert_close``. After
-every test, process-wide debug state (debug requests, pinned modify values, drawings, plots) is reset
-through ``tafel.core.testing.RESET_HOOKS``, so one test's pin cannot leak into the next.
+Fixtures: ``run_module``, ``module_harness``, ``replay_module``, ``log_slice``, ``assert_close``. Debug
+outputs (requests, modify values, drawings, plots) belong to each manager, so each harness has its own;
+process-wide state a package keeps is reset after every test through ``tafel.core.testing.RESET_HOOKS``,
+so one test's leftovers cannot leak into the next.
 """
 
 from __future__ import annotations

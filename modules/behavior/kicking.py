@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass, fields
 
 from tafel.core import bounded
-from tafel.debug.concepts import modify_fields
+from tafel.debug import ModifyParameters
 from tafel.representations import field
 from tafel.representations.geometry import Pose2D
 from tafel.representations.modeling import BallModel, RobotPose
@@ -30,8 +30,13 @@ class KickParameters:
     """rad the robot may face away from the kick direction for a kick"""
 
 
-#: the kick's parameters tried live (modify values Kick:NAME)
+#: the kick's parameters tried live: modify values Kick:NAME, declared by the modules that kick
 KICK_TUNED = tuple(item.name for item in fields(KickParameters))
+
+
+def kick_tuning() -> ModifyParameters:
+    """The declaration of the kick's modify values, for a module that kicks: ``kick_tuning = kick_tuning()``."""
+    return ModifyParameters(KICK_TUNED, "the kick, tried live: modify:set Kick:NAME", prefix="Kick")
 
 
 def goal_direction(ball: BallModel, pose: RobotPose, odometry: Odometry) -> float:
@@ -48,8 +53,8 @@ def approach_and_kick(ball: BallModel, kick_direction: float, p: KickParameters,
     of the kicking foot, else walk to the point ``behind`` mm behind the ball on the kick's line, the
     kicking foot in line with the ball. Returns that point and direction (mm, mm, rad; robot frame).
 
-    Every field of ``p`` is a modify value ``Kick:NAME``: pinned by a debug client, it is tried live."""
-    p = modify_fields("Kick", p, KICK_TUNED)
+    The caller passes ``p`` with its modify values ``Kick:NAME`` applied (``kick_tuning``), so a value pinned
+    by a debug client is tried live."""
     foot = Foot.left if ball.y >= 0 else Foot.right
     side = p.foot_offset if foot is Foot.left else -p.foot_offset
     # behind the ball on the kick's line, shifted so that the kicking foot (not the centre) meets it

@@ -9,8 +9,8 @@ import math
 from dataclasses import dataclass, field
 
 from tafel.core import Module, bounded, fields_of, provides, requires, uses
-from tafel.debug import drawing, request
-from tafel.modules.behavior.kicking import KickParameters, goal_direction
+from tafel.debug import Canvas, DebugRequest
+from tafel.modules.behavior.kicking import KickParameters, goal_direction, kick_tuning
 from tafel.modules.behavior.options import OptionRunner
 from tafel.modules.behavior.options.soccer import FREE_KICKS, OWN_GOAL_X, PlaySoccer
 from tafel.modules.behavior.paths import Disc
@@ -23,7 +23,6 @@ from tafel.representations.motion_control import MotionInfo, MotionRequest, Moti
 from tafel.representations.obstacles import ROBOT_RADIUS, Obstacles
 from tafel.representations.team import PlayerRole, TeamMates
 
-DRAW = request("SoccerBehavior:draw_target", "where the player wants to be, on the field canvas")
 OPPONENT_PENALTY_MARK_X = pitch.LENGTH / 2 - pitch.PENALTY_MARK_DISTANCE
 
 
@@ -72,6 +71,9 @@ class SoccerBehavior(Module):
     motion_request: MotionRequest
     activation_graph: ActivationGraph
     option_graph: OptionGraph
+
+    show_target = DebugRequest("where the player wants to be, on the field canvas", name="SoccerBehavior:draw_target")
+    kick_tuning = kick_tuning()
 
     @dataclass
     class Parameters(KickParameters):
@@ -147,8 +149,8 @@ class SoccerBehavior(Module):
         out.motion, out.target_x, out.target_y, out.target_rotation = MotionType.walk_to, x, y, rotation
 
     def draw_target(self, x: float, y: float, rotation: float) -> None:
-        if DRAW:
-            drawing("field").robot_pose(x, y, rotation, color="orange")
+        if self.show_target:
+            self.show_target.canvas(Canvas.FIELD).robot_pose(x, y, rotation, color="orange")
 
     # ------------------------------------------------------------------------- what they ask about
     def opponents_set_play(self) -> bool:

@@ -5,13 +5,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from tafel.core import Module, bounded, provides, requires, uses
-from tafel.debug import drawing, request
-from tafel.modules.behavior.kicking import KickParameters, approach_and_kick, goal_direction
+from tafel.debug import Canvas, DebugRequest
+from tafel.modules.behavior.kicking import KickParameters, approach_and_kick, goal_direction, kick_tuning
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType, Odometry
-
-DRAW = request("Striker:draw_target", "where the striker wants to stand, on the robot canvas")
 
 
 @requires(BallModel, Odometry, MotionInfo, FrameInfo)
@@ -36,6 +34,9 @@ class Striker(Module):
     robot_pose: RobotPose
     motion_request: MotionRequest
 
+    draw_target = DebugRequest("where the striker wants to stand, on the robot canvas")
+    kick_tuning = kick_tuning()
+
     @dataclass
     class Parameters(KickParameters):
         search_turn: float = bounded(0.0, 2.0, 0.6)
@@ -51,6 +52,7 @@ class Striker(Module):
             out.motion, out.walk_x, out.walk_y = MotionType.walk, 0.0, 0.0
             out.walk_rotation = p.search_turn
             return
-        target_x, target_y, direction = approach_and_kick(ball, goal_direction(ball, self.robot_pose, self.odometry), p, out)
-        if DRAW:
-            drawing("robot").robot_pose(target_x, target_y, direction, color="orange")
+        target_x, target_y, direction = approach_and_kick(ball, goal_direction(ball, self.robot_pose, self.odometry),
+                                                        self.kick_tuning.apply(p), out)
+        if self.draw_target:
+            self.draw_target.canvas(Canvas.ROBOT).robot_pose(target_x, target_y, direction, color="orange")

@@ -6,7 +6,7 @@ import math
 from dataclasses import dataclass
 
 from tafel.core import Module, provides, requires, uses
-from tafel.debug.concepts import modify_fields
+from tafel.debug import ModifyParameters
 from tafel.representations.geometry import Pose2D
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel
@@ -75,6 +75,8 @@ class KalmanBallModeler(Module):
     odometry: Odometry
     ball_model: BallModel
 
+    tuning = ModifyParameters(TUNED, "tried live: modify:set KalmanBallModeler:NAME")
+
     @dataclass
     class Parameters:
         acceleration_noise: float = 1500.0
@@ -109,7 +111,7 @@ class KalmanBallModeler(Module):
         self.tuned = self.parameters  # this frame's parameters, with the modify values pinned by a debug client
 
     def execute(self) -> None:
-        self.tuned = p = modify_fields("KalmanBallModeler", self.parameters, TUNED)
+        self.tuned = p = self.tuning.apply(self.parameters)
         now_ns = self.frame_info.time_ns
         dt = p.nominal_dt
         if self.last_time_ns is not None and now_ns > self.last_time_ns:

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tafel.core import Module, bounded, provides, requires, uses
-from tafel.debug import drawing, plot, request
+from tafel.debug import Canvas, DebugRequest, Plot
 from tafel.modules.modeling.field_model import FIELD_MODEL, OWN_HALF
 from tafel.modules.modeling.mirror_hypotheses import SideBelief, fold, freshest_team_ball, twin
 from tafel.representations import field
@@ -21,7 +21,6 @@ from tafel.representations.perception import BallPercept, GoalPostPercept, LineP
 from tafel.representations.team import TeamMates
 
 KNOWN_POSE_STD, KNOWN_ROTATION_STD = 30.0, 0.03  # mm and rad: the particles' spread round a pose told (KnownPose)
-DRAW_PARTICLES = request("SelfLocator:draw_particles", "every particle and the estimate on the field canvas")
 
 
 @requires(Odometry, LinePercept, GoalPostPercept, FrameInfo)
@@ -64,6 +63,10 @@ class SelfLocator(Module):
     ball_percept: BallPercept
     team_mates: TeamMates
     robot_pose: RobotPose
+
+    draw_particles = DebugRequest("every particle and the estimate on the field canvas")
+    fit = Plot("how well the percepts fit the particles, a frame's mean weight")
+    side_odds = Plot("log odds that the pose is the right one of the mirrored twins")
 
     @dataclass
     class Parameters:
@@ -279,7 +282,7 @@ class SelfLocator(Module):
         p = self.parameters
         self.slow += p.alpha_slow * (fit - self.slow) if self.slow else fit
         self.fast += p.alpha_fast * (fit - self.fast) if self.fast else fit
-        plot("SelfLocator:fit", fit)
+        self.fit.add(fit)
         lost = self.fast < p.lost_ratio * self.slow
         if not lost and self.robot_pose.valid:
             return
@@ -317,12 +320,12 @@ class SelfLocator(Module):
                       and bool(self.evidence & {"circle", "post", "told"} or {"along", "across"} <= self.evidence)
                       and self.side.odds >= p.side_decided)
         pose.mirror_probability = 1.0 / (1.0 + math.exp(self.side.odds))
-        plot("SelfLocator:side_odds", self.side.odds)
+        self.side_odds.add(self.side.odds)
         pose.lost = lost or (self.trusted is not None and not pose.valid)
         if pose.valid:
             self.trusted = (pose.x, pose.y, pose.rotation)
-        if DRAW_PARTICLES:
-            canvas = drawing("field")
+        if self.draw_particles:
+            canvas = self.draw_particles.canvas(Canvas.FIELD)
             for x, y, heading in self.particles[:: max(1, len(self.particles) // 100)]:
                 canvas.line(x, y, x + 120 * math.cos(heading), y + 120 * math.sin(heading), color="gray")
             canvas.robot_pose(pose.x, pose.y, pose.rotation, color="blue" if pose.valid else "red", width=2)

@@ -16,8 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tafel.core import Module, bounded, provides, requires
-from tafel.debug import drawing, plot, request
-from tafel.debug.concepts import modify_fields
+from tafel.debug import Canvas, DebugRequest, ModifyParameters, Plot
 from tafel.modules.motion.inverse_kinematics import apply_leg_angles, leg_angles, pose
 from tafel.modules.motion.stand_motion import stand_pose
 from tafel.representations.geometry import Pose2D
@@ -26,7 +25,6 @@ from tafel.representations.motion import JOINT_COUNT, JOINT_INDEX, FsrData, Iner
 from tafel.representations.motion_control import Foot, MotionRequest, MotionSelection, MotionType, Odometry, WalkingEngineOutput
 from tafel.representations.nao import HIP_OFFSET_Z
 
-DRAW_STEPS = request("WalkingEngine:draw_steps", "planned footsteps and the walk target on the robot canvas")
 WALKING = (MotionType.walk, MotionType.walk_to)
 ARMS = [JOINT_INDEX[n] for n in ("LShoulderPitch", "RShoulderPitch")]
 STAND = stand_pose()  # arms and head while walking; apply_leg_angles copies it
@@ -44,6 +42,12 @@ class WalkingEngine(Module):
     fsr_data: FsrData
     walking_engine_output: WalkingEngineOutput
     odometry: Odometry
+
+    draw_steps = DebugRequest("planned footsteps and the walk target on the robot canvas; the capture plots")
+    tuning = ModifyParameters(TUNED, "tried live while the robot walks: modify:set WalkingEngine:NAME")
+    capture_x = Plot("mm the capture point is ahead of where the walk expects it (while draw_steps is on)")
+    capture_y = Plot("mm the capture point is left of where the walk expects it (while draw_steps is on)")
+    phase = Plot("share of the current step done, 0..1")
 
     @dataclass
     class Parameters:
@@ -128,7 +132,7 @@ class WalkingEngine(Module):
         self.rates = np.zeros(2)  # roll and pitch rate (rad/s), lightly filtered
 
     def execute(self) -> None:
-        self.tuned = modify_fields("WalkingEngine", self.parameters, TUNED)
+        self.tuned = self.tuning.apply(self.parameters)
         p, out = self.tuned, self.walking_engine_output
         now_ns = self.frame_info.time_ns
         dt = (now_ns - self.last_ns) * 1e-9 if self.last_ns is not None and now_ns > self.last_ns else 0.01
@@ -201,9 +205,9 @@ class WalkingEngine(Module):
             inward = (support_y - planned_y) * side - 10.0  # mm it may go towards the support foot (<= 0: none)
             wanted[1] = max(wanted[1] * side, min(inward, 0.0)) * side
             self.adjust += np.clip(wanted - self.adjust, -800.0 * dt, 800.0 * dt)  # mm/s the landing place moves
-        if DRAW_STEPS:
-            plot("WalkingEngine:capture_x", float(error[0]))
-            plot("WalkingEngine:capture_y", float(error[1]))
+        if self.draw_steps:
+            self.capture_x.add(float(error[0]))
+            self.capture_y.add(float(error[1]))
         return beyond
 
     def requested_velocity(self) -> tuple[np.ndarray, bool]:
@@ -233,8 +237,8 @@ class WalkingEngine(Module):
             self.last_target = wanted
         x, y = here.to_local(self.target[0], self.target[1])
         turn = math.remainder(self.target[2] - odometry.rotation, math.tau)
-        if DRAW_STEPS:
-            drawing("robot").robot_pose(float(self.target[0]), float(self.target[1]), float(self.target[2]), color="yellow")
+        if self.draw_steps:
+            self.draw_steps.canvas(Canvas.ROBOT).robot_pose(float(self.target[0]), float(self.target[1]), float(self.target[2]), color="yellow")
         if math.hypot(x, y) < p.target_tolerance and abs(turn) < p.target_tolerance / 400:
             return np.zeros(3), True
         far = math.hypot(x, y) > 400.0  # far away: face the target first, then turn to its rotation
@@ -262,10 +266,10 @@ class WalkingEngine(Module):
         if wanted[2] * side < 0:
             wanted[2] = 0.0
         self.step = wanted
-        if DRAW_STEPS:
+        if self.draw_steps:
             goal = self.goal(swing)
-            drawing("robot").rectangle(float(goal[0]) - 50, float(goal[1]) - 25 + side * 50, float(goal[0]) + 100,
-                                       float(goal[1]) + 25 + side * 50, color="white")
+            self.draw_steps.canvas(Canvas.ROBOT).rectangle(float(goal[0]) - 50, float(goal[1]) - 25 + side * 50,
+                                                           float(goal[0]) + 100, float(goal[1]) + 25 + side * 50, color="white")
 
     def goal(self, foot: Foot) -> np.ndarray:
         """Where a foot ends this step (x, y mm, yaw rad, relative to its place beside the torso)."""
@@ -296,7 +300,7 @@ class WalkingEngine(Module):
         position[ARMS[1]] -= p.arm_swing * swing_x / 100.0
         out.position = position
         out.stiffness = np.full(JOINT_COUNT, p.leg_stiffness)
-        plot("WalkingEngine:phase", phase)
+        self.phase.add(phase)
 
     def accumulate_odometry(self, before: np.ndarray, after: np.ndarray) -> None:
         """The torso moves against the support foot: its backward slide is the robot's forward motion."""

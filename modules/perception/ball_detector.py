@@ -9,10 +9,8 @@ import cv2
 import numpy as np
 
 from tafel.core import Module, provides, requires
-from tafel.debug import drawing, request, stopwatch
+from tafel.debug import Canvas, DebugRequest, Stopwatch
 from tafel.representations.perception import BallCandidate, BallImagePercept, CameraImageBottom, CameraImageTop
-
-DRAW_CANDIDATES = request("BallDetector:draw_candidates", "circle around every ball candidate in the images")
 
 
 @requires(CameraImageTop, CameraImageBottom)
@@ -25,6 +23,9 @@ class BallDetector(Module):
     camera_image_top: CameraImageTop
     camera_image_bottom: CameraImageBottom
     ball_image_percept: BallImagePercept
+
+    draw_candidates = DebugRequest("circle around every ball candidate in the images")
+    segmentation = Stopwatch("colour segmentation and blob check of one image")
 
     @dataclass
     class Parameters:
@@ -47,13 +48,13 @@ class BallDetector(Module):
             pixels = np.asarray(image.image)
             if pixels.size == 0:
                 continue
-            with stopwatch("BallDetector:segmentation"):
+            with self.segmentation:
                 candidates = self.candidates(camera, pixels)
             for candidate in candidates:
                 candidate.horizontal_fov, candidate.vertical_fov = image.horizontal_fov, image.vertical_fov
                 candidate.time_ns = image.time_ns
-                if DRAW_CANDIDATES:
-                    drawing(f"image:{camera}").circle(candidate.x, candidate.y, candidate.radius, color="orange")
+                if self.draw_candidates:
+                    self.draw_candidates.canvas(Canvas.image(camera)).circle(candidate.x, candidate.y, candidate.radius, color="orange")
             found += candidates
         found.sort(key=lambda c: -c.radius)
         self.ball_image_percept.candidates = found[: self.parameters.max_candidates]

@@ -13,13 +13,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from tafel.core import Module, provides, requires
-from tafel.debug import drawing, plot, request
+from tafel.debug import Canvas, DebugRequest, Plot
 from tafel.modules.perception.image_geometry import focal_lengths, ground_point, pixel_ray, projectable
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import CameraMatrix, CameraMatrixBuffer
 from tafel.representations.perception import BallCandidate, BallImagePercept, BallPercept
-
-DRAW_PERCEPT = request("BallLocator:draw_percept", "the located ball in its image and on the robot canvas")
 
 
 @requires(BallImagePercept, CameraMatrixBuffer)
@@ -31,6 +29,9 @@ class BallLocator(Module):
     ball_image_percept: BallImagePercept
     camera_matrix_buffer: CameraMatrixBuffer
     ball_percept: BallPercept
+
+    draw_percept = DebugRequest("the located ball in its image and on the robot canvas")
+    distance = Plot("mm from the robot to the located ball")
 
     @dataclass
     class Parameters:
@@ -54,10 +55,10 @@ class BallLocator(Module):
             percept.x, percept.y = float(position[0]), float(position[1])
             percept.image_x, percept.image_y, percept.radius = candidate.x, candidate.y, candidate.radius
             percept.camera = candidate.camera
-            plot("BallLocator:distance", math.hypot(percept.x, percept.y))
-            if DRAW_PERCEPT:
-                drawing(f"image:{candidate.camera}").circle(candidate.x, candidate.y, candidate.radius, color="blue", width=2)
-                drawing("robot").circle(percept.x, percept.y, BALL_RADIUS, color="orange")
+            self.distance.add(math.hypot(percept.x, percept.y))
+            if self.draw_percept:
+                self.draw_percept.canvas(Canvas.image(candidate.camera)).circle(candidate.x, candidate.y, candidate.radius, color="blue", width=2)
+                self.draw_percept.canvas(Canvas.ROBOT).circle(percept.x, percept.y, BALL_RADIUS, color="orange")
             return
 
     def locate(self, candidate: BallCandidate, matrix: CameraMatrix) -> np.ndarray | None:

@@ -8,13 +8,11 @@ import cv2
 import numpy as np
 
 from tafel.core import Module, bounded, provides, requires, uses
-from tafel.debug import drawing, request
+from tafel.debug import Canvas, DebugRequest
 from tafel.modules.perception.field_color_provider import WHITE_SATURATION_MAX
 from tafel.modules.perception.image_geometry import camera_views
 from tafel.representations.motion import CameraMatrixBuffer
 from tafel.representations.perception import CameraImageBottom, CameraImageTop, FieldBoundary, FieldColor, SegmentedImage
-
-DRAW = request("FieldBoundaryDetector:draw", "the field boundary in both images")
 
 
 def lower_hull(xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -85,6 +83,8 @@ class FieldBoundaryDetector(Module):
     camera_matrix_buffer: CameraMatrixBuffer
     field_boundary: FieldBoundary
 
+    draw = DebugRequest("the field boundary in both images")
+
     @dataclass
     class Parameters:
         cell: int = bounded(2, 32, 4)
@@ -124,8 +124,8 @@ class FieldBoundaryDetector(Module):
             white = (hsv[..., 1] <= WHITE_SATURATION_MAX) & (hsv[..., 2] >= p.white_value * self.segmented_image.white(camera))
             rows = self.boundary(green, horizon, white)
             setattr(self.field_boundary, camera, rows)
-            if DRAW:
-                canvas = drawing(f"image:{camera}")
+            if self.draw:
+                canvas = self.draw.canvas(Canvas.image(camera))
                 step = max(1, len(rows) // 16)
                 for x in range(0, len(rows) - step, step):
                     canvas.line(x, float(rows[x]), x + step, float(rows[x + step]), color="yellow", width=2)

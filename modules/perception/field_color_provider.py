@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 
 from tafel.core import Module, bounded, provides, requires, uses
-from tafel.debug import plot
+from tafel.debug import Plot
 from tafel.modules.perception.image_geometry import camera_views
 from tafel.representations.motion import CameraMatrixBuffer
 from tafel.representations.perception import CameraImageBottom, CameraImageTop, FieldColor, SegmentedImage
@@ -49,6 +49,8 @@ class FieldColorProvider(Module):
     camera_matrix_buffer: CameraMatrixBuffer
     field_color: FieldColor
     segmented_image: SegmentedImage
+
+    hue = Plot("the field colour's hue, OpenCV 0..180")
 
     @dataclass
     class Parameters:
@@ -115,4 +117,4 @@ class FieldColorProvider(Module):
         out.saturation_min += weight * (saturation - out.saturation_min)
         out.value_min += weight * (value - out.value_min)
         out.valid = True
-        plot("FieldColorProvider:hue", out.hue)
+        self.hue.add(out.hue)

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tafel.core import Module, bounded, provides, requires
-from tafel.debug import drawing, request
+from tafel.debug import Canvas, DebugRequest
 from tafel.modules.perception.image_geometry import ImageProjection, camera_views
 from tafel.representations.field import GOAL_POST_DIAMETER
 from tafel.representations.motion import CameraMatrixBuffer
@@ -20,8 +20,6 @@ from tafel.representations.perception import (
     GoalPostPercept,
     SegmentedImage,
 )
-
-DRAW = request("GoalPostDetector:draw", "goal posts found, in the images and on the robot canvas")
 
 
 def column_groups(flags: np.ndarray) -> list[tuple[int, int]]:
@@ -48,6 +46,8 @@ class GoalPostDetector(Module):
     field_boundary: FieldBoundary
     camera_matrix_buffer: CameraMatrixBuffer
     goal_post_percept: GoalPostPercept
+
+    draw = DebugRequest("goal posts found, in the images and on the robot canvas")
 
     @dataclass
     class Parameters:
@@ -94,9 +94,9 @@ class GoalPostDetector(Module):
             post = self.post(camera, white, first, last, top, projection)
             if post is not None:
                 found.append(post)
-                if DRAW:
-                    drawing(f"image:{camera}").line(post.image_x, 0, post.image_x, height, color="yellow", width=2)
-                    drawing("robot").circle(post.x, post.y, GOAL_POST_DIAMETER / 2, color="yellow", width=2)
+                if self.draw:
+                    self.draw.canvas(Canvas.image(camera)).line(post.image_x, 0, post.image_x, height, color="yellow", width=2)
+                    self.draw.canvas(Canvas.ROBOT).circle(post.x, post.y, GOAL_POST_DIAMETER / 2, color="yellow", width=2)
         return found
 
     def post(self, camera: str, white: np.ndarray, first: int, last: int, top: np.ndarray, projection: ImageProjection) -> GoalPost | None:

@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 
 from tafel.core import Module, bounded, provides, requires, uses
-from tafel.debug import drawing, request, stopwatch
+from tafel.debug import Canvas, DebugRequest, Stopwatch
 from tafel.modules.perception.image_geometry import ImageProjection, camera_views, own_body_mask
 from tafel.representations.field import CENTER_CIRCLE_DIAMETER, LINE_WIDTH
 from tafel.representations.motion import CameraMatrixBuffer
@@ -25,8 +25,6 @@ from tafel.representations.perception import (
     SegmentedImage,
 )
 
-DRAW_POINTS = request("LineDetector:draw_points", "line points in the images and on the robot canvas")
-DRAW_LINES = request("LineDetector:draw_lines", "fitted segments and the centre circle on the robot canvas")
 CIRCLE_RADIUS = CENTER_CIRCLE_DIAMETER / 2
 
 
@@ -88,6 +86,10 @@ class LineDetector(Module):
     ball_image_percept: BallImagePercept
     line_percept: LinePercept
 
+    draw_points = DebugRequest("line points in the images and on the robot canvas")
+    draw_lines = DebugRequest("fitted segments and the centre circle on the robot canvas")
+    fit = Stopwatch("fitting segments and the centre circle to the points")
+
     @dataclass
     class Parameters:
         step: int = bounded(1, 32, 5)
@@ -129,11 +131,11 @@ class LineDetector(Module):
             found = found[np.linspace(0, len(found) - 1, self.parameters.max_points).astype(int)]
         out.points = found.astype(np.float32)
         out.segments, out.circle_seen = [], False
-        with stopwatch("LineDetector:fit"):
+        with self.fit:
             rest = self.fit_circle(found)
             out.segments = self.fit_segments(rest)
-        if DRAW_LINES:
-            canvas = drawing("robot")
+        if self.draw_lines:
+            canvas = self.draw_lines.canvas(Canvas.ROBOT)
             for segment in out.segments:
                 canvas.line(segment.x1, segment.y1, segment.x2, segment.y2, color="white", width=3)
             if out.circle_seen:
@@ -163,13 +165,13 @@ class LineDetector(Module):
             extent = np.linalg.norm(ends - starts, axis=1)
             keep = bordered & hit0 & hit1 & hit & (extent <= p.max_run_ground) & (np.linalg.norm(middles, axis=1) <= p.max_distance)
             found.append(middles[keep])
-            if DRAW_POINTS:
-                canvas = drawing(f"image:{camera}")
+            if self.draw_points:
+                canvas = self.draw_points.canvas(Canvas.image(camera))
                 for px, py in zip(((xs0 + xs1) / 2.0)[keep], ((ys0 + ys1) / 2.0)[keep]):
                     canvas.circle(float(px), float(py), 1.5, color="red")
         result = np.concatenate(found) if found else np.zeros((0, 2))
-        if DRAW_POINTS:
-            canvas = drawing("robot")
+        if self.draw_points:
+            canvas = self.draw_points.canvas(Canvas.ROBOT)
             for x, y in result:
                 canvas.circle(float(x), float(y), 15, color="red")
         return result

@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 
 from tafel.core import Module, bounded, provides, requires
-from tafel.debug import drawing, request, stopwatch
+from tafel.debug import Canvas, DebugRequest, Stopwatch
 from tafel.modules.perception.ball_classifier import BallClassifier, features
 from tafel.modules.perception.image_geometry import ImageProjection, camera_views
 from tafel.representations.field import BALL_RADIUS
@@ -24,8 +24,6 @@ from tafel.representations.perception import (
     FieldColor,
     SegmentedImage,
 )
-
-DRAW_CANDIDATES = request("SPLBallDetector:draw_candidates", "every ball candidate (grey) and accepted ball (blue) in the images")
 
 
 def carpet(hsv: np.ndarray, green: np.ndarray) -> tuple[float, float]:
@@ -73,6 +71,9 @@ class SPLBallDetector(Module):
     field_boundary: FieldBoundary
     camera_matrix_buffer: CameraMatrixBuffer
     ball_image_percept: BallImagePercept
+
+    draw_candidates = DebugRequest("every ball candidate (grey) and accepted ball (blue) in the images")
+    image = Stopwatch("the candidates of one image, found and checked")
 
     @dataclass
     class Parameters:
@@ -126,7 +127,7 @@ class SPLBallDetector(Module):
         if self.parameters.classifier and self.model is None:
             self.model = BallClassifier()
         for camera, image, projection in camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer):
-            with stopwatch("SPLBallDetector:image"):
+            with self.image:
                 hsv, green = self.segmented_image.hsv(camera), self.segmented_image.green(camera)
                 spots = self.spots(self.strict_green(hsv, green), self.field_boundary.rows(camera), projection, self.dark_pixels(hsv, green))
                 white = self.segmented_image.white(camera)
@@ -139,8 +140,8 @@ class SPLBallDetector(Module):
                     self.examined.append((camera, spot, score))
                     if score and self.parameters.classifier:
                         score = self.classify(hsv, green, spot, score)
-                    if DRAW_CANDIDATES:
-                        drawing(f"image:{camera}").circle(spot.x, spot.y, spot.radius, color="blue" if score else "gray")
+                    if self.draw_candidates:
+                        self.draw_candidates.canvas(Canvas.image(camera)).circle(spot.x, spot.y, spot.radius, color="blue" if score else "gray")
                     if score:
                         found.append(self.candidate(camera, image, spot, score))
         found.sort(key=lambda c: -c.fill)

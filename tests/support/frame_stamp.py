@@ -8,12 +8,9 @@ Run it with ``tafel run --add-module cognition:tests.support.frame_stamp:FrameSt
 from __future__ import annotations
 
 from tafel.core import Module, provides, representation, requires
-from tafel.debug import drawing, plot, request
+from tafel.debug import Canvas, DebugRequest, Plot
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.perception import CameraImageTop
-
-STAMP = request("FrameStamp:draw", "the frame's number in the top image")
-PLOT = request("FrameStamp:plot", "a plot named FrameStamp:frame")
 
 
 @representation
@@ -26,10 +23,14 @@ class FrameStampOutput:
 @requires(FrameInfo, CameraImageTop)
 @provides(FrameStampOutput)
 class FrameStamp(Module):
+    draw = DebugRequest("the frame's number in the top image")
+    plot = DebugRequest("a plot named FrameStamp:frame")
+    frame = Plot("the frame number, while FrameStamp:plot is on")
+
     def execute(self) -> None:
         frame = self.frame_info.frame_number
         self.frame_stamp_output.frame = frame
-        if STAMP:
-            drawing("image:top").text(12, 40, str(frame), color="yellow", size=24)
-        if PLOT:
-            plot("FrameStamp:frame", frame)
+        if self.draw:
+            self.draw.canvas(Canvas.IMAGE_TOP).text(12, 40, str(frame), color="yellow", size=24)
+        if self.plot:
+            self.frame.add(frame)

@@ -7,6 +7,7 @@ from collections.abc import Sequence
 
 from tafel.core.framework.dot import contexts_dot
 from tafel.core.runtime.platform import available_platforms, load_platform
+from tafel.debug.outputs import describe_outputs
 from tafel.tools.launch.program import prepare
 
 
@@ -71,6 +72,8 @@ def command_modules(args: argparse.Namespace, extra: Sequence[str]) -> int:
             print(f"  warning: the platform consumes {rep}, but no module provides it (defaults are sent)")
         for module in sorted(set(plan.disabled)):
             print(f"  disabled by configuration: {module}")
+        for line in describe_outputs(manager.module_classes):  # what debug clients can switch, pin and watch
+            print(f"  {line}")
     return 0
 
 

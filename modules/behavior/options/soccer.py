@@ -115,7 +115,7 @@ class Striker(Option["SoccerBehavior"]):
         """Walk behind the ball on the kick's line and kick (``kicking.approach_and_kick``)."""
         ball, p, out = b.ball_model, b.parameters, b.motion_request
         direction = b.indirect_direction() if b.indirect else goal_direction(ball, b.robot_pose, b.odometry)
-        approach_and_kick(ball, direction, p, out)
+        approach_and_kick(ball, direction, b.kick_tuning.apply(p), out)
         if out.motion is MotionType.walk_to and math.hypot(ball.x, ball.y) > p.near_ball:  # near it a duel is no push
             out.target_x, out.target_y = waypoint(out.target_x, out.target_y, b.robot_discs(), p.obstacle_margin)
 
@@ -307,7 +307,7 @@ class ShootOut(Option["SoccerBehavior"]):
             direction = math.atan2(gy - ball.y, gx - ball.x)
         else:
             direction = goal_direction(ball, pose, b.odometry)
-        approach_and_kick(ball, direction, p, b.motion_request)
+        approach_and_kick(ball, direction, b.kick_tuning.apply(p), b.motion_request)
 
     @state
     def keep_line(self, b: SoccerBehavior) -> None:
