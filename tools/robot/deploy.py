@@ -36,8 +36,8 @@ from importlib import metadata
 from pathlib import Path
 
 #: the shipped configuration (the repository's config/ folder)
-DEFAULT_CONFIG = Path(__file__).resolve().parent.parent / "config"
-REPOSITORY = Path(__file__).resolve().parent.parent
+REPOSITORY = Path(__file__).resolve().parents[2]  # tools/robot/deploy.py: the project, what the wheel is built from
+DEFAULT_CONFIG = REPOSITORY / "config"
 ROBOT_SCRIPT = Path(__file__).resolve().parent / "deploy_robot.sh"
 #: dependencies a robot never needs: the simulators (PyBullet has no wheels for any robot anyway)
 SIMULATOR_DEPENDENCIES = frozenset({"mujoco", "pybullet"})

@@ -42,7 +42,7 @@ from tafel.platforms.images import posed_image
 from tafel.representations.motion import CameraMatrix
 from tafel.tools.simulation.scene_frames import LabelledFrame, Perception, random_ball_scene
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]  # tools/simulation/: the checkout, for its test images
 DEFAULT_REAL = REPO / "tests" / "data" / "real_images"
 RESOLUTIONS = ("640x480", "320x240")
 
