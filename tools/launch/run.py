@@ -84,6 +84,15 @@ def stuck_timeout(config: dict[str, Any]) -> float:
     return float(config.get("runtime", {}).get("stuck_timeout_s", STUCK_TIMEOUT_S))
 
 
+def stop_servers(debug: Any, *viewers: Any) -> None:
+    """What a run started around its runtime ends with it: viewers, the source watcher, the debug server."""
+    for viewer in viewers:
+        if viewer is not None:
+            viewer.stop()
+    if debug is not None:
+        debug.server.stop()
+
+
 def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, ContextPlan], recorder: Recorder | None,
                  limits: Limits, config: dict[str, Any]) -> int:
     # The loops share the interpreter with the debug server's network thread: hand the lock over within
@@ -141,11 +150,7 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
     try:
         stats = runtime.run(limits)
     finally:
-        for viewer in (live, web, watcher):
-            if viewer is not None:
-                viewer.stop()
-        if debug is not None:
-            debug.server.stop()
+        stop_servers(debug, live, web, watcher)
     print_summary(type(platform).name, "lockstep", stats, runtime.wall_s, runtime.time_ns * 1e-9, stop_reason(signals, runtime.end_reason),
                   simulated=True)
     report_recording(recorder)
@@ -214,11 +219,7 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
     try:
         stats = runtime.run(limits)
     finally:
-        for viewer in (live, web, watcher):
-            if viewer is not None:
-                viewer.stop()
-        if debug is not None:
-            debug.server.stop()
+        stop_servers(debug, live, web, watcher)
     realtime = stats.get("motion", ContextStats("motion")).realtime
     notes = ([f"motion: {realtime}"] if realtime else []) + [f"notice: {notice}" for notice in runtime.notices]
     ran = max((s.wall_s for s in stats.values()), default=0.0)
