@@ -3,6 +3,7 @@ segmented by it once for every detector."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import cv2
@@ -16,6 +17,19 @@ from tafel.representations.perception import CameraImageBottom, CameraImageTop, 
 
 #: the most saturation (0..255) a pixel may have and still count as white (lines, posts, the ball)
 WHITE_SATURATION_MAX = 70
+
+
+def below(hsv: np.ndarray, channel: int, threshold: float) -> np.ndarray:
+    """``hsv[..., channel] < threshold`` (h x w bool) for an image of uint8 channels, by OpenCV: the channel
+    taken out once and thresholded, faster than numpy on the interleaved channel (same pixels)."""
+    if hsv.size == 0 or not math.isfinite(threshold):
+        return hsv[..., channel] < threshold
+    limit = math.ceil(threshold) - 1  # for integers, v < t exactly when v <= ceil(t) - 1
+    if limit < 0:
+        return np.zeros(hsv.shape[:2], bool)
+    if limit >= 255:
+        return np.ones(hsv.shape[:2], bool)
+    return cv2.threshold(cv2.extractChannel(hsv, channel), limit, 1, cv2.THRESH_BINARY_INV)[1].view(bool)
 
 
 def green_mask(color: FieldColor, hsv: np.ndarray) -> np.ndarray:

@@ -11,6 +11,7 @@ import numpy as np
 from tafel.core import Module, bounded, provides, requires
 from tafel.debug import Canvas, DebugRequest, Stopwatch
 from tafel.modules.perception.ball_classifier import BallClassifier, features
+from tafel.modules.perception.field_color_provider import below
 from tafel.modules.perception.image_geometry import ImageProjection, camera_views
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import CameraMatrixBuffer
@@ -26,9 +27,16 @@ from tafel.representations.perception import (
 )
 
 
-def carpet(hsv: np.ndarray, green: np.ndarray) -> tuple[float, float]:
-    """The carpet's median value and saturation (sampled), the measures of the light; (128, 128) without carpet."""
-    sampled = hsv[::4, ::4][green[::4, ::4]]
+def carpet_sample(hsv: np.ndarray, green: np.ndarray) -> np.ndarray:
+    """The carpet's pixels (N x 3, HSV) on every fourth row and column: what the measures of the light use."""
+    return hsv[::4, ::4][green[::4, ::4]]
+
+
+def carpet(hsv: np.ndarray, green: np.ndarray, sampled: np.ndarray | None = None) -> tuple[float, float]:
+    """The carpet's median value and saturation (sampled), the measures of the light; (128, 128) without carpet.
+    ``sampled``: ``carpet_sample(hsv, green)`` where it is at hand."""
+    if sampled is None:
+        sampled = carpet_sample(hsv, green)
     if len(sampled) < 10:
         return 128.0, 128.0
     return float(np.median(sampled[:, 2])), float(np.median(sampled[:, 1]))
@@ -129,8 +137,11 @@ class SPLBallDetector(Module):
         for camera, image, projection in camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer):
             with self.image:
                 hsv, green = self.segmented_image.hsv(camera), self.segmented_image.green(camera)
-                spots = self.spots(self.strict_green(hsv, green), self.field_boundary.rows(camera), projection, self.dark_pixels(hsv, green))
+                sampled = carpet_sample(hsv, green)  # one sample of the carpet for every measure of the light below
+                spots = self.spots(self.strict_green(hsv, green, sampled), self.field_boundary.rows(camera), projection,
+                                   self.dark_pixels(hsv, green, sampled))
                 white = self.segmented_image.white(camera)
+                light: tuple[float, float] | None = None
                 for spot in spots:
                     score, under_post = self.check(hsv, green, spot, white)
                     if under_post:  # perhaps a ball behind a post, merged with it in the image: look beside it
@@ -139,47 +150,51 @@ class SPLBallDetector(Module):
                         spot = beside or spot
                     self.examined.append((camera, spot, score))
                     if score and self.parameters.classifier:
-                        score = self.classify(hsv, green, spot, score)
+                        light = light or carpet(hsv, green, sampled)
+                        score = self.classify(hsv, green, spot, score, light)
                     if self.draw_candidates:
                         self.draw_candidates.canvas(Canvas.image(camera)).circle(spot.x, spot.y, spot.radius, color="blue" if score else "gray")
                     if score:
                         found.append(self.candidate(camera, image, spot, score))
         found.sort(key=lambda c: -c.fill)
 
-    def classify(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, score: float) -> float:
+    def classify(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, score: float, light: tuple[float, float] | None = None) -> float:
         """``score`` if the classifier takes the spot for a ball, else 0. A ball cut by the image's edge is
         left to the checks: its square reaches out of the image, and the classifier, which learned far
-        more edge-cut things that are no ball (dark corners, the hall), turns down the balls there too."""
+        more edge-cut things that are no ball (dark corners, the hall), turns down the balls there too.
+        ``light``: ``carpet(hsv, green)`` where it is at hand."""
         assert self.model is not None
         height, width = green.shape
         side = 1.1 * spot.radius  # the classifier's square round the spot
         if not self.parameters.classifier_at_edge and not (side <= spot.x <= width - side and side <= spot.y <= height - side):
             return score
-        row = features(hsv, green, spot.x, spot.y, spot.radius, *carpet(hsv, green))
+        row = features(hsv, green, spot.x, spot.y, spot.radius, *(light or carpet(hsv, green)))
         return score if float(self.model.scores(row)[0]) >= self.parameters.classifier_min else 0.0
 
-    def dark_pixels(self, hsv: np.ndarray, green: np.ndarray) -> np.ndarray | None:
+    def dark_pixels(self, hsv: np.ndarray, green: np.ndarray, sampled: np.ndarray | None = None) -> np.ndarray | None:
         """Pixels darker than ``black_contrast`` times the carpet's median value (the ball's black patches
-        are); None without carpet to compare with."""
-        sampled = hsv[::4, ::4, 2][green[::4, ::4]]
-        if sampled.size < 10:
+        are); None without carpet to compare with. ``sampled``: ``carpet_sample(hsv, green)`` where it is at hand."""
+        if sampled is None:
+            sampled = carpet_sample(hsv, green)
+        if len(sampled) < 10:
             return None
-        return hsv[..., 2] < self.parameters.black_contrast * float(np.median(sampled))
+        return below(hsv, 2, self.parameters.black_contrast * float(np.median(sampled[:, 2])))
 
-    def strict_green(self, hsv: np.ndarray, green: np.ndarray) -> np.ndarray:
-        """The green mask without the pixels much less saturated than the carpet's median."""
+    def strict_green(self, hsv: np.ndarray, green: np.ndarray, sampled: np.ndarray | None = None) -> np.ndarray:
+        """The green mask without the pixels much less saturated than the carpet's median. ``sampled``:
+        ``carpet_sample(hsv, green)`` where it is at hand."""
         if not green.any():
             return green
-        saturation = hsv[..., 1]
-        sampled = saturation[::4, ::4][green[::4, ::4]]
-        median = float(np.median(sampled)) if sampled.size else float(np.median(saturation[green]))
-        return green & (saturation >= self.parameters.strict_saturation * median)
+        if sampled is None:
+            sampled = carpet_sample(hsv, green)
+        median = float(np.median(sampled[:, 1])) if len(sampled) else float(np.median(hsv[..., 1][green]))
+        return green & ~below(hsv, 1, self.parameters.strict_saturation * median)
 
     @staticmethod
     def dark_share(dark: np.ndarray, xs: np.ndarray, ys: np.ndarray, radii: np.ndarray) -> np.ndarray:
         """Share of dark pixels in the square of half side ``radii`` round each (x, y), by an integral image."""
         height, width = dark.shape
-        integral = cv2.integral(dark.astype(np.uint8))
+        integral = cv2.integral(dark.view(np.uint8) if dark.dtype == np.bool_ else dark.astype(np.uint8))
         x0, x1 = np.clip((xs - radii).astype(int), 0, width), np.clip((xs + radii).astype(int) + 1, 0, width)
         y0, y1 = np.clip((ys - radii).astype(int), 0, height), np.clip((ys + radii).astype(int) + 1, 0, height)
         area = np.maximum((x1 - x0) * (y1 - y0), 1)
@@ -219,10 +234,11 @@ class SPLBallDetector(Module):
             return []
         thickness = cv2.distanceTransform(solid, cv2.DIST_L2, 3)
         peaks = (thickness >= p.min_radius) & (thickness >= cv2.dilate(thickness, np.ones((3, 3), np.uint8)))
-        ys, xs = np.nonzero(peaks)
-        if len(xs) == 0:
+        index = np.flatnonzero(peaks)  # a third of np.nonzero's time on a 2-D mask, same order
+        if len(index) == 0:
             return []
-        radii = thickness[ys, xs]
+        ys, xs = np.divmod(index, width)
+        radii = thickness.ravel()[index]
         ys = ys + top
         centres, hits = projection.to_ground(xs, ys, BALL_RADIUS)
         points = np.column_stack([centres, np.full(len(xs), BALL_RADIUS)])
@@ -231,22 +247,31 @@ class SPLBallDetector(Module):
         fits = hits & (radii >= p.size_low * expected) & (radii <= p.size_high * expected + 1.0)
         if known:
             fits &= ys >= boundary[xs]  # the centre lies on the field; only the top may reach over its edge
+        xs, ys, radii, expected = xs[fits], ys[fits], radii[fits], expected[fits]
         if dark is not None:  # a ball has black patches: spots without dark pixels near their centre are none
             # (a field without any green leaves the distance transform unbounded: radii beyond the image are none)
-            fits &= self.dark_share(dark, xs, ys, np.clip(radii, 1.0, max(height, width))) >= p.dark_spot_min
+            patched = self.dark_share(dark, xs, ys, np.clip(radii, 1.0, max(height, width))) >= p.dark_spot_min
+            xs, ys, radii, expected = xs[patched], ys[patched], radii[patched], expected[patched]
         # the spots most like a ball's size first: lines are thinner, robots and the border thicker
-        order = np.argsort(np.abs(np.log(np.maximum(radii[fits], 0.5) / np.maximum(expected[fits], 0.5))))
+        order = np.argsort(np.abs(np.log(np.maximum(radii, 0.5) / np.maximum(expected, 0.5))))
+        xs, ys, radii, expected = xs[order], ys[order], radii[order], expected[order]
+        # greedily, each spot taken keeps the ones after it that are too close to it out (all at once)
+        free = np.ones(len(xs), bool)
         chosen: list[Spot] = []
-        for x, y, r, e in zip(xs[fits][order], ys[fits][order], radii[fits][order], expected[fits][order]):
-            if all((x - s.x) ** 2 + (y - s.y) ** 2 > (s.expected * 1.5) ** 2 for s in chosen):
-                spot = Spot(float(x), float(y), float(max(r, 0.5 * (r + e))), float(e))
-                if spot.x < e or spot.x > width - 1 - e or spot.y > height - 1 - e:
-                    spot = self.inside_image(spot, ~green)  # moved: it may now be a spot chosen already
-                    if any((spot.x - s.x) ** 2 + (spot.y - s.y) ** 2 <= (s.expected * 1.5) ** 2 for s in chosen):
-                        continue
-                chosen.append(spot)
-                if len(chosen) >= p.max_spots:
-                    break
+        start = 0
+        while len(chosen) < p.max_spots and start < len(xs):
+            start += int(np.argmax(free[start:]))
+            if not free[start]:
+                break
+            x, y, r, e = xs[start], ys[start], radii[start], expected[start]
+            start += 1
+            spot = Spot(float(x), float(y), float(max(r, 0.5 * (r + e))), float(e))
+            if spot.x < e or spot.x > width - 1 - e or spot.y > height - 1 - e:
+                spot = self.inside_image(spot, ~green)  # moved: it may now be a spot chosen already
+                if any((spot.x - s.x) ** 2 + (spot.y - s.y) ** 2 <= (s.expected * 1.5) ** 2 for s in chosen):
+                    continue
+            chosen.append(spot)
+            free[start:] &= (xs[start:] - spot.x) ** 2 + (ys[start:] - spot.y) ** 2 > (spot.expected * 1.5) ** 2
         return chosen
 
     def check(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, beside_post: bool = False) -> tuple[float, bool]:
@@ -259,29 +284,38 @@ class SPLBallDetector(Module):
         reach = int(math.ceil(r * 1.7)) + 1
         x0, x1 = max(0, int(spot.x) - reach), min(width, int(spot.x) + reach + 1)
         y0, y1 = max(0, int(spot.y) - reach), min(height, int(spot.y) + reach + 1)
-        yy, xx = np.mgrid[y0:y1, x0:x1]
-        d = np.hypot(xx - spot.x, yy - spot.y)
+        d = np.hypot(np.arange(x0, x1)[None, :] - spot.x, np.arange(y0, y1)[:, None] - spot.y)
         inside, around = d <= 0.9 * r, (d >= 1.2 * r) & (d <= 1.7 * r)
-        if inside.sum() < 3 or around.sum() < 3:
+        n_inside, n_around = np.count_nonzero(inside), np.count_nonzero(around)
+        if n_inside < 3 or n_around < 3:
             return 0.0, False
         patch_green, patch = green[y0:y1, x0:x1], hsv[y0:y1, x0:x1]
-        green_inside, green_around = patch_green[inside].mean(), patch_green[around].mean()
         solid = inside & ~patch_green  # the ball's own pixels: green ones would count as dark next to white
-        if solid.sum() < 3:
+        if np.count_nonzero(solid) < 3:
+            return 0.0, False
+        if not beside_post:
+            first, posts = self.post_columns(hsv, green, spot, white)
+            if 0 <= int(spot.x) - first < len(posts) and posts[int(spot.x) - first]:
+                return 0.0, True
+        # the tests one by one, the cheapest first: most spots fail one of the first
+        green_inside = np.count_nonzero(patch_green & inside) / n_inside
+        green_around = np.count_nonzero(patch_green & around) / n_around
+        if green_inside > p.green_inside_max or green_around < p.green_around_min:
+            return 0.0, False
+        saturation = float(patch[..., 1][inside].mean())
+        if saturation > p.saturation_max:
             return 0.0, False
         value = patch[..., 2][solid].astype(float)
         bright = np.percentile(value, 90)
-        dark = float((value < p.dark_ratio * bright).mean())
-        saturation = float(patch[..., 1][inside].mean())
+        is_dark = value < p.dark_ratio * bright
+        dark = np.count_nonzero(is_dark) / len(value)
+        if not p.dark_share_min <= dark <= p.dark_share_max:
+            return 0.0, False
         carpet = patch[..., 2][around & patch_green]
         field_value = float(np.median(carpet if carpet.size >= 3 else patch[..., 2][around]))
-        black = value[value < p.dark_ratio * bright]
+        black = value[is_dark]
         darkest = float(black.mean()) if black.size else math.inf  # the black patches' value
-        first, posts = self.post_columns(hsv, green, spot, white)
-        if not beside_post and 0 <= int(spot.x) - first < len(posts) and posts[int(spot.x) - first]:
-            return 0.0, True
-        if (green_inside > p.green_inside_max or green_around < p.green_around_min or not p.dark_share_min <= dark <= p.dark_share_max
-                or saturation > p.saturation_max or darkest > p.black_contrast * field_value):
+        if darkest > p.black_contrast * field_value:
             return 0.0, False
         return float(min(1.0, 0.5 + dark + 0.3 * green_around - green_inside)), False
 
@@ -307,22 +341,30 @@ class SPLBallDetector(Module):
         post = np.nonzero(posts)[0]
         if len(post) == 0:
             return None
-        best: tuple[int, float, int] | None = None  # (extent px, centre x, row)
-        for row in range(max(0, int(spot.y - 2 * spot.radius)), min(height, int(spot.y + 2 * spot.radius) + 1)):
-            solid = ~green[row]
-            solid[first : first + len(posts)] &= ~posts
-            for edge, step in ((first + int(post.max()) + 1, 1), (first + int(post.min()) - 1, -1)):
-                if not (0 <= edge < width and solid[edge]):
-                    continue
-                far = edge
-                while 0 <= far + step < width and solid[far + step]:
-                    far += step
-                extent = abs(far - edge) + 1
-                if extent <= 2 * spot.expected + 2 and (best is None or extent > best[0]):
-                    best = (extent, far - step * spot.expected, row)
-        if best is None or best[0] < 0.5 * spot.expected:
+        low, high = max(0, int(spot.y - 2 * spot.radius)), min(height, int(spot.y + 2 * spot.radius) + 1)
+        if low >= high:
             return None
-        return Spot(float(best[1]), float(best[2]), spot.expected, spot.expected)
+        solid = ~green[low:high]  # the rows searched
+        solid[:, first : first + len(posts)] &= ~posts
+        # per row, right of the post then left of it: the non-green run from the post's side outwards
+        extents, centres = [], []
+        for edge, step in ((first + int(post.max()) + 1, 1), (first + int(post.min()) - 1, -1)):
+            if not 0 <= edge < width:
+                extents.append(np.zeros(high - low, int))
+                centres.append(np.zeros(high - low))
+                continue
+            run = solid[:, edge::step] if step == 1 else solid[:, edge::-1]
+            extent = np.where(run.all(axis=1), run.shape[1], np.argmin(run, axis=1))  # 0 where the edge is green
+            extents.append(extent)
+            centres.append((edge + step * (extent - 1)) - step * spot.expected)
+        extent = np.column_stack(extents).ravel()  # row by row, right before left: the order the first longest is taken in
+        usable = (extent > 0) & (extent <= 2 * spot.expected + 2)
+        if not usable.any():
+            return None
+        best = int(np.argmax(np.where(usable, extent, -1)))
+        if extent[best] < 0.5 * spot.expected:
+            return None
+        return Spot(float(np.column_stack(centres).ravel()[best]), float(low + best // 2), spot.expected, spot.expected)
 
     @staticmethod
     def candidate(camera: str, image: CameraImage, spot: Spot, score: float) -> BallCandidate:
