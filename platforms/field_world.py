@@ -44,6 +44,7 @@ class FieldPart:
     texture: bool = False
     in_cameras: bool = True
     absorbs: bool = False
+    material: str = ""  # an engine's own look for it, where the engine has one (MuJoCo: the realistic carpet's texture)
 
 
 CARPET_RGBA = (0.18, 0.55, 0.2, 1.0)
@@ -65,14 +66,16 @@ def _flat_box(name: str, x1: float, y1: float, x2: float, y2: float, half_width:
                      WHITE, collides=False, yaw=math.atan2(y2 - y1, x2 - x1))
 
 
-def field_parts(ball: tuple[float, float] = (1.0, 0.0), ball_color: str = "spl") -> list[FieldPart]:
-    """Hall, carpet, lines and marks (visual only), goals and the ball at ``ball`` (m)."""
+def field_parts(ball: tuple[float, float] = (1.0, 0.0), ball_color: str = "spl", look: SceneLook | None = None) -> list[FieldPart]:
+    """Hall, carpet, lines and marks (visual only), goals and the ball at ``ball`` (m); with a ``look``
+    (``--realism``) also the hall's clutter, visible nets and its carpet green."""
     if ball_color not in BALL_COLORS:
         raise ValueError(f"ball colour {ball_color!r}: choose one of {', '.join(BALL_COLORS)}")
     half_x, half_y = field.LENGTH / 2 * M, field.WIDTH / 2 * M
     carpet = (half_x + field.BORDER_STRIP * M, half_y + field.BORDER_STRIP * M, 0.1)
     hall_x, hall_y = carpet[0] + HALL_MARGIN, carpet[1] + HALL_MARGIN
-    parts = [FieldPart("carpet", "plane", (0.0, 0.0, 0.0), carpet, CARPET_RGBA)]
+    carpet_rgba = (*look.carpet, 1.0) if look else CARPET_RGBA
+    parts = [FieldPart("carpet", "plane", (0.0, 0.0, 0.0), carpet, carpet_rgba, material="carpet" if look and look.texture else "")]
     # the hall's floor: four strips round the carpet, not a plane under it (PyBullet's CPU renderer would
     # draw the hidden part too, at twice the cost of a frame)
     strip_x, strip_y = (hall_x - carpet[0]) / 2, (hall_y - carpet[1]) / 2
@@ -95,6 +98,10 @@ def field_parts(ball: tuple[float, float] = (1.0, 0.0), ball_color: str = "spl")
     for side, (x, y) in (("opponent", posts[0]), ("own", posts[2])):
         parts.append(FieldPart(f"goal_{side}_bar", "capsule", (x * M, -y * M, h), (r,), WHITE, collides=False, end=(x * M, y * M, h)))
     parts += goal_nets()
+    if look and look.nets:
+        parts += net_strands()
+    if look and look.clutter:
+        parts += hall_clutter(look.seed)
     ball_r = field.BALL_RADIUS * M
     rgba = WHITE if ball_color == "spl" else ORANGE_BALL_RGBA
     parts.append(FieldPart("ball", "sphere", (ball[0], ball[1], ball_r), (ball_r,), rgba, mass=field.BALL_MASS,
@@ -117,6 +124,138 @@ def goal_nets() -> list[FieldPart]:
               ("right", side_x[0], -post_y, h / 2, (side_x[1], t, h / 2)), ("roof", side_x[0], 0.0, h + t, (side_x[1], outer_y + t, t))]
     return [FieldPart(f"goal_{side}_net_{name}", "box", (sign * x, y, z), size, NET_RGBA, in_cameras=False, absorbs=True)
             for sign, side in ((1.0, "opponent"), (-1.0, "own")) for name, x, y, z, size in panels]
+
+
+# ---------------------------------------------------------------------------------- the realistic hall
+@dataclass(frozen=True)
+class SceneLook:
+    """What ``--realism`` adds to the world: clutter in the hall, nets the cameras see, the carpet's green
+    (r, g, b 0..1) and whether it has a texture (``carpet_texture``), all from one seed."""
+
+    seed: int
+    carpet: tuple[float, float, float]
+    texture: float = 0.0
+    clutter: bool = True
+    nets: bool = True
+
+
+NET_STRAND_RGBA = (0.8, 0.8, 0.82, 1.0)
+NET_STRAND = 0.004  # m: half the thickness of a net's cord as the cameras see it
+NET_MESH = 0.1  # m between cords
+
+
+def net_strands() -> list[FieldPart]:
+    """The nets' cords as the cameras see them: thin boxes over each panel of ``goal_nets``, every
+    ``NET_MESH``; they only show (the panels stop the ball)."""
+    strands = []
+    for panel in goal_nets():
+        centre, half = np.array(panel.position), np.array(panel.size)
+        thin = int(np.argmin(half))
+        u, v = (axis for axis in range(3) if axis != thin)
+        for along, across in ((u, v), (v, u)):
+            count = int(2 * half[across] / NET_MESH)
+            for k in range(count + 1):
+                position = centre.copy()
+                position[across] += -half[across] + 2 * half[across] * k / max(1, count)
+                size = np.full(3, NET_STRAND)
+                size[along] = half[along]
+                strands.append(FieldPart(f"{panel.name}_cord{len(strands)}", "box", tuple(position), tuple(size), NET_STRAND_RGBA,
+                                         collides=False))
+    return strands
+
+
+TROUSERS = ((0.1, 0.12, 0.25), (0.05, 0.05, 0.06), (0.55, 0.5, 0.38), (0.35, 0.36, 0.38), (0.2, 0.25, 0.4))
+SHIRTS = ((0.85, 0.85, 0.85), (0.1, 0.1, 0.12), (0.7, 0.15, 0.12), (0.15, 0.3, 0.6), (0.9, 0.75, 0.2), (0.3, 0.5, 0.3))
+CASE_RGBA = ((0.06, 0.06, 0.07, 1.0), (0.12, 0.12, 0.13, 1.0), (0.25, 0.25, 0.27, 1.0), (0.7, 0.7, 0.72, 1.0))
+TABLE_RGBA = ((0.85, 0.85, 0.83, 1.0), (0.55, 0.4, 0.25, 1.0), (0.3, 0.3, 0.32, 1.0))
+
+
+def hall_clutter(seed: int) -> list[FieldPart]:
+    """Tables, equipment cases, people's legs, robots waiting at the carpet's edge and boards on the walls,
+    placed round the carpet from ``seed``; they only show (nothing collides with them)."""
+    rng = np.random.default_rng([seed, 53])
+    carpet_x, carpet_y = field.LENGTH / 2 * M + field.BORDER_STRIP * M, field.WIDTH / 2 * M + field.BORDER_STRIP * M
+    hall_x, hall_y = carpet_x + HALL_MARGIN, carpet_y + HALL_MARGIN
+    parts: list[FieldPart] = []
+
+    def place(near: float, far: float) -> tuple[float, float, float]:
+        """A point on the hall floor ``near`` to ``far`` m beyond the carpet's edge, facing the field."""
+        side = rng.integers(4)
+        gap = rng.uniform(near, far)
+        if side < 2:
+            x, y = (carpet_x + gap) * (1 if side == 0 else -1), rng.uniform(-carpet_y, carpet_y)
+        else:
+            x, y = rng.uniform(-carpet_x, carpet_x), (carpet_y + gap) * (1 if side == 2 else -1)
+        return float(x), float(y), float(math.atan2(-y, -x))
+
+    def box(name: str, x: float, y: float, z: float, size: tuple[float, float, float], rgba: tuple[float, ...], yaw: float) -> None:
+        parts.append(FieldPart(name, "box", (x, y, z), size, (*rgba[:3], 1.0), collides=False, yaw=yaw))
+
+    for i in range(4):  # tables, some with a case or a laptop-grey box on them
+        x, y, yaw = place(0.8, 2.2)
+        rgba = TABLE_RGBA[rng.integers(len(TABLE_RGBA))]
+        box(f"hall_table{i}", x, y, 0.73, (0.8, 0.4, 0.02), rgba, yaw)
+        c, s = math.cos(yaw), math.sin(yaw)
+        for j, (lx, ly) in enumerate(((0.75, 0.35), (0.75, -0.35), (-0.75, 0.35), (-0.75, -0.35))):
+            box(f"hall_table{i}_leg{j}", x + c * lx - s * ly, y + s * lx + c * ly, 0.355, (0.02, 0.02, 0.355), (0.3, 0.3, 0.3), yaw)
+        if rng.random() < 0.6:
+            box(f"hall_table{i}_case", x + rng.uniform(-0.4, 0.4), y, 0.9, (0.25, 0.18, 0.15), CASE_RGBA[rng.integers(len(CASE_RGBA))], yaw)
+    for i in range(7):  # equipment cases on the floor: dark, as in real halls
+        x, y, yaw = place(0.2, 2.5)
+        size = (rng.uniform(0.2, 0.45), rng.uniform(0.15, 0.3), rng.uniform(0.12, 0.3))
+        box(f"hall_case{i}", x, y, size[2], size, CASE_RGBA[rng.integers(len(CASE_RGBA))], yaw + rng.normal(0.0, 0.3))
+    for i in range(8):  # people: two legs, shoes and the lower body of a shirt
+        x, y, yaw = place(0.15, 2.5)
+        trousers, shirt = TROUSERS[rng.integers(len(TROUSERS))], SHIRTS[rng.integers(len(SHIRTS))]
+        c, s = math.cos(yaw), math.sin(yaw)
+        for j, side in enumerate((-0.1, 0.1)):
+            lx, ly = x - s * side, y + c * side
+            parts.append(FieldPart(f"hall_person{i}_leg{j}", "cylinder", (lx, ly, 0.47), (0.07, 0.4), (*trousers, 1.0), collides=False))
+            box(f"hall_person{i}_shoe{j}", lx + c * 0.05, ly + s * 0.05, 0.04, (0.14, 0.05, 0.04), (0.1, 0.1, 0.1) if rng.random() < 0.6 else (0.9, 0.9, 0.9), yaw)
+        box(f"hall_person{i}_body", x, y, 1.2, (0.12, 0.22, 0.35), shirt, yaw)
+    for i in range(3):  # robots waiting beside the field, sitting: white and grey
+        x, y, yaw = place(0.1, 0.6)
+        c, s = math.cos(yaw), math.sin(yaw)
+        box(f"hall_robot{i}_legs", x + c * 0.08, y + s * 0.08, 0.05, (0.12, 0.08, 0.05), (0.85, 0.85, 0.85), yaw)
+        box(f"hall_robot{i}_torso", x, y, 0.2, (0.05, 0.08, 0.1), (0.9, 0.9, 0.9), yaw)
+        box(f"hall_robot{i}_head", x, y, 0.35, (0.06, 0.065, 0.06), (0.88, 0.88, 0.88), yaw)
+        box(f"hall_robot{i}_arms", x, y, 0.2, (0.03, 0.11, 0.08), (0.35, 0.35, 0.37), yaw)
+    for i in range(6):  # boards, doors and banners on the walls
+        width, height = rng.uniform(0.5, 1.5), rng.uniform(0.5, 1.2)
+        colour = tuple(rng.uniform(0.1, 0.9, 3))
+        along = rng.uniform(-0.8, 0.8)
+        if i % 2:
+            box(f"hall_board{i}", (hall_x - 0.06) * (1 if i % 4 == 1 else -1), along * hall_y, height + rng.uniform(0.0, 0.8),
+                (0.01, width, height), colour, 0.0)
+        else:
+            box(f"hall_board{i}", along * hall_x, (hall_y - 0.06) * (1 if i % 4 == 0 else -1), height + rng.uniform(0.0, 0.8),
+                (width, 0.01, height), colour, 0.0)
+    return parts
+
+
+def scene_look(seed: int, greens: list[tuple[float, float, float]], texture: float, clutter: bool, nets: bool) -> SceneLook:
+    """The scene of run ``seed``: one of ``greens`` for the carpet, the rest as the level says."""
+    green = greens[int(np.random.default_rng([seed, 59]).integers(len(greens)))]
+    return SceneLook(seed=seed, carpet=tuple(float(c) for c in green), texture=texture, clutter=clutter, nets=nets)  # type: ignore[arg-type]
+
+
+def carpet_texture(look: SceneLook, size: int = 256) -> np.ndarray:
+    """One metre of the carpet (``size`` x ``size`` RGB, tiling without seams): its green with fibre
+    noise and soft worn patches, seeded; ``look.texture`` is the pattern's strength."""
+    rng = np.random.default_rng([look.seed, 61])
+    fibres = rng.standard_normal((size, size))
+    patches = np.fft.ifft2(np.fft.fft2(rng.standard_normal((size, size))) * _low_pass(size, 10.0)).real
+    patches /= max(1e-9, float(patches.std()))
+    pattern = 1.0 + look.texture * (0.6 * fibres + 0.4 * patches)
+    rgb = np.clip(np.array(look.carpet)[None, None, :] * pattern[:, :, None], 0.0, 1.0)
+    return np.round(rgb * 255).astype(np.uint8)
+
+
+def _low_pass(size: int, wavelength: float) -> np.ndarray:
+    """A Gaussian low-pass in the frequency domain keeping patterns longer than ``wavelength`` texels."""
+    f = np.fft.fftfreq(size)
+    fx, fy = np.meshgrid(f, f)
+    return np.exp(-(fx**2 + fy**2) * (wavelength**2) / 2.0)
 
 
 # ------------------------------------------------------------------------------------- the SPL ball

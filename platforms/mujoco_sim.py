@@ -53,6 +53,12 @@ class MujocoRobot:
         """The MuJoCo name of the ``top`` or ``bottom`` camera."""
         return f"{self.prefix}{name}_camera"
 
+    def camera_rotation(self, data: Any, name: str) -> np.ndarray:
+        """The ``top`` or ``bottom`` camera's orientation (3x3; columns forward, left, up in the world).
+        MuJoCo's camera axes are right, up and back."""
+        right, up, back = data.cam_xmat[self.model.camera(self.camera(name)).id].reshape(3, 3).T
+        return np.column_stack([-back, -right, up])
+
     def joint_angles(self, data: Any) -> np.ndarray:
         return data.qpos[self.joint_qpos].copy()
 
@@ -158,8 +164,9 @@ class MujocoPlatform(SimulatedRobotPlatform):
         self.viewer: Any = None
 
     def build(self, contexts: frozenset[str], viewer: bool) -> None:
-        xml = mjcf(offscreen=(max(self.width, 640), max(self.height, 480)), timestep=TIMESTEP, ball_color=self.ball_color)
-        self.model = mujoco.MjModel.from_xml_string(xml, mjcf_assets(self.ball_color))
+        xml = mjcf(offscreen=(max(self.width, 640), max(self.height, 480)), timestep=TIMESTEP, ball_color=self.ball_color,
+                   look=self.scene_look, shadows=self.shadows)
+        self.model = mujoco.MjModel.from_xml_string(xml, mjcf_assets(self.ball_color, self.scene_look))
         self.data = mujoco.MjData(self.model)
         self.robot = MujocoRobot(self.model)
         self.torque_limits = TorqueLimits(self.model, [self.robot])
@@ -174,7 +181,7 @@ class MujocoPlatform(SimulatedRobotPlatform):
         try:
             for camera in ("top", "bottom"):
                 renderer = mujoco.Renderer(self.model, self.height, self.width)
-                renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = 0
+                renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = int(self.shadows)
                 renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
                 self.renderers[camera] = renderer
         except Exception as exc:  # noqa: BLE001 - the GL stack raises several kinds
@@ -222,6 +229,9 @@ class MujocoPlatform(SimulatedRobotPlatform):
         renderer = self.renderers[camera]
         renderer.update_scene(self.data, camera=self.robot.camera(camera))
         return renderer.render().copy()
+
+    def camera_rotation(self, camera: str) -> np.ndarray:
+        return self.robot.camera_rotation(self.data, camera)
 
     def pose_joints(self, angles: np.ndarray) -> None:
         self.data.qpos[self.robot.joint_qpos] = angles

@@ -29,7 +29,7 @@ import numpy as np
 
 from tafel.core.runtime.platform import PlatformError, PlatformOptionError
 from tafel.platforms.field_world import NET_FRICTION, FieldPart, ball_mesh, ball_texture_png, cylinder_mesh, field_parts
-from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, fsr_sites, joint_motor, urdf
+from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, fsr_sites, joint_motor, sun_direction, urdf
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import JOINT_NAMES
@@ -192,7 +192,7 @@ class PybulletPlatform(SimulatedRobotPlatform):
         pybullet.setPhysicsEngineParameter(numSolverIterations=50, deterministicOverlappingPairs=1, physicsClientId=c)
         self.bodies: dict[str, int] = {}
         ball = (self.initial_ball[0] * M, self.initial_ball[1] * M)
-        for part in field_parts(ball, self.ball_color):
+        for part in field_parts(ball, self.ball_color, self.scene_look):
             self.bodies[part.name] = self._field_body(part)
         self._load_robot()
         self.previous_velocity = np.zeros(3)
@@ -414,21 +414,29 @@ class PybulletPlatform(SimulatedRobotPlatform):
         rgba, _ = self._camera_image(camera, segmentation=False)
         return np.asarray(rgba, dtype=np.uint8).reshape(self.height, self.width, 4)[:, :, :3].copy()
 
-    def _camera_image(self, camera: str, segmentation: bool) -> tuple[Any, Any]:
+    def _camera_pose(self, camera: str) -> tuple[np.ndarray, np.ndarray]:
+        """(position m, axes 3x3: columns forward, left, up) of the ``top`` or ``bottom`` camera in the world."""
         mount = next(m for m in CAMERAS if m.name == camera)
         state = pybullet.getLinkState(self.robot, self.head_link, computeForwardKinematics=True, physicsClientId=self.client)
         head_position, head_rotation = np.array(state[4]), _matrix(state[5])
         c, s = math.cos(mount.tilt), math.sin(mount.tilt)
         tilt = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])  # pitched down by the mount's tilt
-        eye = head_position + head_rotation @ (np.array(mount.position) * M)
-        axes = head_rotation @ tilt
+        return head_position + head_rotation @ (np.array(mount.position) * M), head_rotation @ tilt
+
+    def camera_rotation(self, camera: str) -> np.ndarray:
+        return self._camera_pose(camera)[1]
+
+    def _camera_image(self, camera: str, segmentation: bool) -> tuple[Any, Any]:
+        eye, axes = self._camera_pose(camera)
         view = pybullet.computeViewMatrix(eye.tolist(), (eye + axes[:, 0]).tolist(), axes[:, 2].tolist())
         projection = pybullet.computeProjectionMatrixFOV(math.degrees(VERTICAL_FOV), self.width / self.height, 0.01, 30.0)
         # lit from behind the camera and from above, like MuJoCo's headlight and sun: posts look alike
         light = -axes[:, 0] + np.array([0.0, 0.0, 1.0])
+        if self.shadows and self.scene_look:  # --realism: the hall's sun, where shadows fall the same way from every view
+            light = -np.array(sun_direction(self.scene_look.seed))
         flags = pybullet.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX if segmentation else pybullet.ER_NO_SEGMENTATION_MASK
         _, _, rgba, _, segments = pybullet.getCameraImage(self.width, self.height, view, projection, renderer=pybullet.ER_TINY_RENDERER,
-                                                          flags=flags, shadow=0, lightDirection=light.tolist(),
+                                                          flags=flags, shadow=int(self.shadows), lightDirection=light.tolist(),
                                                           lightAmbientCoeff=0.55, lightDiffuseCoeff=0.5, lightSpecularCoeff=0.0,
                                                           physicsClientId=self.client)
         return rgba, segments

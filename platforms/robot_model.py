@@ -13,9 +13,10 @@ import re
 from dataclasses import dataclass
 from xml.sax.saxutils import quoteattr
 
+import cv2
 import numpy as np
 
-from tafel.platforms.field_world import NET_FRICTION, ball_mesh, ball_texture_png, field_parts
+from tafel.platforms.field_world import NET_FRICTION, SceneLook, ball_mesh, ball_texture_png, carpet_texture, field_parts
 from tafel.representations import field
 from tafel.representations.nao import (
     ACCELEROMETER_POSITION,
@@ -209,10 +210,12 @@ def _body_xml(link: str, children: dict[str, list], indent: str) -> list[str]:
 VIEWER_ONLY_GROUP = 3
 
 
-def _field_xml(ball_color: str, robot_bits: int = ROBOT_GROUP) -> list[str]:
+def _field_xml(ball_color: str, robot_bits: int = ROBOT_GROUP, look: SceneLook | None = None) -> list[str]:
     lines = []
-    for part in field_parts(ball_color=ball_color):
+    for part in field_parts(ball_color=ball_color, look=look):
         rgba = _vec(part.rgba)
+        if part.material:
+            rgba = f'1 1 1 1" material="{part.material}'  # the material's texture gives the colour
         groups = f'contype="{WORLD_GROUP}" conaffinity="{WORLD_GROUP | robot_bits}"' if part.collides else 'contype="0" conaffinity="0"'
         groups += "" if part.in_cameras else f' group="{VIEWER_ONLY_GROUP}"'
         groups += f' priority="1" friction="{NET_FRICTION} 0.005 0.0001" solref="0.004 2"' if part.absorbs else ""  # its friction wins
@@ -251,13 +254,34 @@ def _ball_assets(ball_color: str) -> list[str]:
 
 
 BALL_TEXTURE_FILE = "spl_ball.png"
+CARPET_TEXTURE_FILE = "carpet.png"
 
 
-def mjcf_assets(ball_color: str = "spl") -> dict[str, bytes]:
+def _carpet_assets(look: SceneLook | None) -> list[str]:
+    """The realistic carpet's texture and material: one seeded metre, repeated over the carpet."""
+    if not (look and look.texture):
+        return []
+    return [f'<texture name="carpet" type="2d" file="{CARPET_TEXTURE_FILE}"/>',
+            '<material name="carpet" texture="carpet" texuniform="true" texrepeat="1 1" specular="0" shininess="0"/>']
+
+
+def mjcf_assets(ball_color: str = "spl", look: SceneLook | None = None) -> dict[str, bytes]:
     """The files ``mjcf`` refers to, for ``MjModel.from_xml_string(xml, assets)``: made here, never read from disk."""
-    if ball_color != "spl":
-        return {}
-    return {BALL_TEXTURE_FILE: ball_texture_png()}
+    assets = {BALL_TEXTURE_FILE: ball_texture_png()} if ball_color == "spl" else {}
+    if look and look.texture:
+        ok, png = cv2.imencode(".png", cv2.cvtColor(carpet_texture(look), cv2.COLOR_RGB2BGR))
+        if not ok:
+            raise RuntimeError("OpenCV could not encode the carpet's texture")
+        assets[CARPET_TEXTURE_FILE] = png.tobytes()
+    return assets
+
+
+def sun_direction(seed: int) -> tuple[float, float, float]:
+    """Where the hall's main light shines (a unit vector down and a little aside), seeded: shadows fall
+    a different way in each run with ``--realism``."""
+    rng = np.random.default_rng([seed, 67])
+    tilt, heading = rng.uniform(0.2, 0.6), rng.uniform(-math.pi, math.pi)
+    return math.sin(tilt) * math.cos(heading), math.sin(tilt) * math.sin(heading), -math.cos(tilt)
 
 
 #: sliding, torsional and rolling friction of the ball (MuJoCo's three coefficients)
@@ -318,9 +342,10 @@ def _robot_xml(index: int, robots: int, position: tuple[float, float]) -> tuple[
 
 
 def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002, ball_color: str = "spl",
-         robots: list[tuple[float, float]] | None = None) -> str:
+         robots: list[tuple[float, float]] | None = None, look: SceneLook | None = None, shadows: bool = False) -> str:
     """MuJoCo XML of the field with the ball (``ball_color`` spl or orange; see ``mjcf_assets``) and one
-    robot at the centre spot, or several at the given places (m) named by ``robot_prefix``."""
+    robot at the centre spot, or several at the given places (m) named by ``robot_prefix``; ``look`` and
+    ``shadows``: the realistic hall (``--realism``), its sun casting shadows from a seeded direction."""
     places = robots or [(0.0, 0.0)]
     parts = [_robot_xml(index, len(places), place) for index, place in enumerate(places)]
     every_robot = sum(robot_collision_bits(k, len(places))[0] for k in range(len(places)))
@@ -329,12 +354,13 @@ def mjcf(*, offscreen: tuple[int, int] = (640, 480), timestep: float = 0.002, ba
         '<mujoco model="tafel-nao-spl">',
         f'  <option timestep="{timestep}" integrator="implicitfast" cone="elliptic"/>',
         '  <compiler angle="radian" autolimits="true"/>',
-        f'  <visual><global offwidth="{width}" offheight="{height}"/><quality shadowsize="0" offsamples="0"/>'
+        f'  <visual><global offwidth="{width}" offheight="{height}"/><quality shadowsize="{1024 if shadows else 0}" offsamples="0"/>'
         '<headlight ambient="0.45 0.45 0.45" diffuse="0.5 0.5 0.5" specular="0 0 0"/></visual>',
-        "  <asset>", *("    " + a for a in _ball_assets(ball_color)), "  </asset>",
+        "  <asset>", *("    " + a for a in _ball_assets(ball_color) + _carpet_assets(look)), "  </asset>",
         "  <worldbody>",
-        '    <light name="sun" pos="0 0 6" dir="0 0 -1" directional="true" diffuse="0.6 0.6 0.6" castshadow="false"/>',
-        *("    " + line for line in _field_xml(ball_color, every_robot)),
+        f'    <light name="sun" pos="0 0 6" dir="{_vec(sun_direction(look.seed) if shadows and look else (0, 0, -1))}" '
+        f'directional="true" diffuse="0.6 0.6 0.6" castshadow="{"true" if shadows else "false"}"/>',
+        *("    " + line for line in _field_xml(ball_color, every_robot, look)),
         *("    " + line for body, _, _, _ in parts for line in body),
         "  </worldbody>",
         "  <equality>", *("    " + e for _, _, equalities, _ in parts for e in equalities), "  </equality>",

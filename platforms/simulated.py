@@ -21,8 +21,9 @@ from tafel.core.framework.manager import Blackboard
 from tafel.core.framework.values import Range, convert, refusal
 from tafel.core.runtime.platform import Platform, PlatformOptionError, seed_number
 from tafel.platforms.actuators import ActuatorGuard
-from tafel.platforms.field_world import BALL_COLORS
+from tafel.platforms.field_world import BALL_COLORS, scene_look
 from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS, NetworkedPlatform
+from tafel.platforms.realism import LEVELS, CameraRealism, image_shift, parse_realism, realism_level
 from tafel.platforms.robot_model import STANDING_HEIGHT
 from tafel.representations import field
 from tafel.representations.geometry import Pose2D
@@ -144,6 +145,16 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         self.ball_color = convert(self.options.get("ball_color") or "spl", str, where="--ball-color", choices=tuple(BALL_COLORS),
                                   error=PlatformOptionError)
         self.initial_pose = parse_pose(self.options.get("start") or DEFAULT_START)
+        #: --realism: off (the plain render), mild or full (config/realism.toml): the cameras' pipeline and the scene's look
+        self.realism = parse_realism(self.options.get("realism"))
+        self.realism_level = realism_level(self.realism)
+        self.camera_realism = {camera: CameraRealism(self.realism_level, self.seed, camera)
+                               for camera in ("top", "bottom")} if self.realism_level else {}
+        self.last_camera: dict[str, tuple[int, np.ndarray]] = {}  # camera -> (time_ns, rotation) at its last image
+        level = self.realism_level
+        #: what the engines add to the world with --realism (None: the plain scene)
+        self.scene_look = scene_look(self.seed, level.carpet_greens, level.carpet_texture, level.hall_clutter, level.goal_nets) if level else None
+        self.shadows = bool(level and level.shadows)
         self.viewer_requested = bool(self.options.get("viewer"))
         self.rng = np.random.default_rng(self.seed)
         self.stiffness = np.zeros(len(JOINT_NAMES))
@@ -184,6 +195,10 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         parser.add_argument("--viewer", action="store_true", help=f"{name}: open the {cls.engine} viewer (needs a display)")
         parser.add_argument("--camera-latency-ms", type=float, default=0.0, metavar="MS",
                             help=f"{name}: images are rendered at time t and delivered MS later, as on the NAO (30 to 40)")
+        parser.add_argument("--realism", nargs="?", const="full", default="off", choices=LEVELS, metavar="LEVEL",
+                            help=f"{name}: render what a real camera sees: off (default), mild or full (the bare option): "
+                                 "exposure, white balance, noise, motion blur, vignetting, YUV422 and JPEG, a hall with "
+                                 "clutter, goal nets, shadows, carpet greens; seeded by --seed (config/realism.toml)")
 
     def config_layers(self) -> list[str]:
         """The engine's layer, then ``orange_ball`` with ``--ball-color orange`` (it picks the orange detector)."""
@@ -217,6 +232,11 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
     def render(self, camera: str) -> np.ndarray:
         """The image of ``top`` or ``bottom`` (height x width x 3 RGB uint8)."""
         raise NotImplementedError
+
+    def camera_rotation(self, camera: str) -> np.ndarray | None:
+        """The camera's orientation now (3x3; columns forward, left, up in the world), for motion blur;
+        None where the engine does not say (no blur)."""
+        return None
 
     def world_state(self) -> Any:
         """The world as it is now, to render it later (only used with a camera latency)."""
@@ -352,11 +372,34 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
             self.tell_known_pose(blackboard)
         if context == "cognition" and self.cameras:
             taken_ns, images = self.images(time_ns)
+            if self.camera_realism:
+                images = self.realistic(images, time_ns)
             for camera, rep in (("top", CameraImageTop), ("bottom", CameraImageBottom)):
                 image = blackboard[rep]
                 image.image = images[camera]
                 image.time_ns = taken_ns
                 image.horizontal_fov, image.vertical_fov = self.fov()
+
+    def realistic(self, images: dict[str, np.ndarray], time_ns: int) -> dict[str, np.ndarray]:
+        """The rendered images as the real cameras would deliver them (``--realism``), blurred by how fast
+        each camera turned since its last image (measured on the world as it is now)."""
+        result = {}
+        for camera, image in images.items():
+            shift = (0.0, 0.0)
+            rotation = self.camera_rotation(camera)
+            if rotation is not None:
+                last = self.last_camera.get(camera)
+                if last is not None:
+                    pipeline = self.camera_realism[camera]
+                    shift = image_shift(last[1], rotation, (time_ns - last[0]) * 1e-9, pipeline.exposure_s, self.focal_px())
+                self.last_camera[camera] = (time_ns, rotation)
+            result[camera] = self.camera_realism[camera](image, shift)
+        return result
+
+    def focal_px(self) -> tuple[float, float]:
+        """(horizontal, vertical) focal length of the rendered images (px)."""
+        horizontal, vertical = self.fov()
+        return self.width / 2 / math.tan(horizontal / 2), self.height / 2 / math.tan(vertical / 2)
 
     def tell_known_pose(self, blackboard: Blackboard) -> None:
         """``KnownPose``: the last pose told, and after ``sim:move_robot -reset on`` a new one, where the

@@ -18,11 +18,15 @@ from typing import Any
 from tafel.core.framework.config import ConfigError, apply_overrides, check_config
 from tafel.core.framework.naming import did_you_mean
 from tafel.core.framework.representation import fields_of, get_representation
+from tafel.platforms.realism import LEVELS as REALISM_LEVELS
 from tafel.representations.field import BORDER_STRIP, LENGTH, WIDTH
 from tafel.tools.simulation.scenario_predicates import PREDICATES, REQUIRED, TIMING, Parameter
 
 PLATFORMS = ("mujoco", "pybullet")
 CONTEXTS = ("cognition", "motion")
+#: predicates that judge what the robot perceived: a scenario with one of them and cameras renders with
+#: ``realism = "full"`` unless its file says otherwise
+PERCEPTION_PREDICATES = ("ball_model_accurate",)
 #: N of a push: more throws the robot off the field instead of testing a fall (the simulators' limit)
 MAX_PUSH_N = 500.0
 #: s a scenario may last at the most (an hour of simulated time)
@@ -90,6 +94,8 @@ class Scenario:
     description: str = ""
     platform: str = "mujoco"
     cameras: bool = True
+    #: the simulator's --realism level (off, mild, full)
+    realism: str = "off"
     ball_velocity_mm_s: tuple[float, float] = (0.0, 0.0)
     overrides: tuple[str, ...] = ()
     perturbation: Perturbation = field(default_factory=Perturbation)
@@ -234,7 +240,7 @@ def _table_name(table: tuple[Any, ...]) -> str:
     return f"[{table[0]}]"
 
 
-TOP_KEYS = ["name", "description", "platform", "cameras", "duration_s", "required_success_rate", "set",
+TOP_KEYS = ["name", "description", "platform", "cameras", "realism", "duration_s", "required_success_rate", "set",
             "robots", "ball", "perturbation", "events", "success"]
 PERTURBATION_KINDS = {"robot_x_mm": "number", "robot_y_mm": "number", "robot_rotation_deg": "number", "ball_x_mm": "number",
                       "ball_y_mm": "number", "ball_velocity_mm_s": "number", "sensor_noise": "range"}
@@ -267,12 +273,19 @@ def load_scenario(path: str | Path) -> Scenario:
     if not success:
         raise f.error((), None, "a scenario needs at least one [[success]] table with a predicate; "
                                 f"predicates: {', '.join(PREDICATES)}")
+    conditions = tuple(_condition(f, ("success", i), entry, duration) for i, entry in enumerate(success))
+    cameras = f.take((), top, "cameras", "bool", True)
+    judges_perception = cameras and any(c.predicate in PERCEPTION_PREDICATES for c in conditions)
+    realism = f.take((), top, "realism", "string", "full" if judges_perception else "off")
+    if realism not in REALISM_LEVELS:
+        raise f.error((), "realism", f"realism takes {', '.join(map(repr, REALISM_LEVELS))}, got {realism!r}")
     return Scenario(
         name=f.take((), top, "name", "string", f.path.stem),
         path=str(f.path),
         description=f.take((), top, "description", "string", ""),
         platform=platform,
-        cameras=f.take((), top, "cameras", "bool", True),
+        cameras=cameras,
+        realism=realism,
         duration_s=duration,
         required_success_rate=f.take((), top, "required_success_rate", "rate"),
         overrides=overrides,
@@ -281,7 +294,7 @@ def load_scenario(path: str | Path) -> Scenario:
         ball_velocity_mm_s=f.take(("ball",), ball, "velocity", "pair", (0.0, 0.0)),
         perturbation=_perturbation(f, top),
         events=tuple(_push(f, ("events", i), event, duration) for i, event in enumerate(_tables(f, top, "events"))),
-        success=tuple(_condition(f, ("success", i), entry, duration) for i, entry in enumerate(success)),
+        success=conditions,
     )
 
 

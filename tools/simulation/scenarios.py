@@ -139,7 +139,7 @@ class _Judge:
 def _options(scenario: Scenario, start: Start, seed: int) -> dict[str, Any]:
     return {"start": ",".join(f"{v:.6f}" for v in start.robot), "ball": f"{start.ball[0]:.3f},{start.ball[1]:.3f}",
             "ball_velocity": f"{start.ball_velocity[0]:.3f},{start.ball_velocity[1]:.3f}", "seed": seed,
-            "cameras": "on" if scenario.cameras else "off", "sensor_noise": start.sensor_noise}
+            "cameras": "on" if scenario.cameras else "off", "sensor_noise": start.sensor_noise, "realism": scenario.realism}
 
 
 def play(scenario: Scenario, seed: int, record: Path | None = None) -> dict[str, Any]:

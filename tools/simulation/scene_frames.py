@@ -61,8 +61,12 @@ class LabelledFrame:
 class SceneRenderer:
     """A simulated platform used as a camera: pose, place, render, with the truth alongside."""
 
-    def __init__(self, engine: str = "mujoco", resolution: str = "320x240", ball_color: str = "spl") -> None:
-        self.platform: SimulatedRobotPlatform = load_platform(engine)({"resolution": resolution, "ball_color": ball_color})
+    def __init__(self, engine: str = "mujoco", resolution: str = "320x240", ball_color: str = "spl", realism: str = "off",
+                 seed: int = 0) -> None:
+        """``realism``: the platform's ``--realism`` level (the hall and the camera pipeline, seeded by ``seed``);
+        posed frames have no motion of their own, so each gets a seeded head turn for its blur."""
+        options = {"resolution": resolution, "ball_color": ball_color, "realism": realism, "seed": seed}
+        self.platform: SimulatedRobotPlatform = load_platform(engine)(options)
         self.platform.start(frozenset({"motion", "cognition"}))
         self.angles = stand_pose()
 
@@ -98,6 +102,9 @@ class SceneRenderer:
             camera = torso_in_robot @ camera_pose_in_torso(poses, mount)
             matrix = CameraMatrix(camera[:3, :3].copy(), camera[:3, 3].copy(), True)
             image = p.render(name)
+            pipeline = p.camera_realism.get(name)
+            if pipeline is not None:
+                image = pipeline(image, pipeline.posed_shift(p.focal_px()[0]))
             mask = p.ball_mask(name)
             projected = project_ball(matrix, ball_robot, p.width, p.height, horizontal_fov, vertical_fov)
             visible = 0.0
