@@ -12,11 +12,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tafel.core.framework.manager import make_module
-from tafel.modules.perception.field_color_provider import below
-from tafel.modules.perception.image_geometry import ImageProjection
+from tafel.modules.perception.field_boundary_detector import cell_shares
+from tafel.modules.perception.field_color_provider import below, white_pixels
+from tafel.modules.perception.image_geometry import ImageProjection, own_body_mask
+from tafel.modules.perception.line_detector import LineDetector, green_on_both_sides, white_runs
 from tafel.modules.perception.spl_ball_detector import SPLBallDetector, Spot, carpet, carpet_sample
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import CameraMatrix
+from tafel.representations.perception import BallCandidate, BallImagePercept, FieldBoundary, GoalPost, GoalPostPercept
 
 
 def level_projection(width: int, height: int, pitch: float) -> ImageProjection:
@@ -241,3 +244,95 @@ def test_spl_checks_anywhere_are_the_loops(painted: tuple[np.ndarray, np.ndarray
             assert self.check(hsv, green, spot, white, beside) == reference_check(self, hsv, green, spot, white, beside)
         moved, old = self.beside_post(hsv, green, spot, white), reference_beside_post(self, hsv, green, spot, white)
         same_spots([moved] if moved else [], [old] if old else [])
+
+
+# -------------------------------------------------------------- LineDetector and FieldBoundaryDetector
+def reference_white_runs(white: np.ndarray, step: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    columns = white[:, ::step].astype(np.int8)
+    edge = np.zeros((1, columns.shape[1]), np.int8)
+    change = np.diff(np.vstack([edge, columns, edge]), axis=0).T
+    start_columns, start_rows = np.nonzero(change == 1)
+    _, end_rows = np.nonzero(change == -1)
+    return start_columns * step, start_rows, end_rows - 1
+
+
+def reference_green_on_both_sides(green: np.ndarray, line: np.ndarray, first: np.ndarray, last: np.ndarray, reach: int) -> np.ndarray:
+    rows = green.shape[0]
+    above = np.zeros(len(line), bool)
+    below = np.zeros(len(line), bool)
+    for offset in range(1, reach + 1):
+        up, down = first - offset, last + offset
+        above |= (up >= 0) & green[np.clip(up, 0, rows - 1), line]
+        below |= (down < rows) & green[np.clip(down, 0, rows - 1), line]
+    return above & below
+
+
+def reference_ignored(self: LineDetector, camera: str, projection: ImageProjection) -> np.ndarray:
+    height, width = projection.height, projection.width
+    boundary = self.field_boundary.rows(camera)
+    ignored = (np.arange(height)[:, None] < boundary[None, :]) if boundary.size == width else np.zeros((height, width), bool)
+    ignored |= own_body_mask(projection, (height, width))
+    for post in self.goal_post_percept.posts:
+        if post.camera == camera:
+            half = post.image_width
+            ignored[: int(post.image_foot) + 2, max(0, int(post.image_x - half)) : int(post.image_x + half) + 1] = True
+    balls = np.zeros((height, width), np.uint8)
+    for ball in self.ball_image_percept.candidates:
+        if ball.camera == camera:
+            cv2.circle(balls, (int(ball.x), int(ball.y)), int(ball.radius * 1.4) + 2, 1, -1)
+    return ignored | balls.astype(bool)
+
+
+@settings(max_examples=300)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 60), st.integers(1, 60), st.floats(0.0, 1.0), st.integers(1, 6), st.integers(0, 12))
+def test_line_runs_and_their_green_borders_are_the_loops(seed: int, rows: int, columns: int, share: float, step: int, reach: int) -> None:
+    rng = np.random.default_rng(seed)
+    white = rng.random((rows, columns)) < share
+    green = rng.random((rows, columns)) < 1.0 - share
+    for mask in (white, white.T, white[::2]):  # views as the scan lines cut them
+        runs = white_runs(mask, step)
+        for ours, theirs in zip(runs, reference_white_runs(mask, step)):
+            np.testing.assert_array_equal(ours, theirs)
+    line, first, last = white_runs(white, 1)
+    for borders in (green, np.ascontiguousarray(green.T).T):
+        np.testing.assert_array_equal(green_on_both_sides(borders, line, first, last, reach),
+                                      reference_green_on_both_sides(borders, line, first, last, reach))
+
+
+@settings(max_examples=100)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([(320, 240), (64, 48), (50, 37)]), st.floats(0.05, 0.9), st.integers(1, 7))
+def test_line_detectors_ignored_pixels_are_the_full_masks(seed: int, size: tuple[int, int], pitch: float, step: int) -> None:
+    """The pixels ignored on the scan lines are the full mask's there: off the field, the own body, posts, balls."""
+    rng = np.random.default_rng(seed)
+    width, height = size
+    boundary = np.clip(rng.normal(height / 3, height / 6, width), 0, height).astype(np.float32)
+    posts = [GoalPost(0.0, 0.0, str(rng.choice(["top", "bottom"])), float(rng.uniform(0, width)), float(rng.uniform(1, 20)),
+                      float(rng.uniform(0, height))) for _ in range(int(rng.integers(0, 3)))]
+    balls = [BallCandidate(str(rng.choice(["top", "bottom"])), float(rng.uniform(-5, width + 5)), float(rng.uniform(-5, height + 5)),
+                           float(rng.uniform(1, 20))) for _ in range(int(rng.integers(0, 3)))]
+    self = make_module(LineDetector, parameters=LineDetector.Parameters(), field_boundary=FieldBoundary(top=boundary),
+                       goal_post_percept=GoalPostPercept(posts=posts), ball_image_percept=BallImagePercept(candidates=balls))
+    projection = level_projection(width, height, pitch)
+    full = reference_ignored(self, "top", projection)  # type: ignore[arg-type]
+    for grid in ((slice(None), slice(None, None, step)), (slice(None, None, step), slice(None)), (slice(None), slice(None))):
+        np.testing.assert_array_equal(self.ignored("top", projection, grid), full[grid])  # type: ignore[attr-defined]
+
+
+@settings(max_examples=200)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 90), st.integers(1, 90), st.sampled_from([2, 3, 4, 5, 8]), st.floats(0.0, 1.0))
+def test_cell_shares_are_opencvs_area_resize(seed: int, rows: int, columns: int, cell: int, share: float) -> None:
+    mask = np.random.default_rng(seed).random((rows, columns)) < share
+    shares = cell_shares(mask, cell)
+    expected = cv2.resize(mask.astype(np.float32), (max(1, columns // cell), max(1, rows // cell)), interpolation=cv2.INTER_AREA)
+    assert shares.dtype == np.float32
+    np.testing.assert_array_equal(shares, expected)
+
+
+@settings(max_examples=300)
+@given(st.integers(0, 2**32 - 1), st.one_of(st.floats(-20.0, 280.0), st.integers(-2, 258).map(float), st.sampled_from([math.inf, -math.inf, math.nan])),
+       st.one_of(st.floats(-20.0, 280.0), st.integers(-2, 258).map(float), st.sampled_from([math.inf, -math.inf, math.nan])))
+def test_white_pixels_are_numpys_comparisons(seed: int, saturation_max: float, value_min: float) -> None:
+    hsv = np.random.default_rng(seed).integers(0, 256, (6, 8, 3)).astype(np.uint8)
+    mask = white_pixels(hsv, saturation_max, value_min)
+    assert mask.dtype == np.bool_
+    np.testing.assert_array_equal(mask, (hsv[..., 1] <= saturation_max) & (hsv[..., 2] >= value_min))

@@ -9,7 +9,7 @@ import numpy as np
 
 from tafel.core import Module, bounded, provides, requires, uses
 from tafel.debug import Canvas, DebugRequest
-from tafel.modules.perception.field_color_provider import WHITE_SATURATION_MAX
+from tafel.modules.perception.field_color_provider import WHITE_SATURATION_MAX, white_pixels
 from tafel.modules.perception.image_geometry import camera_views
 from tafel.representations.motion import CameraMatrixBuffer
 from tafel.representations.perception import CameraImageBottom, CameraImageTop, FieldBoundary, FieldColor, SegmentedImage
@@ -53,13 +53,33 @@ def highest_field_rows(field: np.ndarray, lines: np.ndarray, max_gap: int) -> np
 
 def local_medians(tops: np.ndarray, found: np.ndarray, reach: int) -> np.ndarray:
     """For each found column, the median of the found columns' ``tops`` within ``reach`` columns of it.
-    One window per column over the tops with NaN where none was found, so numpy does it at once (a
-    median per column in Python took most of the detector's time)."""
+    One window per column over the tops with NaN where none was found, sorted at once (NaN last), and
+    the middle of each window's found tops taken (a median per column in Python, and then np.nanmedian,
+    took most of the detector's time)."""
     n_cols = len(tops)
     padded = np.full(n_cols + 2 * reach, np.nan, np.float32)
     padded[reach : reach + n_cols][found] = tops[found]
-    windows = np.lib.stride_tricks.sliding_window_view(padded, 2 * reach + 1)[np.nonzero(found)[0]]
-    return np.nanmedian(windows, axis=1)
+    columns = np.nonzero(found)[0]
+    ordered = np.sort(np.lib.stride_tricks.sliding_window_view(padded, 2 * reach + 1)[columns], axis=1)
+    counted = np.concatenate([[0], np.cumsum(~np.isnan(padded))])
+    counts = counted[columns + 2 * reach + 1] - counted[columns]  # found columns in each window (at least the column itself)
+    rows = np.arange(len(columns))
+    return (ordered[rows, (counts - 1) // 2] + ordered[rows, counts // 2]) / np.float32(2)
+
+
+def cell_shares(mask: np.ndarray, cell: int) -> np.ndarray:
+    """The share of each ``cell`` x ``cell`` square of a mask that is set (float32), as
+    ``cv2.resize(mask.astype(np.float32), ..., interpolation=cv2.INTER_AREA)`` gives it: where the cells
+    tile the mask and hold a power of two pixels, from the mask's integral image (the same values, a
+    fraction of the time); else by that resize."""
+    height, width = mask.shape
+    n_rows, n_cols = max(1, height // cell), max(1, width // cell)
+    area = cell * cell
+    if height % cell or width % cell or area & (area - 1):
+        return cv2.resize(mask.astype(np.float32), (n_cols, n_rows), interpolation=cv2.INTER_AREA)
+    corners = cv2.integral(mask.view(np.uint8) if mask.dtype == np.bool_ else mask.astype(np.uint8))[::cell, ::cell]
+    counts = corners[1:, 1:] - corners[:-1, 1:] - corners[1:, :-1] + corners[:-1, :-1]
+    return counts.astype(np.float32) * (np.float32(1) / np.float32(area))
 
 
 @requires(SegmentedImage, FieldColor)
@@ -121,7 +141,7 @@ class FieldBoundaryDetector(Module):
                 # the horizon is a straight line in the image: its rows at both edges give every column's
                 horizon = np.linspace(projection.horizon(0.0), projection.horizon(green.shape[1] - 1.0), green.shape[1]).astype(np.float32)
             hsv = self.segmented_image.hsv(camera)
-            white = (hsv[..., 1] <= WHITE_SATURATION_MAX) & (hsv[..., 2] >= p.white_value * self.segmented_image.white(camera))
+            white = white_pixels(hsv, WHITE_SATURATION_MAX, p.white_value * self.segmented_image.white(camera))
             rows = self.boundary(green, horizon, white)
             setattr(self.field_boundary, camera, rows)
             if self.draw:
@@ -136,7 +156,7 @@ class FieldBoundaryDetector(Module):
         scan upwards crosses however wide they look)."""
         p = self.parameters
         height, width = green.shape
-        cells = cv2.resize(green.astype(np.float32), (max(1, width // p.cell), max(1, height // p.cell)), interpolation=cv2.INTER_AREA)
+        cells = cell_shares(green, p.cell)
         n_rows, n_cols = cells.shape
         # share of green in the window below each cell (the last rows look at what is left)
         padded = np.vstack([cells, np.zeros((p.window, n_cols), np.float32)])
@@ -151,7 +171,7 @@ class FieldBoundaryDetector(Module):
         max_gap = int(round(p.max_gap * height / p.cell))
         lines = np.zeros_like(field)
         if white is not None and white.shape == green.shape:
-            lines = cv2.resize(white.astype(np.float32), (n_cols, n_rows), interpolation=cv2.INTER_AREA) >= p.green_share
+            lines = cell_shares(white, p.cell) >= p.green_share
         top = highest_field_rows(field, lines, max_gap)
         found = top < n_rows
         tops = top.astype(np.float32) * p.cell

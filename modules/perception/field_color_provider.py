@@ -32,6 +32,19 @@ def below(hsv: np.ndarray, channel: int, threshold: float) -> np.ndarray:
     return cv2.threshold(cv2.extractChannel(hsv, channel), limit, 1, cv2.THRESH_BINARY_INV)[1].view(bool)
 
 
+def white_pixels(hsv: np.ndarray, saturation_max: float, value_min: float) -> np.ndarray:
+    """``(hsv[..., 1] <= saturation_max) & (hsv[..., 2] >= value_min)`` (h x w bool) for an image of uint8
+    channels, in one pass of OpenCV's inRange (same pixels)."""
+    if hsv.size == 0 or not (math.isfinite(saturation_max) and math.isfinite(value_min)):
+        return (hsv[..., 1] <= saturation_max) & (hsv[..., 2] >= value_min)
+    high, low = math.floor(saturation_max), math.ceil(value_min)  # the bounds as integers, both kept
+    if high < 0 or low > 255:
+        return np.zeros(hsv.shape[:2], bool)
+    mask = cv2.inRange(hsv, (0, 0, max(low, 0)), (255, min(high, 255), 255))
+    np.bitwise_and(mask, 1, out=mask)  # 255 -> 1: a bool mask
+    return mask.view(bool)
+
+
 def green_mask(color: FieldColor, hsv: np.ndarray) -> np.ndarray:
     """Which pixels of an HSV image (h x w x 3 uint8) are field green by ``color`` (h x w bool); the hue
     range may wrap round red (OpenCV hue is 0..179)."""

@@ -106,11 +106,16 @@ def own_body_mask(projection: ImageProjection, shape: tuple[int, int]) -> np.nda
     and arms for lines. Boxes round the feet, legs and arms projected into the image (the body
     contour teams use, for the parts of the body a camera can see)."""
     mask = np.zeros(shape, np.uint8)
+    paint_own_body(projection, mask)
+    return mask.view(bool)
+
+
+def paint_own_body(projection: ImageProjection, mask: np.ndarray) -> None:
+    """Set the pixels of ``own_body_mask`` to 1 in ``mask`` (h x w uint8), among other things drawn there."""
     for points in BODY_POINTS:
         pixels, front = projection.to_image(points)
         if front.sum() >= 3:  # the part of the box in front of the camera (a grid of points: boxes reach behind it)
             cv2.fillConvexPoly(mask, cv2.convexHull(np.clip(pixels[front], -1e4, 1e4).astype(np.int32)), 1)
-    return mask.astype(bool)
 
 
 #: each box of ``BODY_BOXES`` as a grid of points, so that the part in front of a camera can be projected

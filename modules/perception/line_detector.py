@@ -10,7 +10,7 @@ import numpy as np
 
 from tafel.core import Module, bounded, provides, requires, uses
 from tafel.debug import Canvas, DebugRequest, Stopwatch
-from tafel.modules.perception.image_geometry import ImageProjection, camera_views, own_body_mask
+from tafel.modules.perception.image_geometry import ImageProjection, camera_views, paint_own_body
 from tafel.representations.field import CENTER_CIRCLE_DIAMETER, LINE_WIDTH
 from tafel.representations.motion import CameraMatrixBuffer
 from tafel.representations.perception import (
@@ -30,26 +30,28 @@ CIRCLE_RADIUS = CENTER_CIRCLE_DIAMETER / 2
 
 def white_runs(white: np.ndarray, step: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Runs of white down every ``step``-th column of a mask: (column x, first row, last row) per run."""
-    columns = white[:, ::step].astype(np.int8)
-    edge = np.zeros((1, columns.shape[1]), np.int8)
-    change = np.diff(np.vstack([edge, columns, edge]), axis=0).T  # per column: +1 where a run starts, -1 after it ends
-    start_columns, start_rows = np.nonzero(change == 1)
-    _, end_rows = np.nonzero(change == -1)  # same order: each run ends in its column before the next starts
+    columns = white[:, ::step]
+    n_rows, n_cols = columns.shape
+    padded = np.zeros((n_cols, n_rows + 2), bool)  # a column per row, a pixel of no white at both ends
+    padded[:, 1:-1] = columns.T
+    start_columns, start_rows = np.divmod(np.flatnonzero(padded[:, 1:] & ~padded[:, :-1]), n_rows + 1)
+    end_rows = np.flatnonzero(~padded[:, 1:] & padded[:, :-1]) % (n_rows + 1)  # in the same order: column by column
     return start_columns * step, start_rows, end_rows - 1
 
 
 def green_on_both_sides(green: np.ndarray, line: np.ndarray, first: np.ndarray, last: np.ndarray, reach: int) -> np.ndarray:
     """Whether each run (down column ``line`` of ``green``, rows ``first`` to ``last``) has green within
     ``reach`` pixels above and below it. Lines lie on the field; a white run with no green on one
-    side is the field's edge (the carpet's end, a wall), a robot or a goal."""
-    rows = green.shape[0]
-    above = np.zeros(len(line), bool)
-    below = np.zeros(len(line), bool)
-    for offset in range(1, reach + 1):
-        up, down = first - offset, last + offset
-        above |= (up >= 0) & green[np.clip(up, 0, rows - 1), line]
-        below |= (down < rows) & green[np.clip(down, 0, rows - 1), line]
-    return above & below
+    side is the field's edge (the carpet's end, a wall), a robot or a goal. For all runs at once: the
+    green mask dilated upwards and downwards by ``reach`` rows (not counting the row itself)."""
+    if len(line) == 0 or reach < 1:
+        return np.zeros(len(line), bool)
+    mask = np.ascontiguousarray(green).view(np.uint8)
+    kernel = np.ones((reach + 1, 1), np.uint8)
+    kernel[reach] = 0
+    above = cv2.dilate(mask, kernel, anchor=(0, reach))  # any green in the reach rows above each pixel
+    below = cv2.dilate(mask, kernel[::-1].copy(), anchor=(0, 0))  # ... and below it
+    return above[first, line].view(bool) & below[last, line].view(bool)
 
 
 def longest_arc(angles: np.ndarray, max_gap: float) -> float:
@@ -145,14 +147,15 @@ class LineDetector(Module):
         """Line points (N x 2, mm, robot frame) of one camera's image."""
         p = self.parameters
         hsv, green = self.segmented_image.hsv(camera), self.segmented_image.green(camera)
-        ignored = self.ignored(camera, projection)
+        obstacles = self.obstacles(camera, projection)
         threshold = p.white_share * self.segmented_image.white(camera)
         found = []
         # white is only classified on the scan lines: every step-th column (runs down) and row (runs across)
         for transposed in (False, True):
             grid = (slice(None, None, p.step), slice(None)) if transposed else (slice(None), slice(None, None, p.step))
             cut = hsv[grid]
-            white = ~green[grid] & ~ignored[grid] & (cut[..., 1] <= p.saturation_max) & (cut[..., 2] >= threshold)
+            ignored = self.ignored(camera, projection, grid, obstacles)
+            white = ~green[grid] & ~ignored & (cut[..., 1] <= p.saturation_max) & (cut[..., 2] >= threshold)
             line, first, last = white_runs(white.T if transposed else white, 1)
             bordered = green_on_both_sides(green[grid].T if transposed else green[grid], line, first, last, p.green_reach)
             line = line * p.step
@@ -176,22 +179,34 @@ class LineDetector(Module):
                 canvas.circle(float(x), float(y), 15, color="red")
         return result
 
-    def ignored(self, camera: str, projection: ImageProjection) -> np.ndarray:
+    def ignored(self, camera: str, projection: ImageProjection, grid: tuple[slice, slice] = (slice(None), slice(None)),
+                obstacles: np.ndarray | None = None) -> np.ndarray:
         """Pixels that are white but no line: off the field, the robot's own feet and arms, goal posts
-        (on the ground they would be lines behind the goal) and ball candidates."""
+        (on the ground they would be lines behind the goal) and ball candidates; only those of ``grid``
+        (rows, columns: the scan lines), every pixel by default. ``obstacles``: ``self.obstacles(camera,
+        projection)`` where it is at hand."""
         height, width = projection.height, projection.width
+        if obstacles is None:
+            obstacles = self.obstacles(camera, projection)
+        ignored = obstacles[grid]
         boundary = self.field_boundary.rows(camera)
-        ignored = (np.arange(height)[:, None] < boundary[None, :]) if boundary.size == width else np.zeros((height, width), bool)
-        ignored |= own_body_mask(projection, (height, width))
+        if boundary.size == width:
+            ignored = ignored | (np.arange(height)[grid[0]][:, None] < boundary[grid[1]][None, :])
+        return ignored
+
+    def obstacles(self, camera: str, projection: ImageProjection) -> np.ndarray:
+        """The robot's own feet and arms, goal posts and ball candidates in one image (h x w bool), drawn
+        into one mask."""
+        drawn = np.zeros((projection.height, projection.width), np.uint8)
+        paint_own_body(projection, drawn)
         for post in self.goal_post_percept.posts:
             if post.camera == camera:
                 half = post.image_width
-                ignored[: int(post.image_foot) + 2, max(0, int(post.image_x - half)) : int(post.image_x + half) + 1] = True
-        balls = np.zeros((height, width), np.uint8)
+                drawn[: int(post.image_foot) + 2, max(0, int(post.image_x - half)) : int(post.image_x + half) + 1] = 1
         for ball in self.ball_image_percept.candidates:
             if ball.camera == camera:
-                cv2.circle(balls, (int(ball.x), int(ball.y)), int(ball.radius * 1.4) + 2, 1, -1)
-        return ignored | balls.astype(bool)
+                cv2.circle(drawn, (int(ball.x), int(ball.y)), int(ball.radius * 1.4) + 2, 1, -1)
+        return drawn.view(bool)
 
     def fit_circle(self, points: np.ndarray) -> np.ndarray:
         """Find the centre circle among ``points``; returns the points it does not explain."""
