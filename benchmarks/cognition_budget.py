@@ -40,7 +40,6 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
 from tafel.platforms.images import posed_image  # noqa: E402
-from tafel.representations.infrastructure import FrameInfo  # noqa: E402
 from tafel.representations.motion import CameraMatrix, CameraMatrixBottom, CameraMatrixBuffer, CameraMatrixTop  # noqa: E402
 from tafel.representations.perception import CameraImageBottom, CameraImageTop  # noqa: E402
 from tafel.tools.simulation.stepped_program import SteppedProgram  # noqa: E402
@@ -124,18 +123,18 @@ def cognition(source: Path | None, pairs: list[tuple[Shot, Shot]], frames: int) 
         runner = program.runtime.runners["cognition"]
         manager = runner.manager
         counter = iter(range(1 << 62))
+        clock = {"time_ns": 0}  # the frame's time, which the runtime writes into FrameInfo
 
         def sense(context: str, blackboard: Any, frame_number: int, time_ns: int) -> None:
             top, bottom = pairs[next(counter) % len(pairs)]
-            time_ns = frame_number * FRAME_NS
-            blackboard.set(FrameInfo(frame_number=frame_number, time_ns=time_ns))
+            time_ns = clock["time_ns"] = frame_number * FRAME_NS
             for shot, rep in ((top, CameraImageTop), (bottom, CameraImageBottom)):
                 blackboard.set(rep(image=shot.image, horizontal_fov=shot.horizontal_fov, vertical_fov=shot.vertical_fov, time_ns=time_ns))
             blackboard.set(CameraMatrixBuffer.of(CameraMatrixTop(top.matrix.rotation, top.matrix.translation, True),
                                                  CameraMatrixBottom(bottom.matrix.rotation, bottom.matrix.translation, True), time_ns))
 
         program.platform.sense = sense  # type: ignore[method-assign]
-        program.platform.frame_time_ns = lambda context: None  # type: ignore[method-assign]
+        program.platform.frame_time_ns = lambda context: clock["time_ns"]  # type: ignore[method-assign]
         whole: list[float] = []
         modules: dict[str, list[float]] = defaultdict(list)
         execute: Callable[[], None] = manager.execute

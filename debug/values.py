@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from tafel.core.framework.errors import TafelError
+from tafel.core.framework.frame_info import FrameInfo
 from tafel.core.framework.manager import ModuleManager
 from tafel.core.framework.representation import FieldInfo, fields_of
 from tafel.core.framework.values import convert, refusal
@@ -128,15 +129,16 @@ def parse_field_text(info: FieldInfo, text: str, where: str) -> Any:
 
 
 def frame_number(manager: ModuleManager) -> int:
-    """The frame's number as the platform counts it (``FrameInfo``: a replayed log's recorded numbers),
-    else as the manager does."""
-    return int(getattr(manager.blackboard.find("FrameInfo"), "frame_number", manager.frame))
+    """The frame's number as ``FrameInfo`` says (a replayed log's recorded numbers), else as the
+    manager counts."""
+    blackboard = manager.blackboard
+    return int(blackboard[FrameInfo].frame_number) if FrameInfo in blackboard else manager.frame
 
 
 def frame_time_ns(manager: ModuleManager) -> int | None:
     """The frame's time on the program's clock (``FrameInfo``), or None without one."""
-    info = manager.blackboard.find("FrameInfo")  # by name: debug knows no representation
-    return None if info is None else int(info.time_ns)
+    blackboard = manager.blackboard
+    return int(blackboard[FrameInfo].time_ns) if FrameInfo in blackboard else None
 
 
 def representation_message(rep: Any, context: str, frame: int, time_ns: int | None = None) -> dict[str, Any]:

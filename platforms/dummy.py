@@ -17,7 +17,6 @@ import numpy as np
 from tafel.core.framework.manager import Blackboard
 from tafel.core.runtime.platform import Platform, seed_number
 from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS, NetworkedPlatform
-from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import RobotPose
 from tafel.representations.motion import HEAD_YAW, JOINT_COUNT, FsrData, InertialSensorData, JointCommand, JointSensorData, TouchSensorData
 from tafel.representations.perception import BallPercept
@@ -31,8 +30,8 @@ class DummyPlatform(NetworkedPlatform, Platform):
     clock = "simulated"
     default_network = "simulated"  # equal runs stay equal: no other program on the machine is heard
     provides: ClassVar[Mapping[str, tuple[type, ...]]] = {
-        "motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData, TouchSensorData),
-        "cognition": (FrameInfo, BallPercept, RobotPose, *NETWORK_INPUTS),
+        "motion": (JointSensorData, InertialSensorData, FsrData, TouchSensorData),
+        "cognition": (BallPercept, RobotPose, *NETWORK_INPUTS),
     }
     consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {"motion": (JointCommand,), "cognition": NETWORK_OUTPUTS}
 
@@ -83,7 +82,6 @@ class DummyPlatform(NetworkedPlatform, Platform):
     def sense(self, context: str, blackboard: Blackboard, frame_number: int, time_ns: int) -> None:
         if not self.simulates_joints:
             self.advance(time_ns)  # concurrent runtime: no one else moves the clock
-        blackboard.set(FrameInfo(frame_number=frame_number, time_ns=time_ns))
         if context == "motion":
             joints = blackboard[JointSensorData]
             joints.position = self.joints.copy()

@@ -1,7 +1,8 @@
 """The log platform: replays a recorded MCAP log frame by frame, so modules run again on recorded data.
 
 Recorded sensor data (what the recording platform provided) is fed to both contexts in the recorded
-order and with the recorded frame times; every processing module runs again. ``--replace`` feeds
+order; every processing module runs again. Each frame keeps its recorded number and time: the platform
+gives them to the runtime (``frame_number_of``, ``frame_time_ns``), which writes ``FrameInfo``. ``--replace`` feeds
 further recorded representations in place of the modules that computed them, so the modules
 downstream can be tested alone. Replay can be paused, stepped forward and backward, and sent to a
 frame; the debug server exposes these as ``log:*`` commands.
@@ -21,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from tafel.core.framework.errors import TafelError
+from tafel.core.framework.frame_info import FrameInfo
 from tafel.core.framework.manager import Blackboard
 from tafel.core.framework.naming import did_you_mean
 from tafel.core.framework.representation import get_representation
@@ -68,11 +70,13 @@ class LogPlatform(Platform):
             replace = sorted({c.representation for c in self.reader.channels.values() if c.metadata.get("source") != "platform"})
         classes = self._resolve_classes(self.reader, replace)
         topics = self._fed_topics(self.reader, replace)
-        #: topic -> class of exactly what replay writes onto the blackboards: sensor data and --replace
+        #: topic -> class of exactly what replay reads: sensor data, --replace, and the frame clock
         self.classes = {topic: cls for topic, cls in classes.items() if any(topic in t for t in topics.values())}
         self.decoders = {topic: codec(cls).decode for topic, cls in self.classes.items()}
+        #: the recorded frame clock of each context: given to the runtime, which writes FrameInfo
+        self.clock_topics = {topic for topic, cls in self.classes.items() if cls is FrameInfo}
         self.provides = {  # type: ignore[misc] - depends on the file, so per instance
-            context: tuple(self.classes[topic] for topic in names if topic in self.classes)
+            context: tuple(self.classes[topic] for topic in names if topic in self.classes and topic not in self.clock_topics)
             for context, names in topics.items()
         }
         self.consumes = {}  # type: ignore[misc]
@@ -89,6 +93,8 @@ class LogPlatform(Platform):
         self._by_context = {c: np.flatnonzero(self.frame_context == codes[c]) for c in self.provides}
         self._cursors: dict[str, int] = {}
         self._cache: OrderedDict[int, dict[tuple[str, int], dict[str, bytes]]] = OrderedDict()
+        #: context -> (number, time) of the frame its last ``sense`` replayed
+        self._stamps: dict[str, tuple[int, int]] = {}
 
     @property
     def path(self) -> str:
@@ -106,8 +112,10 @@ class LogPlatform(Platform):
     # -------------------------------------------------------------------------------- set-up
     @staticmethod
     def _fed_topics(reader: LogReader, replace: list[str]) -> dict[str, list[str]]:
-        """Per context, the recorded topics replay feeds: what the recording platform provided, and
-        what ``--replace`` names. Recorded module outputs are only there to compare against."""
+        """Per context, the recorded topics replay reads: what the recording platform provided, what
+        ``--replace`` names, and the frame clock (``FrameInfo``, whose channel says ``runtime``, or
+        ``platform`` in logs from before the runtime wrote it). Recorded module outputs are only there
+        to compare against."""
         recorded = {c.representation for c in reader.channels.values()}
         unknown = [name for name in replace if name not in recorded]
         if unknown:
@@ -117,7 +125,8 @@ class LogPlatform(Platform):
             )
         topics: dict[str, list[str]] = {}
         for topic, channel in reader.channels.items():
-            if channel.metadata.get("source") == "platform" or channel.representation in replace:
+            if (channel.metadata.get("source") == "platform" or channel.representation in replace
+                    or channel.representation == FrameInfo.__name__):
                 topics.setdefault(channel.context, []).append(topic)
         return topics
 
@@ -223,12 +232,28 @@ class LogPlatform(Platform):
         frame = self._pending.pop(context, None)
         if frame is None:  # concurrent runtime: no schedule, serve this context's frames in order
             frame = self._next_frame_of(context)
+        self._stamps[context] = (frame.number, frame.time_ns)  # without a readable FrameInfo: the message's
         for topic, data in self._messages_of(frame).items():
             try:
                 # each channel's schema was checked against its class when the log was opened
-                blackboard.set(self.decoders[topic](data))
+                value = self.decoders[topic](data)
             except Exception as exc:  # noqa: BLE001 - a damaged message is reported, the replay goes on
                 log.error("%s frame %d of %s: cannot decode: %s", self.path, frame.number, topic, exc)
+                continue
+            if topic in self.clock_topics:  # the recorded clock: the runtime writes it (frame_number_of, frame_time_ns)
+                self._stamps[context] = (int(value.frame_number), int(value.time_ns))
+            else:
+                blackboard.set(value)
+
+    def frame_number_of(self, context: str) -> int | None:
+        """The recorded number of the frame of ``context`` replayed last."""
+        stamp = self._stamps.get(context)
+        return None if stamp is None else stamp[0]
+
+    def frame_time_ns(self, context: str) -> int | None:
+        """The recorded time of the frame of ``context`` replayed last."""
+        stamp = self._stamps.get(context)
+        return None if stamp is None else stamp[1]
 
     def _messages_of(self, frame: _Frame) -> dict[str, bytes]:
         messages: dict[str, bytes] = {}

@@ -36,7 +36,6 @@ from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS
 from tafel.platforms.robot_model import mjcf_assets, robot_prefix
 from tafel.platforms.simulated import SimulatedRobotPlatform
 from tafel.representations.geometry import Pose2D
-from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import RobotPose
 from tafel.representations.motion import HEAD_YAW, JOINT_COUNT, FsrData, InertialSensorData, JointCommand, JointSensorData, TouchSensorData
 from tafel.representations.nao import HORIZONTAL_FOV
@@ -63,8 +62,8 @@ class MatchRobotPlatform(SimulatedRobotPlatform):
         self.address = (host, int(port))
         self.index = int(self.options.get("index") or 0)
         self.side = Side(-1.0 if str(self.options.get("side") or "+x") == "-x" else 1.0)
-        cognition = (FrameInfo, CameraImageTop, CameraImageBottom) if self.cameras else (FrameInfo, BallPercept, RobotPose, RobotsPercept)
-        self.provides = {"motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData, TouchSensorData),  # type: ignore[misc]
+        cognition = (CameraImageTop, CameraImageBottom) if self.cameras else (BallPercept, RobotPose, RobotsPercept)
+        self.provides = {"motion": (JointSensorData, InertialSensorData, FsrData, TouchSensorData),  # type: ignore[misc]
                          "cognition": (*cognition, *NETWORK_INPUTS)}
         self.consumes = {"motion": (JointCommand,), "cognition": NETWORK_OUTPUTS}  # type: ignore[misc]
         self.connection: Connection | None = None

@@ -33,7 +33,6 @@ from tafel.core.runtime.platform import Platform, PlatformError
 from tafel.platforms.actuators import ActuatorGuard
 from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS, NetworkedPlatform
 from tafel.platforms.v4l2 import newest_image
-from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import (
     JOINT_COUNT,
     JOINT_INDEX,
@@ -121,8 +120,8 @@ class NaoPlatform(NetworkedPlatform, Platform):
     description = "the real NAO V6: LoLA (msgpack over /tmp/robocup) and both cameras through V4L2"
     clock = "own"
     provides: ClassVar[Mapping[str, tuple[type, ...]]] = {
-        "motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData, TouchSensorData, BatteryData),
-        "cognition": (FrameInfo, CameraImageTop, CameraImageBottom, *NETWORK_INPUTS),
+        "motion": (JointSensorData, InertialSensorData, FsrData, TouchSensorData, BatteryData),
+        "cognition": (CameraImageTop, CameraImageBottom, *NETWORK_INPUTS),
     }
     consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {"motion": (JointCommand, LedRequest), "cognition": NETWORK_OUTPUTS}
 
@@ -270,7 +269,6 @@ class NaoPlatform(NetworkedPlatform, Platform):
         if context == "motion":
             values = self.receive()
             self.time_ns = clock.now_ns()
-            blackboard.set(FrameInfo(frame_number=frame_number, time_ns=self.time_ns))
             self.measured = values["Position"]
             self.guard.hold(self.measured)
             blackboard.set(JointSensorData(position=values["Position"], stiffness=values["Stiffness"],
@@ -282,7 +280,6 @@ class NaoPlatform(NetworkedPlatform, Platform):
             blackboard.set(battery_data(values["Battery"]))
         elif context == "cognition":
             self.time_ns = clock.now_ns()
-            blackboard.set(FrameInfo(frame_number=frame_number, time_ns=self.time_ns))
             self.network.receive(blackboard, self.time_ns)
             if not self.captures:
                 time.sleep(1.0 / 30.0)  # no cameras: keep cognition at its usual pace

@@ -27,7 +27,6 @@ from tafel.platforms.realism import LEVELS, CameraRealism, image_shift, parse_re
 from tafel.platforms.robot_model import STANDING_HEIGHT
 from tafel.representations import field
 from tafel.representations.geometry import Pose2D
-from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import KnownPose
 from tafel.representations.motion import (
     CHEST_BUTTON,
@@ -127,8 +126,8 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
     concurrent = False  # images and joints must come from the same simulated world
     default_network = "simulated"  # parallel simulations must not hear each other (tafel match asks for udp)
     provides: ClassVar[Mapping[str, tuple[type, ...]]] = {
-        "motion": (FrameInfo, JointSensorData, InertialSensorData, FsrData, TouchSensorData),
-        "cognition": (FrameInfo, CameraImageTop, CameraImageBottom, KnownPose, *NETWORK_INPUTS),
+        "motion": (JointSensorData, InertialSensorData, FsrData, TouchSensorData),
+        "cognition": (CameraImageTop, CameraImageBottom, KnownPose, *NETWORK_INPUTS),
     }
     consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {"motion": (JointCommand,), "cognition": NETWORK_OUTPUTS}
     #: the engine's name in help texts
@@ -349,7 +348,6 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
             self.forget_state(self.history.popleft()[1])
 
     def sense(self, context: str, blackboard: Blackboard, frame_number: int, time_ns: int) -> None:
-        blackboard.set(FrameInfo(frame_number=frame_number, time_ns=time_ns))
         if context == "motion":
             joints = blackboard[JointSensorData]
             joints.position = self.joint_angles() + self.rng.normal(0.0, 0.0005 * self.sensor_noise, len(JOINT_NAMES))

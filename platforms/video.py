@@ -31,7 +31,6 @@ from tafel.core.runtime import clock
 from tafel.core.runtime.platform import EndOfData, Platform, PlatformError, PlatformOptionError
 from tafel.platforms.images import IMAGE_SUFFIXES, RAW_SUFFIXES, ImageSourceError, PosedImage, image_files, options_pose, posed_image
 from tafel.platforms.v4l2 import image_time_ns
-from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import CameraMatrixBottom, CameraMatrixBuffer, CameraMatrixTop
 from tafel.representations.motion_control import Odometry
 from tafel.representations.perception import CameraImageBottom, CameraImageTop
@@ -44,7 +43,7 @@ class VideoPlatform(Platform):
     name = "video"
     description = "a video file, webcam or folder of NAO images as the camera (--source FILE|DEVICE_INDEX|FOLDER)"
     clock = "own"
-    provides: ClassVar[Mapping[str, tuple[type, ...]]] = {"cognition": (FrameInfo, CameraImageTop, CameraImageBottom)}
+    provides: ClassVar[Mapping[str, tuple[type, ...]]] = {"cognition": (CameraImageTop, CameraImageBottom)}
     consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {}
 
     def __init__(self, options: Mapping[str, Any] | None = None) -> None:
@@ -77,7 +76,7 @@ class VideoPlatform(Platform):
         self.ball_color = str(ball_color)
         if self.images is not None or self.pose is not None:  # the camera's pose is known: matrices for every detector
             # the robot stands where the images were taken: no odometry, so the localization runs as well
-            self.provides = {"cognition": (FrameInfo, CameraImageTop, CameraImageBottom, CameraMatrixBuffer, Odometry)}
+            self.provides = {"cognition": (CameraImageTop, CameraImageBottom, CameraMatrixBuffer, Odometry)}
         self.paused = False
         self.steps = 0
         self.current: PosedImage | None = None
@@ -207,7 +206,6 @@ class VideoPlatform(Platform):
         self.time_ns = (frame_number - 1) * self.period_ns
         posed = self.current
         assert posed is not None
-        blackboard.set(FrameInfo(frame_number=frame_number, time_ns=self.time_ns))
         for camera, rep in (("top", CameraImageTop), ("bottom", CameraImageBottom)):
             image = blackboard[rep]
             image.time_ns = self.time_ns
@@ -242,7 +240,6 @@ class VideoPlatform(Platform):
             self.time_ns = clock.now_ns()
             taken_ns = image_time_ns(self.capture, str(self.device))
         self.frame_index += 1
-        blackboard.set(FrameInfo(frame_number=frame_number, time_ns=self.time_ns))
         image = blackboard[CameraImageTop]
         image.time_ns = taken_ns
         image.image = cv2.cvtColor(frame, cv2.COLOR_BGR2RGB)

@@ -49,8 +49,9 @@ def _index() -> dict[str, str]:
         module = importlib.import_module(f"{__name__}.{short}")
         # a file still being imported (it asked for a name from here) is indexed again next time
         complete = complete and not getattr(module.__spec__, "_initializing", False)
+        exported = set(getattr(module, "__all__", ()))  # what a file re-exports (FrameInfo, defined in core)
         for name, value in vars(module).items():
-            if isinstance(value, type) and value.__module__ == module.__name__ and not name.startswith("_"):
+            if isinstance(value, type) and (value.__module__ == module.__name__ or name in exported) and not name.startswith("_"):
                 index.setdefault(name, short)
     if complete:
         _INDEX.update(index)

@@ -1,24 +1,14 @@
-"""Representations every context has: the frame clock."""
+"""Representations every context has: the frame clock (``FrameInfo``) and, in motion, ``CognitionStatus``.
+
+Both are written by the runtime, so they are defined in core and re-exported here unchanged.
+"""
 
 from __future__ import annotations
 
-from tafel.core import representation
-
-
-@representation
-class FrameInfo:
-    """The current frame of a context: its number and its time (platform clock, nanoseconds)."""
-
-    frame_number: int = 0
-    time_ns: int = 0
-
-    @property
-    def time_s(self) -> float:
-        """``time_ns`` in seconds."""
-        return self.time_ns * 1e-9
-
+# The runtime writes the frame clock every frame; defined in core for that reason.
+from tafel.core.framework.frame_info import FrameInfo
 
 # Provided by the runtime to motion; defined in core because the runtime fills it.
-from tafel.core.runtime.status import CognitionStatus  # noqa: E402
+from tafel.core.runtime.status import CognitionStatus
 
 __all__ = ["CognitionStatus", "FrameInfo"]

@@ -90,7 +90,7 @@ def test_platforms_lists_what_each_provides_and_consumes() -> None:
     result = tafel("platforms")
     assert result.returncode == 0
     assert "dummy: deterministic clock" in result.stdout
-    assert "motion: provides FrameInfo, JointSensorData, InertialSensorData, FsrData, TouchSensorData; consumes JointCommand" in result.stdout
+    assert "motion: provides JointSensorData, InertialSensorData, FsrData, TouchSensorData; consumes JointCommand" in result.stdout
     assert "consumes GameControllerReturn, OutgoingTeamMessage" in result.stdout
     verbose = tafel("platforms", "--verbose")
     assert "option --seed: dummy: seed of the synthetic sensor noise" in verbose.stdout
@@ -106,6 +106,8 @@ def test_modules_shows_order_providers_and_hand_overs() -> None:
     assert "provider BallModel: KalmanBallModeler (alternatives: SimpleBallModeler)" in out
     assert "hand-over in: HeadMotionRequest from cognition" in out
     assert "hand-over out: HeadMotionRequest to motion" in out
+    assert "from runtime: FrameInfo, CognitionStatus\n" in out and "from runtime: FrameInfo\n" in out  # motion's, cognition's
+    assert "from platform: JointSensorData, InertialSensorData" in out
 
 
 def test_modules_dot_has_both_contexts_and_the_hand_over() -> None:

@@ -508,3 +508,26 @@ def test_a_start_that_fails_leaves_no_recording_behind(tmp_path: Path) -> None:
     assert result.returncode != 0 and f"127.0.0.1:{port} is taken" in result.stderr, result.stderr
     assert not (tmp_path / "x.mcap").exists()
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("clock_source", ["runtime", "platform"])  # "platform": logs from before the runtime wrote it
+def test_replay_keeps_the_recorded_frame_clock(tmp_path: Path, clock_source: str) -> None:
+    from tafel.core.runtime import Limits, LockstepRuntime
+    from tafel.core.runtime.program import plan_program
+    from tafel.representations import FrameInfo, JointSensorData
+    from tests.test_program import CLOCKS_SEEN
+
+    path = tmp_path / "clock.mcap"
+    writer = LogWriter(path)
+    for frame in range(1, 6):  # numbered 101..105 by FrameInfo (a replay of a slice), 1..5 by the messages
+        time_ns = 7_000_000_000 + frame * 10_000_000
+        writer.write("motion/FrameInfo", FrameInfo, time_ns, frame, serialize(FrameInfo(frame_number=100 + frame, time_ns=time_ns)),
+                     {"source": clock_source})
+        writer.write("motion/JointSensorData", JointSensorData, time_ns, frame, serialize(JointSensorData()), {"source": "platform"})
+    writer.close()
+    platform = LogPlatform({"log": str(path)})
+    assert platform.provides == {"motion": (JointSensorData,)}  # the runtime writes the clock, from what the log says
+    plans = plan_program({"cognition": {"modules": []}, "motion": {"modules": ["tests.test_program:TpMotionClock"]}}, platform)
+    CLOCKS_SEEN.clear()
+    LockstepRuntime(plans, platform).run(Limits(speed=None))
+    assert CLOCKS_SEEN == [("motion", 100 + k, 7_000_000_000 + k * 10_000_000) for k in range(1, 6)]

@@ -138,3 +138,97 @@ def test_lockstep_hands_over_the_newest_complete_value() -> None:
     assert all(yaw == -pitch for yaw, pitch in seen)
     assert seen[0] == (0.0, 0.0)  # motion runs first on a shared tick: nothing handed over yet
     assert seen[4] == (1.0, -1.0) and seen[-1] == (30.0, -30.0)
+
+
+class SilentTestPlatform(Platform):
+    """Provides joints and ball percepts but writes nothing, not even the frame clock."""
+
+    name = "silent-test"
+    provides: ClassVar = {"cognition": (BallPercept,), "motion": (JointSensorData,)}
+    consumes: ClassVar = {}
+
+
+class OwnTimeTestPlatform(SilentTestPlatform):
+    """Gives each frame a time of its own (a robot's clock), still without writing FrameInfo."""
+
+    name = "own-time-test"
+
+    def __init__(self, options=None) -> None:
+        super().__init__(options)
+        self.sensed = {"cognition": 0, "motion": 0}
+
+    def sense(self, context, blackboard, frame_number, time_ns) -> None:
+        self.sensed[context] += 1
+
+    def frame_time_ns(self, context: str) -> int | None:
+        return 5_000_000_000 + 1000 * self.sensed[context] + (1 if context == "cognition" else 0)
+
+
+CLOCKS_SEEN: list[tuple[str, int, int]] = []
+
+
+@requires(FrameInfo)
+class TpMotionClock(Module):
+    """Notes the frame clock motion sees (a module of the runtime's tests)."""
+
+    def execute(self) -> None:
+        CLOCKS_SEEN.append(("motion", self.frame_info.frame_number, self.frame_info.time_ns))
+
+
+@requires(FrameInfo)
+class TpCognitionClock(Module):
+    """Notes the frame clock cognition sees."""
+
+    def execute(self) -> None:
+        CLOCKS_SEEN.append(("cognition", self.frame_info.frame_number, self.frame_info.time_ns))
+
+
+CLOCK_CONFIG = {"cognition": {"modules": ["tests.test_program:TpCognitionClock"]},
+                "motion": {"modules": ["tests.test_program:TpMotionClock"]}}
+
+
+def test_the_runtime_provides_frame_info_in_every_context_it_runs() -> None:
+    plans = plan_program(CLOCK_CONFIG, SilentTestPlatform)
+    for plan in plans.values():
+        assert FrameInfo not in plan.platform_provides and FrameInfo in plan.runtime_provides
+        assert FrameInfo in plan.external and plan.pruned == {}
+    assert plans["motion"].runtime_provides == [FrameInfo, CognitionStatus]
+    class CognitionOnly(SilentTestPlatform):
+        provides: ClassVar = {"cognition": (BallPercept,)}
+
+    for platform in (CognitionOnly, CameraOnlyPlatform):  # the second lists FrameInfo as platforms did before
+        only_cognition = plan_program(CLOCK_CONFIG, platform)
+        assert only_cognition["cognition"].platform_provides == [BallPercept]
+        assert not only_cognition["motion"].runs and FrameInfo not in only_cognition["motion"].runtime_provides
+        # motion does not run, so nothing writes its clock: pruned quietly, as for a sensor this platform lacks
+        assert only_cognition["motion"].pruned == {"TpMotionClock": ["FrameInfo"]}
+
+
+def test_the_runtime_writes_frame_info_for_a_platform_that_writes_nothing() -> None:
+    CLOCKS_SEEN.clear()
+    LockstepRuntime(plan_program(CLOCK_CONFIG, SilentTestPlatform), SilentTestPlatform()).run(Limits(frames=10, speed=None))
+    motion = [(number, time_ns) for context, number, time_ns in CLOCKS_SEEN if context == "motion"]
+    cognition = [(number, time_ns) for context, number, time_ns in CLOCKS_SEEN if context == "cognition"]
+    assert motion == [(k, (k - 1) * 10_000_000) for k in range(1, 11)]  # 100 Hz from 0
+    assert cognition == [(1, 0), (2, 40_000_000), (3, 70_000_000)]  # 30 Hz on the motion ticks
+
+
+def test_frame_info_takes_the_time_the_platform_gives() -> None:
+    CLOCKS_SEEN.clear()
+    platform = OwnTimeTestPlatform()
+    LockstepRuntime(plan_program(CLOCK_CONFIG, platform), platform).run(Limits(frames=4, speed=None))
+    motion = [(number, time_ns) for context, number, time_ns in CLOCKS_SEEN if context == "motion"]
+    cognition = [(number, time_ns) for context, number, time_ns in CLOCKS_SEEN if context == "cognition"]
+    assert motion == [(k, 5_000_000_000 + 1000 * k) for k in range(1, 5)]  # the runtime's count, the platform's time
+    assert cognition == [(1, 5_000_001_001)]  # 4 motion ticks hold one cognition frame
+
+
+def test_a_platform_that_feeds_a_context_only_the_frame_clock_runs_it() -> None:
+    class ClockOnly(SilentTestPlatform):
+        provides: ClassVar = {"cognition": (BallPercept,), "motion": ()}
+
+    CLOCKS_SEEN.clear()
+    plans = plan_program(CLOCK_CONFIG, ClockOnly)
+    assert plans["motion"].runs and plans["motion"].pruned == {}
+    LockstepRuntime(plans, ClockOnly()).run(Limits(frames=3, speed=None))
+    assert [(c, n) for c, n, _ in CLOCKS_SEEN if c == "motion"] == [("motion", 1), ("motion", 2), ("motion", 3)]

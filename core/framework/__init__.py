@@ -1,5 +1,6 @@
 """The framework wing: what a module author meets. Representations (``representation.py``: plain data
-classes with defaults, ranges and a registry by name), modules and their declarations (``module.py``),
+classes with defaults, ranges and a registry by name; ``frame_info.py``: the frame clock the runtime
+writes), modules and their declarations (``module.py``),
 read-only and writing views of the blackboard (``access.py``), the module manager and its blackboard
 (``manager.py``, ordering by ``graph.py``), parameters and the checking of every value a client or a
 file sets (``parameters.py``, ``validation.py``), configuration (``config.py``), modules from folders

@@ -124,7 +124,7 @@ def _choose_providers(
     for rep, modules_able in candidates.items():
         if rep in external:
             raise ConflictingProvidersError(
-                f"{rep.__name__} is provided from outside this manager (platform or other context) and by "
+                f"{rep.__name__} is provided from outside this manager (platform, runtime or other context) and by "
                 f"{', '.join(m.__name__ for m in modules_able)}; disable the module, or stop providing "
                 f"{rep.__name__} externally"
             )

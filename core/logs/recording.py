@@ -1,7 +1,8 @@
 """Recording representations while a program runs, switchable at run time.
 
 Which representations: per context, always those the platform provides (sensor data, which replay
-needs), plus the names chosen in configuration (``[recording] representations``) or with
+needs) and the frame clock the runtime writes (``FrameInfo``: replay runs each frame at its recorded
+number and time), plus the names chosen in configuration (``[recording] representations``) or with
 ``--record-reps`` (which replaces the configured names; ``all`` records every representation). Each is
 recorded in the context that owns it (the platform's or the provider module's), not where it was
 handed over to. Serialization happens in the loop (a few microseconds a message); writing happens in
@@ -16,6 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 from tafel.core.framework.errors import UnknownModuleError
+from tafel.core.framework.frame_info import FrameInfo
 from tafel.core.framework.manager import Blackboard
 from tafel.core.framework.naming import did_you_mean
 from tafel.core.framework.representation import is_state
@@ -67,6 +69,7 @@ def select(plans: Mapping[str, ContextPlan], names: Iterable[str] | None, *, inc
             continue
         for rep in extra:
             owners.setdefault(rep.__name__, []).append(Selection(context, rep, "debug"))
+        owners.setdefault(FrameInfo.__name__, []).append(Selection(context, FrameInfo, "runtime"))
         for rep in plan.platform_provides:
             owners.setdefault(rep.__name__, []).append(Selection(context, rep, "platform"))
         providers = {rep: m for m in plan.active_modules() for rep in m.requirements().provides}
@@ -83,7 +86,7 @@ def select(plans: Mapping[str, ContextPlan], names: Iterable[str] | None, *, inc
     result: list[Selection] = []
     for name, selections in owners.items():
         for selection in selections:
-            sensor = selection.source == "platform"
+            sensor = selection.source == "platform" or selection.rep is FrameInfo  # replay needs both
             if name in chosen_names or (include_sensors and sensor):
                 result.append(selection)
     return list(dict.fromkeys(result))

@@ -4,8 +4,8 @@ Layout: one channel per context and representation, topic ``<context>/<Represent
 encoding with the schema as a FileDescriptorSet (so Foxglove and the ``mcap`` tool read it, and a
 reader with only ``mcap`` and ``protobuf`` decodes it), publish time = frame time in nanoseconds (what
 replay uses), log time = wall-clock time at recording (ns since the epoch, what viewers show), sequence
-= frame number. Channel metadata says who wrote the representation (``source`` = ``platform`` or
-``module``), and a ``tafel`` metadata record holds the rates and the platform of the run.
+= frame number. Channel metadata says who wrote the representation (``source`` = ``platform``,
+``module``, ``runtime`` for ``FrameInfo``, which logs before it name ``platform``, or ``debug``), and a ``tafel`` metadata record holds the rates and the platform of the run.
 
 Other channels may ride along (``translate``: Foxglove's well-known messages, computed from the
 representations in the writer thread); their topics start with ``/`` and replay leaves them alone.

@@ -14,6 +14,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from tafel.core.framework.frame_info import FrameInfo
 from tafel.core.framework.manager import ModuleManager
 from tafel.core.framework.representation import is_state
 from tafel.core.logs.recording import Recorder
@@ -134,11 +135,17 @@ class ContextRunner:
         return self.manager.frame
 
     def step(self, time_ns: int) -> None:
+        """One frame at ``time_ns`` (the runtime's clock): sense, write ``FrameInfo``, take the hand-over,
+        execute, act, publish."""
         blackboard = self.manager.blackboard
         frame_number = self.manager.frame + 1
         self.platform.sense(self.name, blackboard, frame_number, time_ns)
         own_time = self.platform.frame_time_ns(self.name)
         self.time_ns = own_time if own_time is not None else time_ns
+        own_number = self.platform.frame_number_of(self.name)
+        info = blackboard.ensure(FrameInfo)  # the frame clock is the runtime's; the platform gives the time
+        info.frame_number = own_number if own_number is not None else frame_number
+        info.time_ns = self.time_ns
         if self.inbox is not None:
             bundle = self.inbox.latest()
             if bundle is not None and bundle is not self.last_bundle:

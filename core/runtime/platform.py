@@ -3,7 +3,9 @@
 A platform declares, per context, the representations it provides (sensors) and consumes (actuators).
 The runtime registers them as external inputs of the managers; modules never see the platform itself.
 Each frame the runtime calls ``sense`` before the context's modules run and ``act`` after them, as in
-NaoTH: cognition runs after sensing, motion before acting.
+NaoTH: cognition runs after sensing, motion before acting. The frame clock, ``FrameInfo``, is the
+runtime's: it writes it after ``sense`` with its own frame count and the time the platform gives
+(``frame_time_ns``, else the runtime's clock); a platform neither writes nor provides it.
 
 Two kinds of clock:
 - ``clock = "simulated"``: the runtime owns time (lockstep, deterministic). ``advance(time_ns)`` moves
@@ -94,7 +96,8 @@ class Platform:
         """Simulated clock only: move the world forward to ``time_ns`` (physics, synthetic data)."""
 
     def sense(self, context: str, blackboard: Blackboard, frame_number: int, time_ns: int) -> None:
-        """Write this frame's sensor representations of ``context`` into ``blackboard``.
+        """Write this frame's sensor representations of ``context`` into ``blackboard`` (the runtime
+        writes ``FrameInfo`` afterwards, with ``frame_number`` and ``time_ns`` or the platform's own).
 
         With an own clock this blocks until the data is there and may update the time it was taken
         (see ``frame_time_ns``); it raises ``EndOfData`` when the source is exhausted.
@@ -111,7 +114,14 @@ class Platform:
         raise NotImplementedError
 
     def frame_time_ns(self, context: str) -> int | None:
-        """Own clock only: the platform's time of the last ``sense``; None to use the wall clock."""
+        """The platform's time of the last ``sense`` of ``context`` (an own clock's, a log's recorded
+        one); None to use the runtime's clock. It becomes ``FrameInfo.time_ns``."""
+        return None
+
+    def frame_number_of(self, context: str) -> int | None:
+        """The number the platform's data gives the last ``sense``'s frame of ``context`` (a replayed
+        log's recorded one); None, as almost always, for the runtime's count. It becomes
+        ``FrameInfo.frame_number``."""
         return None
 
     def stop(self) -> None:

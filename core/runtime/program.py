@@ -2,7 +2,8 @@
 
 ``plan_program`` turns a merged configuration and a platform class into one ``ContextPlan`` per
 context: the module classes, provider choices and parameters, what the platform provides and
-consumes, which representations are handed over from the other context, and which modules had to be
+consumes, what the runtime itself provides (``FrameInfo`` everywhere, ``CognitionStatus`` in motion),
+which representations are handed over from the other context, and which modules had to be
 pruned because nothing can provide what they read. Plans are plain picklable data, so the concurrent
 runtime can send them to the processes that run the contexts.
 """
@@ -15,6 +16,7 @@ from typing import Any
 
 from tafel.core.framework.config import CONTEXTS, ConfigError, context_section
 from tafel.core.framework.errors import ConflictingProvidersError, MissingProviderError
+from tafel.core.framework.frame_info import FrameInfo
 from tafel.core.framework.graph import build_plan
 from tafel.core.framework.manager import ModuleManager
 from tafel.core.framework.module import Module, find_module
@@ -44,16 +46,28 @@ class ContextPlan:
     unfed: list[str] = field(default_factory=list)
     #: module name -> representations it would provide that come from the platform instead
     replaced: dict[str, list[str]] = field(default_factory=dict)
+    #: the platform feeds this context even if it provides no representation of it (``provides`` names
+    #: the context with an empty tuple: a log that holds only the frame clock of a context)
+    fed: bool = False
+
+    @property
+    def runtime_provides(self) -> list[type]:
+        """What the runtime writes itself: the frame clock (``FrameInfo``) in a context it runs, and
+        cognition's status in motion."""
+        clock: list[type] = [FrameInfo] if self.runs else []
+        return [*clock, CognitionStatus] if self.name == "motion" else clock
 
     @property
     def external(self) -> list[type]:
-        extra = [CognitionStatus] if self.name == "motion" else []
-        return list(dict.fromkeys([*self.platform_provides, *self.handover_in, *extra]))
+        """What comes from outside the context's modules: the runtime's, the platform's, the other context's."""
+        clock: list[type] = [FrameInfo] if self.runs else []
+        status: list[type] = [CognitionStatus] if self.name == "motion" else []  # the order blackboards always had
+        return list(dict.fromkeys([*clock, *self.platform_provides, *self.handover_in, *status]))
 
     @property
     def runs(self) -> bool:
         """A context runs when the platform feeds it: its frames are driven by the platform's data."""
-        return bool(self.platform_provides)
+        return self.fed or bool(self.platform_provides)
 
     def representations(self) -> set[type]:
         """Every representation the context's blackboard may hold: from outside, and what its modules
@@ -120,8 +134,10 @@ def plan_program(config: Mapping[str, Any], platform: type[Platform] | Platform,
             providers=section["providers"],
             disabled=section["disabled"],
             parameters={k: dict(v) for k, v in parameters.items() if isinstance(v, Mapping)},
-            platform_provides=list(platform.provides.get(context, ())),
+            # the runtime writes the frame clock: a platform that still lists it does not provide it
+            platform_provides=[r for r in platform.provides.get(context, ()) if r is not FrameInfo],
             platform_consumes=list(platform.consumes.get(context, ())),
+            fed=context in platform.provides,
         )
     for module_name, values in parameters.items():  # after the module lists, which import modules given by path
         find_module(module_name)  # a misspelt module must not silently lose its parameters
@@ -175,10 +191,11 @@ def _check_missing_providers(plans: Mapping[str, ContextPlan], platform: type[Pl
 
 
 def _provided_by_any_platform(current: type[Platform] | Platform) -> set[str]:
-    """Names of the representations that some registered platform provides (platforms load lazily)."""
+    """Names of the representations that some registered platform provides (platforms load lazily), and
+    the frame clock, which the runtime writes in every context a platform feeds."""
     from tafel.core.runtime.platform import available_platforms
 
-    names = {r.__name__ for reps in current.provides.values() for r in reps}
+    names = {FrameInfo.__name__, *(r.__name__ for reps in current.provides.values() for r in reps)}
     for entry in available_platforms().values():
         try:
             cls = entry.load()
@@ -206,15 +223,14 @@ def _check_single_provider(plans: Mapping[str, ContextPlan]) -> None:
 def _route(plans: Mapping[str, ContextPlan]) -> None:
     """Decide hand-overs and prune modules whose inputs nobody provides, until nothing changes.
 
-    Only what modules compute crosses between contexts; platform data stays in the context it is
-    given to (each context has its own clock in ``FrameInfo``, for example).
+    Only what modules compute crosses between contexts; platform and runtime data stay in the context
+    they are given to (each context has its own clock in ``FrameInfo``, for example).
     """
     pruned: dict[str, dict[str, list[str]]] = {c: {} for c in plans}
     while True:
         remaining = {c: [m for m in p.modules if m.__name__ not in {*p.disabled, *p.replaced, *pruned[c]}] for c, p in plans.items()}
         computed = {c: _provided(remaining[c]) for c in plans}
-        local = {c: set(plans[c].platform_provides) | computed[c] for c in plans}
-        local["motion"].add(CognitionStatus)
+        local = {c: {*plans[c].runtime_provides, *plans[c].platform_provides} | computed[c] for c in plans}
         changed = False
         for context in plans:
             available = local[context] | computed[_other(context)]

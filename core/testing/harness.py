@@ -8,6 +8,7 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, TypeVar
 
+from tafel.core.framework.frame_info import FrameInfo
 from tafel.core.framework.manager import Blackboard, ModuleManager
 from tafel.core.framework.module import Module
 from tafel.core.framework.representation import get_representation, is_representation
@@ -96,7 +97,7 @@ class ModuleHarness:
             if not is_representation(type(value)):
                 raise TypeError(f"inputs are representation instances, got {value!r}")
             self._check_input(type(value))
-            if type(value) is _frame_info_class():
+            if type(value) is FrameInfo:
                 self._clock_given = True  # the test sets the time of the next frame itself
             target = self.blackboard[type(value)]
             target.__dict__.update(copy.deepcopy(value).__dict__)  # deep: arrays and lists too
@@ -151,16 +152,15 @@ class ModuleHarness:
             self.set(*(values[self._fed_position] for values in self._fed.values()))
             self._fed_position += 1
         self.frame_number += 1
-        frame_info = _frame_info_class()
         if recorded_clock is not None:  # a replayed frame keeps its recorded number and time
             self.frame_number, self.time_ns = recorded_clock
-        elif self._clock_given and frame_info is not None and frame_info in self.blackboard:  # the test set FrameInfo: it is the clock
-            info = self.blackboard[frame_info]
+        elif self._clock_given and FrameInfo in self.blackboard:  # the test set FrameInfo: it is the clock
+            info = self.blackboard[FrameInfo]
             self.frame_number, self.time_ns = info.frame_number, info.time_ns
         elif self.frame_number > 1:
             self.time_ns += self.period_ns
-        if frame_info is not None and frame_info in self.blackboard and not self._clock_given:
-            info = self.blackboard[frame_info]
+        if FrameInfo in self.blackboard and not self._clock_given:
+            info = self.blackboard[FrameInfo]
             info.frame_number, info.time_ns = self.frame_number, self.time_ns
         self._clock_given = False
         self.manager.execute()
@@ -192,13 +192,6 @@ class ModuleHarness:
 
     def __getitem__(self, rep: type[R]) -> R:
         return self.blackboard[rep]
-
-
-def _frame_info_class() -> type[Any] | None:
-    try:
-        return get_representation("FrameInfo")
-    except KeyError:
-        return None
 
 
 def run_module(module: type[Module], *inputs: Any, frames: int = 1, parameters: Mapping[str, Any] | None = None) -> Blackboard:

@@ -8,9 +8,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from tafel.core.framework.frame_info import FrameInfo
 from tafel.core.framework.module import Module
 from tafel.core.testing.compare import differences
-from tafel.core.testing.harness import ModuleHarness, R, _frame_info_class, context_of
+from tafel.core.testing.harness import ModuleHarness, R, context_of
 
 
 @dataclass
@@ -65,9 +66,6 @@ def replay_module(module: type[Module], path: str | Path, *, start_s: float = 0.
     declared = module.requirements()
     context = context or context_of(module)
     harness = ModuleHarness(module, parameters=parameters, context=context)
-    frame_info = _frame_info_class()
-    if frame_info is None:
-        raise ValueError("replay_module needs the FrameInfo representation (import tafel.representations)")
     with LogReader(path) as reader:
         topics = set(reader.channels)
         frame_topic = f"{context}/FrameInfo"
@@ -77,7 +75,7 @@ def replay_module(module: type[Module], path: str | Path, *, start_s: float = 0.
         sources: dict[type, str] = {}
         missing = []
         for rep in declared.reads():
-            if rep is frame_info:
+            if rep is FrameInfo:
                 continue
             own, other = f"{context}/{rep.__name__}", f"{'motion' if context == 'cognition' else 'cognition'}/{rep.__name__}"
             if own in topics:
@@ -123,7 +121,7 @@ def replay_module(module: type[Module], path: str | Path, *, start_s: float = 0.
             continue
         inputs = [value(rep, latest[topic]) for rep, topic in sources.items() if topic in latest]
         harness.set(*inputs)
-        recorded_frame = deserialize(frame_info, frame_message.data)
+        recorded_frame = deserialize(FrameInfo, frame_message.data)
         harness._step((recorded_frame.frame_number, recorded_frame.time_ns))
         frames.append(ReplayFrame(
             frame_number=recorded_frame.frame_number,

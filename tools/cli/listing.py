@@ -55,6 +55,7 @@ def command_modules(args: argparse.Namespace, extra: Sequence[str]) -> int:
             if info["provider"] and len(info["alternatives"]) > 1:
                 others = [a for a in info["alternatives"] if a != info["provider"]]
                 print(f"  provider {rep}: {info['provider']} (alternatives: {', '.join(others)})")
+        print("  from runtime: " + ", ".join(r.__name__ for r in plan.runtime_provides))
         if plan.platform_provides:
             print("  from platform: " + ", ".join(r.__name__ for r in plan.platform_provides))
         if plan.platform_consumes:
