@@ -78,7 +78,8 @@ def label_pose(camera: str, x: float, y: float, radius: float, width: int, heigh
 
 def field_pose(crossings: dict[str, list[float]], projection: ImageProjection) -> tuple[float, float, float] | None:
     """The robot's pose on the field (mm, rad) from HULKs' three labelled goal-area lines, taken as the
-    opponent's goal area: the goal line, the goal area's front line and its side line."""
+    opponent's goal area: the goal line, the goal area's front line and its side line (the labels call
+    either of the last two ``goal_box_line``: the front line is the one along the goal line)."""
     try:
         names = ("border_line_0", "border_line_1", "goal_box_line_0", "goal_box_line_1", "connecting_line_0", "connecting_line_1")
         xs = np.array([crossings[n][0] for n in names], float)
@@ -90,6 +91,12 @@ def field_pose(crossings: dict[str, list[float]], projection: ImageProjection) -
         return None
     g0, g1, b0, b1, c0, c1 = ground
 
+    def parallel(p: np.ndarray, q: np.ndarray) -> float:
+        """|cos| of the angle between the goal line and the line p -> q."""
+        return abs(float(np.dot(g1 - g0, q - p))) / max(float(np.linalg.norm(g1 - g0) * np.linalg.norm(q - p)), 1e-9)
+
+    if parallel(c0, c1) > parallel(b0, b1):  # the labels name the front and side lines either way: the front one runs along the goal line
+        b0, b1, c0, c1 = c0, c1, b0, b1
     def meet(p: np.ndarray, q: np.ndarray, r: np.ndarray, s: np.ndarray) -> np.ndarray:
         d1, d2 = q - p, s - r
         t = np.linalg.solve(np.column_stack([d1, -d2]), r - p)[0]
@@ -102,7 +109,8 @@ def field_pose(crossings: dict[str, list[float]], projection: ImageProjection) -
     if np.dot(meet(g0, g1, c0, c1) - corner, forward) < 0:
         forward = -forward
     left = np.array([-forward[1], forward[0]])
-    side = -1.0 if np.dot(b1 - corner, left) > 0 else 1.0  # the front line runs from the corner towards the middle
+    middle = b1 if np.linalg.norm(b1 - corner) > np.linalg.norm(b0 - corner) else b0  # the front line's end away from the corner
+    side = -1.0 if np.dot(middle - corner, left) > 0 else 1.0  # the front line runs from the corner towards the middle
     corner_field = np.array([field.LENGTH / 2 - field.GOAL_AREA_LENGTH, side * field.GOAL_AREA_WIDTH / 2])
     heading = -math.atan2(forward[1], forward[0])
     c, s = math.cos(heading), math.sin(heading)

@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 
 from tafel.core import Module, bounded, provides, requires
 from tafel.debug import Canvas, DebugRequest
 from tafel.modules.perception.image_geometry import ImageProjection, camera_views
-from tafel.representations.field import GOAL_POST_DIAMETER
+from tafel.representations.field import GOAL_DEPTH, GOAL_HEIGHT, GOAL_POST_DIAMETER
 from tafel.representations.motion import CameraMatrixBuffer
 from tafel.representations.perception import (
     CameraImageBottom,
@@ -29,15 +31,64 @@ def column_groups(flags: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.nonzero(change == 1)[0], np.nonzero(change == -1)[0] - 1))
 
 
+def running_sums(values: np.ndarray) -> np.ndarray:
+    """``values`` (rows first) summed down the rows, with a row of zeros on top: a band's sum is a difference."""
+    return np.concatenate([np.zeros((1, *values.shape[1:]), np.float32), np.cumsum(values, axis=0, dtype=np.float32)])
+
+
+def edge_profile(summed: np.ndarray, top: np.ndarray, band: int, first_row: int, step: int = 1) -> np.ndarray:
+    """For each column, the strength of a vertical edge in the ``band`` rows above its row ``top``: the
+    length of the colour change from ``step`` px left of it to ``step`` px right of it, averaged over those
+    rows (``summed``: ``running_sums`` of the colour from ``first_row`` on). Averaged before its length is
+    taken, so an edge that runs straight up through the band adds up and noise cancels; over a few px,
+    so that the soft edge of a shaded round post counts as much as a sharp one."""
+    rows, width = summed.shape[0] - 1, summed.shape[1]
+    columns = np.arange(step, width - step)
+    low = np.clip(top[columns] - first_row, 0, rows)
+    high = np.clip(top[columns] - band - first_row, 0, rows)
+    change = (summed[low, columns + step] - summed[high, columns + step] - summed[low, columns - step] + summed[high, columns - step])
+    profile = np.zeros(width, np.float32)
+    profile[columns] = np.linalg.norm(change, axis=1) / np.maximum(low - high, 1)
+    return profile
+
+
+def band_means(summed: np.ndarray, top: np.ndarray, band: int, first_row: int) -> np.ndarray:
+    """For each column, the mean over the ``band`` rows above its row ``top`` of what ``summed`` (``running_sums``
+    from ``first_row`` on) sums."""
+    rows, width = summed.shape[0] - 1, summed.shape[1]
+    columns = np.arange(width)
+    low = np.clip(top - first_row, 0, rows)
+    high = np.clip(top - band - first_row, 0, rows)
+    count = np.maximum(low - high, 1).reshape((width,) + (1,) * (summed.ndim - 2))
+    return np.asarray((summed[low, columns] - summed[high, columns]) / count)
+
+
+def edge_peaks(profile: np.ndarray, minimum: float) -> np.ndarray:
+    """Columns where ``profile`` is at least ``minimum`` and no lower than its neighbours (one per plateau)."""
+    padded = np.concatenate([[-np.inf], profile, [-np.inf]])
+    peak = (profile >= minimum) & (profile >= padded[:-2]) & (profile > padded[2:])
+    return np.nonzero(peak)[0]
+
+
 @requires(CameraImageTop, CameraImageBottom, SegmentedImage, FieldColor, FieldBoundary, CameraMatrixBuffer)
 @provides(GoalPostPercept)
 class GoalPostDetector(Module):
-    """Posts stand on the field and rise over its boundary: columns that are white just above the
-    boundary are grouped, and each group is followed down to where it meets the field (its foot).
-    The goal line meets the foot, so the foot is where the white widens into the line. A group is a
-    post if its width fits a 100 mm post at the distance of its foot and it rises well above it. The
-    goal's rear frame and the net's poles are thinner pipes, farther away than the foot the scan finds
-    for them: too thin for a post there."""
+    """A post stands on the field and rises over its boundary, as the teams find it:
+
+    - Edges: just above the field boundary, columns where the colour changes sharply and the change
+      runs straight up (a vertical edge); two edges with something white between them that differs
+      from both sides are a post candidate. Edges, not white alone: a hall's pale floor is as
+      unsaturated as a post, and merged with it into one wide white stretch.
+    - Foot: followed down between the edges to where the carpet begins (the post stands on the goal
+      line, so its foot may lie below the boundary the carpet behind the goal makes). The foot must lie
+      near the boundary: no more than ``max_behind`` mm in front of it (a robot's leg on the field is
+      not a post), and the white must reach down to it (something behind the field's edge stands on
+      the hall's floor, with floor between it and the carpet).
+    - Size: the width fits a 100 mm post at the foot's distance, by the camera matrix, and the white
+      rises between the edges along the post's projected axis to most of a goal's height.
+    - The goal's frame: its rear pipes stand half a metre behind the posts and are thinner; of two
+      posts found within a goal's depth of each other, the nearer one is the post.
+    """
 
     camera_image_top: CameraImageTop
     camera_image_bottom: CameraImageBottom
@@ -51,80 +102,201 @@ class GoalPostDetector(Module):
 
     @dataclass
     class Parameters:
-        band: int = bounded(2, 60, 12)
-        """px above the boundary that must be white for a post column"""
+        band: float = bounded(0.01, 0.2, 0.04)
+        """share of the image height above the boundary in which the posts' edges are measured"""
+        edge_min: float = bounded(1.0, 100.0, 14.0)
+        """the least colour change (YCrCb, averaged over the band) across a post's edge (2 px at 320x240, 4 at 640x480)"""
+        contrast_min: float = bounded(1.0, 100.0, 14.0)
+        """the least colour difference between a post and what is beside it (YCrCb)"""
         saturation_max: int = bounded(0, 255, 60)
         white_share: float = bounded(0.3, 1.0, 0.55)
         """white is at least this share of the brightest unsaturated value"""
-        width_tolerance: float = bounded(0.1, 2.0, 0.6)
+        width_tolerance: float = bounded(0.1, 2.0, 0.5)
         """share by which the width may exceed a post's at that distance (shading, blur)"""
-        width_low: float = bounded(0.1, 1.0, 0.75)
+        width_low: float = bounded(0.1, 1.0, 0.7)
         """the least share of a post's width at that distance: the goal's rear frame and the net's poles are
         thinner pipes, and farther away than the foot the scan finds for them"""
+        max_behind: float = bounded(100.0, 5000.0, 1500.0)
+        """mm the field's boundary may lie behind a post's foot (the border strip behind the goal line)"""
+        rise: float = bounded(0.2, 1.0, 0.85)
+        """share of a goal's height along which the white must rise above the foot (where it is in the image)"""
+        white_rows: float = bounded(0.3, 1.0, 0.75)
+        """share of the rows along that rise in which the post's middle is white, of its colour, unlike its sides"""
+        uniform_max: float = bounded(1.0, 100.0, 20.0)
+        """the most a row of the post may differ from the post's median colour (YCrCb)"""
         min_height: float = bounded(1.0, 20.0, 3.0)
-        """the white above the foot must be this many widths high"""
+        """the white above the foot in the image must be this many widths high"""
 
     parameters: Parameters
+
+    def __init__(self) -> None:
+        self.colour = np.zeros((0, 0, 3), np.float32)
+        """the image being searched, in YCrCb"""
+        self.band_colour = np.zeros((0, 3), np.float32)
+        """each column's mean colour (YCrCb) in the band above the boundary"""
+        self.band_white = np.zeros(0, np.float32)
+        """each column's share of white pixels in that band"""
 
     def execute(self) -> None:
         self.goal_post_percept.posts = []
         if not self.field_color.valid:
             return
-        for camera, _, projection in camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer):
+        for camera, image, projection in camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer):
             boundary = self.field_boundary.rows(camera)
             if boundary.size != projection.width:
                 continue
-            self.goal_post_percept.posts += self.posts(camera, boundary, projection)
+            self.goal_post_percept.posts += self.posts(camera, np.asarray(image.image), boundary, projection)
         self.goal_post_percept.posts.sort(key=lambda post: post.x * post.x + post.y * post.y)
 
-    def posts(self, camera: str, boundary: np.ndarray, projection: ImageProjection) -> list[GoalPost]:
+    def posts(self, camera: str, image: np.ndarray, boundary: np.ndarray, projection: ImageProjection) -> list[GoalPost]:
+        """The posts in one camera's image."""
         p = self.parameters
         hsv, green = self.segmented_image.hsv(camera), self.segmented_image.green(camera)
-        height = hsv.shape[0]
-        unsaturated = (hsv[..., 1] <= p.saturation_max) & ~green
-        if not unsaturated.any():
+        height, width = green.shape
+        if image.shape[:2] != green.shape:
             return []
-        white = unsaturated & (hsv[..., 2] >= p.white_share * self.segmented_image.white(camera))
-        rows = np.arange(height)[:, None]
+        white = (hsv[..., 1] <= p.saturation_max) & ~green & (hsv[..., 2] >= p.white_share * self.segmented_image.white(camera))
+        band = max(3, int(round(p.band * height)))
         top = np.round(boundary).astype(int)
-        band = (rows < top[None, :]) & (rows >= top[None, :] - p.band)
-        share = (white & band).sum(axis=0) / np.maximum(band.sum(axis=0), 1)
-        found = []
-        for first, last in column_groups((share >= 0.8) & (top > p.band)):
-            post = self.post(camera, white, first, last, top, projection)
-            if post is not None:
-                found.append(post)
-                if self.draw:
-                    self.draw.canvas(Canvas.image(camera)).line(post.image_x, 0, post.image_x, height, color="yellow", width=2)
-                    self.draw.canvas(Canvas.ROBOT).circle(post.x, post.y, GOAL_POST_DIAMETER / 2, color="yellow", width=2)
+        room = top > band
+        if not room.any():
+            return []
+        self.colour = cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2YCrCb).astype(np.float32)
+        first_row, last_row = int(top[room].min()) - band, int(top[room].max())
+        colour = self.colour[first_row:last_row]
+        summed = running_sums(colour)
+        profile = np.where(room, edge_profile(summed, top, band, first_row, max(1, width // 320)), 0.0)
+        edges = edge_peaks(profile, p.edge_min)
+        # the least width a post can have at each edge: the one it has standing on the boundary (its foot is no farther)
+        ground, hit = projection.to_ground(edges + 0.5, top[edges] + 0.5)
+        distance = np.linalg.norm(np.column_stack([ground, np.zeros(len(edges))]) - projection.translation, axis=1)
+        least = np.where(hit, p.width_low * projection.fx * GOAL_POST_DIAMETER / np.maximum(distance, 1.0) - 1.0, 0.0)
+        self.band_colour = band_means(summed, top, band, first_row)
+        self.band_white = band_means(running_sums(white[first_row:last_row].astype(np.float32)), top, band, first_row)
+        found: list[GoalPost] = []
+        for i, left in enumerate(edges):
+            best: tuple[float, GoalPost] | None = None
+            for right in edges[i + 1 : i + 5]:  # one of the next edges (stickers, dents and shadows on a post make more)
+                if right - left < least[i]:
+                    continue
+                post = self.post(camera, int(left), int(right), top, white, green, projection)
+                if post is not None:
+                    distance = float(np.linalg.norm(np.array([post.x, post.y, 0.0]) - projection.translation))
+                    misfit = abs(math.log(post.image_width * distance / (projection.fx * GOAL_POST_DIAMETER)))
+                    if best is None or misfit < best[0]:
+                        best = (misfit, post)
+            if best is not None:
+                found.append(best[1])
+        found = self.nearest(self.distinct(found))
+        if self.draw:
+            for post in found:
+                self.draw.canvas(Canvas.image(camera)).line(post.image_x, 0, post.image_x, post.image_foot, color="yellow", width=2)
+                self.draw.canvas(Canvas.ROBOT).circle(post.x, post.y, GOAL_POST_DIAMETER / 2, color="yellow", width=2)
         return found
 
-    def post(self, camera: str, white: np.ndarray, first: int, last: int, top: np.ndarray, projection: ImageProjection) -> GoalPost | None:
-        """The post whose columns are ``first``..``last``, or None if they are no post."""
+    def post(self, camera: str, left: int, right: int, top: np.ndarray, white: np.ndarray, green: np.ndarray,
+             projection: ImageProjection) -> GoalPost | None:
+        """The post between the edges at columns ``left`` and ``right``, or None if there is none."""
         p = self.parameters
-        height, width = white.shape
-        centre = (first + last) // 2
-        post_width = last - first + 1
-        foot = int(top[centre])
-        while foot + 1 < height and white[foot + 1, centre]:
-            run = white[foot + 1, max(0, first - post_width) : min(width, last + post_width + 1)]
-            if run.mean() > 0.9 and post_width > 1:  # as wide as three posts: the goal line under the foot
-                break
-            foot += 1
-        if foot + 1 >= height:
+        height, width = green.shape
+        post_width = right - left
+        side = max(2, post_width // 2)
+        if post_width < 2 or left < 1 or right > width - 2:
+            return None  # too thin to tell, or cut by the image's edge: its width is not known
+        centre = (left + right) / 2
+        column = int(centre)
+        margin = post_width // 4
+        inner = slice(left + 1 + margin // 2, max(left + 2 + margin // 2, right - margin // 2))
+        # between the edges, in the band above the boundary: white, and unlike both sides
+        if self.band_white[inner].mean() < 0.6:
+            return None
+        inside = self.band_colour[inner].mean(axis=0)
+        for outside in (self.band_colour[max(0, left - side) : left], self.band_colour[right + 1 : right + 1 + side]):
+            if np.linalg.norm(inside - outside.mean(axis=0)) < p.contrast_min:
+                return None
+        # the foot: down between the edges to where the carpet begins (a few rows of it: the carpet's
+        # light makes green spots on a post's lower part)
+        start = max(0, int(top[column]) - 1)
+        carpet = (green[start:, inner].mean(axis=1) >= 0.5).astype(np.int32)
+        run = max(2, post_width // 6)
+        lasting = np.convolve(carpet, np.ones(run, np.int32), mode="valid") == run
+        if not lasting.any():
             return None  # the foot is not in the image
-        ground, hit = projection.to_ground(np.array([centre + 0.5]), np.array([foot + 0.5]))
+        foot = start + int(np.argmax(lasting)) - 1
+        if foot < start:
+            foot = start
+        ground, hit = projection.to_ground(np.array([centre]), np.array([foot + 0.5]))
         if not hit[0]:
             return None
         distance = float(np.linalg.norm(np.append(ground[0], 0.0) - projection.translation))
         expected = projection.fx * GOAL_POST_DIAMETER / distance
         if post_width - expected > p.width_tolerance * expected + 1.5 or post_width < p.width_low * expected - 1.0:
             return None
-        column = white[: foot + 1, centre]
-        rise = foot - (np.nonzero(~column)[0].max() if (~column).any() else -1)
-        if rise < p.min_height * max(post_width, expected):
+        # the foot near the boundary: the boundary no farther behind it than max_behind
+        eye = projection.translation[:2]
+        direction = (ground[0] - eye) / max(float(np.linalg.norm(ground[0] - eye)), 1.0)
+        behind, front = projection.to_image(np.array([[*(ground[0] + direction * p.max_behind), 0.0]]))
+        if front[0] and top[column] < behind[0, 1] - 2.0 - 0.01 * height:
             return None
-        # the foot's edge is seen; the post's centre lies half a post behind it
-        direction = ground[0] / max(np.linalg.norm(ground[0]), 1.0)
-        x, y = ground[0] + direction * GOAL_POST_DIAMETER / 2
+        # the post rises from the foot along its projected axis: white, of one colour, unlike what is beside it
+        post_centre = ground[0] + direction * GOAL_POST_DIAMETER / 2
+        summit, front = projection.to_image(np.array([[*post_centre, p.rise * GOAL_HEIGHT]]))
+        if not front[0] or summit[0, 1] >= foot:
+            return None
+        upper = max(0, int(summit[0, 1]))
+        if foot - upper < p.min_height * post_width:
+            return None
+        def axis(ys: np.ndarray) -> np.ndarray:
+            """The post's centre column in the rows ``ys``."""
+            return np.round(centre + (summit[0, 0] - centre) * (foot - ys) / max(foot - summit[0, 1], 1.0)).astype(int)
+
+        ys = np.unique(np.linspace(upper, foot, min(foot - upper + 1, 48)).round().astype(int))  # at most 48 rows: enough to judge
+        if self.post_rows(ys, axis(ys), post_width, white).mean() < p.white_rows:
+            return None
+        # down to the foot (above the line it stands on): a thing behind the field's edge stands on the hall's
+        # floor (or its reflection on a glossy floor continues it), with something else between it and the carpet
+        line = max(2, post_width // 3)
+        ys = np.arange(max(upper, foot - 3 * line), foot - line + 1)
+        if ys.size and self.post_rows(ys, axis(ys), post_width, white).mean() < 0.5:
+            return None
+        x, y = post_centre
         return GoalPost(float(x), float(y), camera, float(centre), float(post_width), float(foot))
+
+    def post_rows(self, ys: np.ndarray, xs: np.ndarray, post_width: int, white: np.ndarray) -> np.ndarray:
+        """For each row ``ys`` with the post's centre at ``xs``: whether the post's middle is white, of the
+        post's colour (the median along it) and unlike at least one side."""
+        p = self.parameters
+        height, width = white.shape
+        half = max(1, post_width // 4)
+        side = max(2, post_width // 2)
+
+        def strip(first: int, last: int) -> np.ndarray:
+            columns = np.clip(xs[:, None] + np.arange(first, last + 1)[None, :], 0, width - 1)
+            return np.asarray(self.colour[ys[:, None], columns].mean(axis=1))
+
+        columns = np.clip(xs[:, None] + np.arange(-half, half + 1)[None, :], 0, width - 1)
+        inside = strip(-half, half)
+        edge = (post_width + 1) // 2
+        left, right = strip(-edge - side, -edge - 1), strip(edge + 1, edge + side)
+        unlike = np.maximum(np.linalg.norm(inside - left, axis=1), np.linalg.norm(inside - right, axis=1)) >= p.contrast_min
+        same = np.linalg.norm(inside - np.median(inside, axis=0), axis=1) <= p.uniform_max
+        return np.asarray((white[ys[:, None], columns].mean(axis=1) >= 0.5) & unlike & same)
+
+    @staticmethod
+    def distinct(posts: list[GoalPost]) -> list[GoalPost]:
+        """One post per stretch of columns: of overlapping ones, the first found."""
+        kept: list[GoalPost] = []
+        for post in posts:
+            if all(abs(post.image_x - other.image_x) > (post.image_width + other.image_width) / 2 for other in kept):
+                kept.append(post)
+        return kept
+
+    @staticmethod
+    def nearest(posts: list[GoalPost]) -> list[GoalPost]:
+        """Without the posts that stand within a goal's depth behind a nearer one: the goal's rear frame
+        (behind each post), seen past the post."""
+        kept: list[GoalPost] = []
+        for post in sorted(posts, key=lambda post: post.x * post.x + post.y * post.y):
+            if all((post.x - other.x) ** 2 + (post.y - other.y) ** 2 > (GOAL_DEPTH + GOAL_POST_DIAMETER) ** 2 for other in kept):
+                kept.append(post)
+        return kept
