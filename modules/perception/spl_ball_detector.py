@@ -148,6 +148,10 @@ class SPLBallDetector(Module):
                         beside = self.beside_post(hsv, green, spot, white)
                         score = self.check(hsv, green, beside, white, beside_post=True)[0] if beside else 0.0
                         spot = beside or spot
+                    if score and self.near_edge(spot, green.shape):  # partly out of sight: centred on what is seen of it
+                        fitted = self.fit_visible(hsv, green, spot)
+                        refitted = self.check(hsv, green, fitted, white)[0] if fitted else 0.0
+                        spot, score = (fitted, refitted) if fitted and refitted else (spot, score)
                     self.examined.append((camera, spot, score))
                     if score and self.parameters.classifier:
                         light = light or carpet(hsv, green, sampled)
@@ -220,6 +224,59 @@ class SPLBallDetector(Module):
                 far -= 1
             spot.y = float(far + e)
         return spot
+
+    @staticmethod
+    def near_edge(spot: Spot, shape: tuple[int, ...]) -> bool:
+        """Whether the ball at ``spot`` may reach out of the image (its expected radius and a half)."""
+        height, width = shape[:2]
+        reach = 1.5 * max(spot.expected, spot.radius)
+        return spot.x < reach or spot.x > width - 1 - reach or spot.y < reach or spot.y > height - 1 - reach
+
+    @staticmethod
+    def fit_visible(hsv: np.ndarray, green: np.ndarray, spot: Spot, rays: int = 24) -> Spot | None:
+        """The spot re-centred on the visible part of the ball's outline, or None if too little of it is seen.
+        Near the image's edge the distance transform's peak is off the ball's centre (the edge cuts the ball,
+        its shadow or a foot beside it widens the blob): along rays from the spot, the last of the ball's
+        bright pixels before the carpet is a point of its outline; rays that leave the image first saw none.
+        A circle of the expected radius is fitted to those points (Gauss-Newton, the worst fifth dropped)."""
+        height, width = green.shape
+        r = max(spot.expected, 1.0)
+        angles = np.linspace(0.0, 2 * math.pi, rays, endpoint=False)
+        steps = np.arange(0.3 * r, 1.8 * r, 1.0)
+        xs = spot.x + np.cos(angles)[:, None] * steps[None, :]
+        ys = spot.y + np.sin(angles)[:, None] * steps[None, :]
+        seen = (xs >= 0) & (xs <= width - 1) & (ys >= 0) & (ys <= height - 1)
+        xi, yi = np.clip(np.round(xs).astype(int), 0, width - 1), np.clip(np.round(ys).astype(int), 0, height - 1)
+        inner = (np.hypot(xi - spot.x, yi - spot.y) <= 0.9 * r) & ~green[yi, xi]
+        if inner.sum() < 3:
+            return None
+        bright = float(np.percentile(hsv[yi, xi, 2][inner], 90))
+        ball = seen & ~green[yi, xi] & (hsv[yi, xi, 2] >= 0.6 * bright)
+        last = np.where(ball.any(axis=1), steps.size - 1 - np.argmax(ball[:, ::-1], axis=1), -1)
+        index = np.arange(rays)
+        ends = (last >= 0) & (last + 1 < steps.size)
+        ends &= seen[index, np.minimum(last + 1, steps.size - 1)]  # the outline is in sight, not cut by the edge
+        points = np.column_stack([xs[index, np.maximum(last, 0)], ys[index, np.maximum(last, 0)]])[ends]
+        if len(points) < rays // 4:
+            return None
+        centre = np.array([spot.x, spot.y])
+        for keep in (1.0, 0.8):
+            for _ in range(10):
+                offset = points - centre
+                distance = np.maximum(np.linalg.norm(offset, axis=1), 1e-6)
+                residual = distance - r
+                jacobian = -offset / distance[:, None]
+                step = np.linalg.lstsq(jacobian, -residual, rcond=None)[0]
+                centre = centre + step
+                if np.linalg.norm(step) < 0.05:
+                    break
+            if keep < 1.0:
+                break
+            residual = np.abs(np.linalg.norm(points - centre, axis=1) - r)
+            points = points[residual <= np.quantile(residual, 0.8)]
+        if np.hypot(*(centre - (spot.x, spot.y))) > r:
+            return None  # not the spot's ball any more
+        return Spot(float(centre[0]), float(centre[1]), r, spot.expected)
 
     def spots(self, green: np.ndarray, boundary: np.ndarray, projection: ImageProjection, dark: np.ndarray | None = None) -> list[Spot]:
         """Peaks of the non-green field's distance transform whose thickness fits a ball there (and, given
