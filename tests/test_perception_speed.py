@@ -13,13 +13,13 @@ from hypothesis import strategies as st
 
 from tafel.core.framework.manager import make_module
 from tafel.modules.perception.field_boundary_detector import cell_shares
-from tafel.modules.perception.field_color_provider import below, white_pixels
+from tafel.modules.perception.field_color_provider import below, byte_median, white_pixels
 from tafel.modules.perception.image_geometry import ImageProjection, own_body_mask
-from tafel.modules.perception.line_detector import LineDetector, green_on_both_sides, white_runs
+from tafel.modules.perception.line_detector import CIRCLE_RADIUS, LineDetector, green_on_both_sides, longest_arc, white_runs
 from tafel.modules.perception.spl_ball_detector import SPLBallDetector, Spot, carpet, carpet_sample
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import CameraMatrix
-from tafel.representations.perception import BallCandidate, BallImagePercept, FieldBoundary, GoalPost, GoalPostPercept
+from tafel.representations.perception import BallCandidate, BallImagePercept, FieldBoundary, GoalPost, GoalPostPercept, LinePercept
 
 
 def level_projection(width: int, height: int, pitch: float) -> ImageProjection:
@@ -336,3 +336,56 @@ def test_white_pixels_are_numpys_comparisons(seed: int, saturation_max: float, v
     mask = white_pixels(hsv, saturation_max, value_min)
     assert mask.dtype == np.bool_
     np.testing.assert_array_equal(mask, (hsv[..., 1] <= saturation_max) & (hsv[..., 2] >= value_min))
+
+
+@settings(max_examples=300)
+@given(st.lists(st.integers(0, 255), max_size=300))
+def test_byte_median_is_numpys(values: list[int]) -> None:
+    array = np.array(values, np.uint8)
+    if values:
+        assert byte_median(array) == np.median(array)
+
+
+def reference_fit_circle(self: LineDetector, points: np.ndarray) -> np.ndarray:
+    p, out = self.parameters, self.line_percept
+    if len(points) < p.min_circle_points:
+        return points
+    pairs = self.rng.integers(0, len(points), (p.iterations * 2, 2))
+    a, b = points[pairs[:, 0]], points[pairs[:, 1]]
+    chord = np.linalg.norm(b - a, axis=1)
+    usable = (chord > 200.0) & (chord < 2 * CIRCLE_RADIUS)
+    a, b, chord = a[usable], b[usable], chord[usable]
+    if len(a) == 0:
+        return points
+    normal = np.column_stack([-(b - a)[:, 1], (b - a)[:, 0]]) / chord[:, None]
+    offset = np.sqrt(CIRCLE_RADIUS**2 - (chord / 2) ** 2)[:, None]
+    centres = np.vstack([(a + b) / 2 + offset * normal, (a + b) / 2 - offset * normal])
+    residual = np.abs(np.linalg.norm(points[None, :, :] - centres[:, None, :], axis=2) - CIRCLE_RADIUS)
+    counts = (residual < p.inlier_distance).sum(axis=1)
+    best = int(np.argmax(counts))
+    if counts[best] < p.min_circle_points:
+        return points
+    centre, inliers = centres[best], residual[best] < p.inlier_distance
+    angles = np.arctan2(points[inliers, 1] - centre[1], points[inliers, 0] - centre[0])
+    if longest_arc(angles, math.radians(p.max_arc_gap)) < math.radians(p.min_arc):
+        return points
+    out.circle_seen, out.circle_x, out.circle_y = True, float(centre[0]), float(centre[1])
+    return points[~inliers]
+
+
+@settings(max_examples=200)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 200), st.floats(0.0, 1.0))
+def test_the_centre_circle_is_found_as_before(seed: int, count: int, on_circle: float) -> None:
+    rng = np.random.default_rng(seed)
+    centre = rng.normal(0, 1500, 2)
+    angles = rng.uniform(0, 2 * math.pi, count)
+    points = np.where((rng.random(count) < on_circle)[:, None], centre + CIRCLE_RADIUS * np.column_stack([np.cos(angles), np.sin(angles)]),
+                      rng.normal(0, 2000, (count, 2))) + rng.normal(0, 20, (count, 2))
+    found = []
+    for fit in (LineDetector.fit_circle, reference_fit_circle):
+        self = make_module(LineDetector, parameters=LineDetector.Parameters(), line_percept=LinePercept(segments=[]))
+        self.rng = np.random.default_rng(seed)  # type: ignore[attr-defined]
+        rest = fit(self, points)  # type: ignore[arg-type]
+        percept = self.line_percept  # type: ignore[attr-defined]
+        found.append((rest.tobytes(), percept.circle_seen, percept.circle_x, percept.circle_y))
+    assert found[0] == found[1]

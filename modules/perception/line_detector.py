@@ -224,7 +224,8 @@ class LineDetector(Module):
         normal = np.column_stack([-(b - a)[:, 1], (b - a)[:, 0]]) / chord[:, None]
         offset = np.sqrt(CIRCLE_RADIUS**2 - (chord / 2) ** 2)[:, None]
         centres = np.vstack([(a + b) / 2 + offset * normal, (a + b) / 2 - offset * normal])
-        residual = np.abs(np.linalg.norm(points[None, :, :] - centres[:, None, :], axis=2) - CIRCLE_RADIUS)
+        dx, dy = points[None, :, 0] - centres[:, None, 0], points[None, :, 1] - centres[:, None, 1]
+        residual = np.abs(np.sqrt(dx * dx + dy * dy) - CIRCLE_RADIUS)  # the norm as np.linalg.norm sums it, without its copies
         counts = (residual < p.inlier_distance).sum(axis=1)
         best = int(np.argmax(counts))
         if counts[best] < p.min_circle_points:
