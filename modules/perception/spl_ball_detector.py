@@ -11,7 +11,7 @@ import numpy as np
 from tafel.core import Module, bounded, provides, requires
 from tafel.debug import Canvas, DebugRequest, Stopwatch
 from tafel.modules.perception.ball_classifier import BallClassifier, features
-from tafel.modules.perception.field_color_provider import below
+from tafel.modules.perception.field_color_provider import below, byte_median
 from tafel.modules.perception.image_geometry import ImageProjection, camera_views
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import CameraMatrixBuffer
@@ -39,7 +39,7 @@ def carpet(hsv: np.ndarray, green: np.ndarray, sampled: np.ndarray | None = None
         sampled = carpet_sample(hsv, green)
     if len(sampled) < 10:
         return 128.0, 128.0
-    return float(np.median(sampled[:, 2])), float(np.median(sampled[:, 1]))
+    return byte_median(sampled[:, 2]), byte_median(sampled[:, 1])
 
 
 @dataclass
@@ -182,7 +182,7 @@ class SPLBallDetector(Module):
             sampled = carpet_sample(hsv, green)
         if len(sampled) < 10:
             return None
-        return below(hsv, 2, self.parameters.black_contrast * float(np.median(sampled[:, 2])))
+        return below(hsv, 2, self.parameters.black_contrast * byte_median(sampled[:, 2]))
 
     def strict_green(self, hsv: np.ndarray, green: np.ndarray, sampled: np.ndarray | None = None) -> np.ndarray:
         """The green mask without the pixels much less saturated than the carpet's median. ``sampled``:
@@ -191,7 +191,7 @@ class SPLBallDetector(Module):
             return green
         if sampled is None:
             sampled = carpet_sample(hsv, green)
-        median = float(np.median(sampled[:, 1])) if len(sampled) else float(np.median(hsv[..., 1][green]))
+        median = byte_median(sampled[:, 1]) if len(sampled) else byte_median(hsv[..., 1][green])
         return green & ~below(hsv, 1, self.parameters.strict_saturation * median)
 
     @staticmethod
@@ -286,7 +286,7 @@ class SPLBallDetector(Module):
         known = boundary.size == width
         top = max(0, int(boundary.min() - p.above_boundary)) if known else 0  # nothing above the field is looked at
         field = np.arange(top, height)[:, None] >= boundary[None, :] - p.above_boundary if known else np.ones((height - top, width), bool)
-        solid = (~green[top:] & field).astype(np.uint8)
+        solid = (~green[top:] & field).view(np.uint8)
         if not solid.any():
             return []
         thickness = cv2.distanceTransform(solid, cv2.DIST_L2, 3)
