@@ -119,3 +119,59 @@ def test_bad_team_sizes_are_refused_with_what_would_be_right(tmp_path: Path) -> 
     done = subprocess.run([sys.executable, "-m", "tafel.tools.cli", "match", "--teams", "6v6"], capture_output=True, text=True,
                           env={**os.environ, "PYTHONPATH": str(REPO)}, cwd=tmp_path)
     assert done.returncode == 2 and "--teams takes NvM with 0 to 5 robots a team (1v1, 2v2, 5v5, 1v0), got '6v6'" in done.stderr
+
+
+# --------------------------------------------------------------------------- the rules, refereed from ground truth
+@pytest.fixture(scope="module")
+def set_plays(tmp_path_factory: pytest.TempPathFactory) -> dict:
+    """One short 2v2 (one half, cameras off) staged by the referee: team 1's kick-off, with READY cut short so
+    that team 2's robots are still on their way to the ball while it is on; at 17 s a pushing free kick for
+    team 1 at the centre spot, where team 2's striker waits; open play until the half ends at 27 s."""
+    folder = tmp_path_factory.mktemp("set_plays")
+    result, done = match(folder, "--teams", "2v2", "--halves", "1", "--seconds", "18", "--ready-seconds", "3", "--cameras", "off",
+                         "--seed", "1", "--call", "17:pushing_free_kick:1")
+    assert done.returncode == 0 and result["ended"] == "the game is over", done.stdout[-2000:] + done.stderr[-3000:]
+    return result
+
+
+def restriction(result: dict, set_play: str) -> dict:
+    return next(r for r in result["set_plays"] if r["set_play"] == set_play)
+
+
+def test_at_the_opponents_kick_off_nobody_enters_the_centre_circle_until_the_ball_moved_or_10_s(set_plays: dict) -> None:
+    kick_off = restriction(set_plays, "kick_off")
+    assert kick_off["kicking_team"] == 1 and kick_off["end_s"] - kick_off["start_s"] >= 5.0, kick_off  # seconds of it
+    assert kick_off["nearest_mm"] < kick_off["nearest_at_start_mm"] - 1000.0  # team 2 walked towards the ball ...
+    assert kick_off["nearest_mm"] >= 750.0  # ... and stayed out of the centre circle (the torso's distance from the centre)
+    assert not [f for f in set_plays["fouls"] if "centre circle" in f["reason"]]
+
+
+def test_at_an_opponent_free_kick_every_defender_keeps_0_75_m_from_the_ball_until_it_is_taken(set_plays: dict) -> None:
+    free_kick = restriction(set_plays, "pushing_free_kick")
+    assert free_kick["kicking_team"] == 1 and free_kick["start_s"] == 17.0 and free_kick["end_s"] - free_kick["start_s"] >= 2.0
+    assert free_kick["nearest_at_start_mm"] < 2000.0  # team 2 was near the ball when it was called ...
+    assert free_kick["nearest_mm"] >= 750.0, free_kick  # ... and kept 0.75 m until team 1 touched it (or the half ended)
+    assert not [f for f in set_plays["fouls"] if "0.75 m" in f["reason"]]
+
+
+def test_in_that_match_robots_walk_around_each_other_and_nobody_commits_a_foul(set_plays: dict) -> None:
+    assert not [f for f in set_plays["fouls"] if f["penalty"] == "player_pushing"]
+    assert set_plays["fouls"] == [] and [team["fouls"] for team in set_plays["teams"]] == [0, 0]
+
+
+def test_a_penalty_shoot_out_alone_the_teams_kick_in_turn_and_the_referee_judges_each_shot(tmp_path: Path) -> None:
+    result, done = match(tmp_path, "--teams", "1v1", "--shoot-out", "--penalty-shots", "1", "--sudden-death-shots", "0",
+                         "--cameras", "off", "--seed", "1")
+    assert done.returncode == 0 and result["ended"] == "the game is over", done.stdout[-2000:] + done.stderr[-3000:]
+    shoot_out, shots = result["shoot_out"], result["shoot_out"]["shots"]
+    assert [(s["team"], s["striker"], s["keeper"]) for s in shots] == [(1, 1, 1), (2, 1, 1)]
+    assert all(s["outcome"] in ("goal", "saved", "missed") for s in shots)  # the striker took each shot: none ran out of time
+    playing = [e["time_s"] for e in result["events"] if e["event"] == "PLAYING"]
+    assert len(playing) == 2 and all(0.0 < s["time_s"] - start < 30.0 for s, start in zip(shots, playing))
+    goals = [sum(s["team"] == team and s["outcome"] == "goal" for s in shots) for team in (1, 2)]
+    assert shoot_out["score"] == f"{goals[0]}:{goals[1]}" and result["score"] == "0:0"
+    assert shoot_out["winner"] == (1 if goals[0] > goals[1] else 2 if goals[1] > goals[0] else None)
+    assert f"penalty shot 1: team 1 player 1 against keeper 1: {shots[0]['outcome']}" in done.stdout
+    assert f"shoot-out {shoot_out['score']}" in done.stdout
+    # GameController3 counts no team messages in the shoot-out
+    assert all(team["team_messages"] == 0 < team["team_messages_heard"] for team in result["teams"])

@@ -10,9 +10,11 @@ from collections.abc import Iterator
 import pytest
 
 from tafel.platforms.match_world import MatchWorld, Side
+from tafel.platforms.network import listening_socket
 from tafel.representations.game import Penalty, SetPlay, State
 from tafel.tools.simulation.match import free_udp_port
-from tafel.tools.simulation.referee import Player, Referee
+from tafel.tools.simulation.referee import Call, Player, Referee
+from tests.test_game_controller import GAME, TEAM  # the published layout, never the code under test
 
 TICK = 0.01
 
@@ -122,3 +124,127 @@ def test_walking_into_an_opponent_away_from_the_ball_is_pushing(referee: Referee
     run(referee, TICK)
     foul = referee.fouls[-1]
     assert (foul.team, foul.player, foul.penalty) == (1, 1, Penalty.player_pushing) and "walked into team 2 player 1" in foul.reason
+
+
+# ------------------------------------------------------------------------------- penalty shoot-out
+def packets_heard(sock: socket.socket) -> list[tuple[tuple, list[tuple]]]:
+    """Every GameController packet waiting on ``sock``, read with the published layout (the header's
+    fields, then each team's fields and (penalty, seconds) per robot)."""
+    heard = []
+    while True:
+        try:
+            data = sock.recv(1024)
+        except BlockingIOError:
+            return heard
+        header = GAME.unpack_from(data)
+        teams = [TEAM.unpack_from(data, GAME.size + t * TEAM.size) for t in (0, 1)]
+        heard.append((header, [(*team[:8], list(zip(team[8::2], team[9::2]))) for team in teams]))
+
+
+def last_packet(ref: Referee, sock: socket.socket) -> dict:
+    """The newest packet after half a second more of refereeing, by field name."""
+    run(ref, 0.51)
+    header, teams = packets_heard(sock)[-1]
+    names = ("team", "colour", "keeper_colour", "goalkeeper", "score", "penalty_shot", "single_shots", "budget", "robots")
+    return {"phase": header[6], "state": header[7], "set_play": header[8], "first_half": header[9], "kicking": header[10],
+            "secs_remaining": header[11], "teams": [dict(zip(names, team)) for team in teams]}
+
+
+@pytest.fixture
+def shoot_out() -> Iterator[tuple[Referee, socket.socket]]:
+    """A 2v2 world refereed as a penalty shoot-out alone (three shots each and sudden death, as the rules
+    say), and a socket that hears the referee's packets."""
+    players = [Player(team=t, number=n, index=2 * t + n - 1, side=Side(1.0 if t == 0 else -1.0)) for t in (0, 1) for n in (1, 2)]
+    world = MatchWorld([(-3000.0, -3000.0), (-2000.0, -3000.0), (3000.0, -3000.0), (2000.0, -3000.0)])
+    port = free_udp_port()
+    ear = listening_socket(port)
+    ref = Referee(world, (1, 2), players, 600.0, port, free_udp_port(), (free_udp_port(), free_udp_port()), shoot_out="only")
+    ref.now = 0.0
+    yield ref, ear
+    ref.close()
+    ear.close()
+
+
+def take_shot(ref: Referee, outcome: str) -> None:
+    """Wait for the shot's PLAYING, then let it end as ``outcome``: the ball into the goal, wide over the
+    goal line, or left on the penalty mark until the time is up."""
+    until(ref, State.playing, limit=ref.now + 10.0)
+    sign = 1.0 if ref.game.kicking_team == 1 else -1.0  # the goal the kicking team attacks
+    if outcome == "goal":
+        ref.world.move_ball(sign * 4600.0, 200.0)
+    elif outcome == "missed":
+        ref.world.move_ball(sign * 4600.0, 1500.0)
+    run(ref, 30.1 if outcome == "time" else TICK)
+    assert ref.game.state is State.finished and ref.shots[-1].outcome == outcome
+
+
+def test_the_shoot_out_packets_say_penalty_shoot_who_kicks_and_who_plays_and_the_shots_alternate(
+        shoot_out: tuple[Referee, socket.socket]) -> None:
+    ref, ear = shoot_out
+    start = last_packet(ref, ear)
+    assert (start["phase"], start["state"], start["set_play"], start["first_half"], start["kicking"]) == (1, 0, 0, 0, 1)
+    assert all(robot[0] == 14 for team in start["teams"] for robot in team["robots"][:2])  # everybody a substitute
+    until(ref, State.set)
+    first = last_packet(ref, ear)
+    assert (first["phase"], first["state"], first["set_play"], first["kicking"], first["secs_remaining"]) == (1, 2, 0, 1, 30)
+    kicking, keeping = first["teams"]
+    assert [robot[0] for robot in kicking["robots"][:2]] == [14, 0] and kicking["penalty_shot"] == 1  # player 2 strikes
+    assert [robot[0] for robot in keeping["robots"][:2]] == [0, 14] and keeping["goalkeeper"] == 1  # player 1 keeps
+    # placed as the rules place them: the ball on team 2's penalty mark, the striker on the edge of the penalty
+    # area facing the goal, the keeper on the goal line in the goal's centre
+    assert ref.world.ball_position() == pytest.approx((3200.0, 0.0), abs=1.0)
+    assert ref.world.robot_pose(1) == pytest.approx((2850.0, 0.0, 0.0), abs=5.0)
+    x, y, heading = ref.world.robot_pose(2)
+    assert (x, y, abs(heading)) == pytest.approx((4400.0, 0.0, math.pi), abs=5.0)
+    take_shot(ref, "goal")
+    scored = last_packet(ref, ear)
+    assert scored["state"] == 4 and scored["teams"][0]["score"] == 1 and scored["teams"][0]["single_shots"] == 0b1
+    until(ref, State.set)
+    second = last_packet(ref, ear)  # the other team kicks, at the goal it attacks, with its own clock
+    assert (second["state"], second["kicking"], second["secs_remaining"]) == (2, 2, 30)
+    assert second["teams"][1]["penalty_shot"] == 1 and second["teams"][0]["goalkeeper"] == 1
+    assert ref.world.ball_position() == pytest.approx((-3200.0, 0.0), abs=1.0)
+    until(ref, State.playing)
+    run(ref, 10.0)
+    assert last_packet(ref, ear)["secs_remaining"] == 20  # the shot's clock runs in PLAYING
+    run(ref, 20.0)
+    assert ref.shots[-1].outcome == "time"  # 30 s and nobody kicked
+    take_shot(ref, "goal")
+    take_shot(ref, "missed")
+    # 2:0 with one shot each left: team 2 can no longer draw level, so the shoot-out is over, as GameController3 decides
+    run(ref, 2.1)
+    assert ref.over and ref.winner == 1 and ref.shoot_out_score() == "2:0" and ref.score() == "0:0"
+    assert [(s.team, s.striker, s.keeper, s.outcome) for s in ref.shots] == [(1, 2, 1, "goal"), (2, 2, 1, "time"), (1, 2, 1, "goal"),
+                                                                             (2, 2, 1, "missed")]
+    assert ref.events[-1].what == "SHOOT-OUT OVER 2:0, team 1 wins"
+
+
+def test_a_level_shoot_out_goes_to_sudden_death_where_the_second_team_always_answers(shoot_out: tuple[Referee, socket.socket]) -> None:
+    ref, _ = shoot_out
+    ref.penalty_shots, ref.sudden_death_shots = 1, 2
+    take_shot(ref, "goal")
+    take_shot(ref, "goal")  # 1:1 after the regular shot each: sudden death
+    take_shot(ref, "missed")
+    assert not ref.over and ref.shots[-1].sudden_death
+    take_shot(ref, "goal")  # the second team answers and wins
+    run(ref, 2.1)
+    assert ref.over and ref.winner == 2 and ref.shoot_out_score() == "1:2"
+
+
+def test_a_called_free_kick_puts_the_ball_where_the_set_play_does_and_each_set_play_notes_how_near_the_defenders_came(
+        referee: Referee) -> None:
+    until(referee, State.playing)  # team 1 kicks off: team 2 is kept out of the centre circle
+    referee.world.move_robot(1, 1200.0, 0.0, math.pi)
+    run(referee, 1.0)
+    kick_off = referee.restrictions[0]
+    assert (kick_off.set_play, kick_off.kicking_team, kick_off.nearest_at_start_mm) == ("kick_off", 1, pytest.approx(2000.0, abs=5.0))
+    assert kick_off.nearest_mm == pytest.approx(1200.0, abs=5.0) and kick_off.nearest_player == 1
+    run(referee, 9.1)
+    assert (kick_off.ended, kick_off.end_s) == ("10 s", pytest.approx(referee.events[-1].time_s + 10.0, abs=0.02))
+    referee.calls = [Call(referee.now + 1.0, SetPlay.kick_in, 2)]
+    run(referee, 1.05)
+    assert referee.game.set_play is SetPlay.kick_in and referee.game.kicking_team == 2
+    assert referee.world.ball_position() == pytest.approx((0.0, 2950.0), abs=1.0)  # on the touchline beside where it was
+    kick_in = referee.restrictions[-1]
+    assert (kick_in.set_play, kick_in.kicking_team, kick_in.ended) == ("kick_in", 2, "")
+    assert kick_in.nearest_at_start_mm == pytest.approx(math.hypot(2000.0, 2950.0), abs=5.0)  # team 1's robot, from the ball

@@ -14,6 +14,7 @@ from hypothesis import strategies as st
 from tafel.core.framework.manager import Blackboard
 from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.look_at_ball_behavior import LookAtBallBehavior
+from tafel.modules.behavior.soccer_behavior import SoccerBehavior
 from tafel.modules.communication.game_state_provider import GameStateProvider
 from tafel.modules.motion.head_motion import HeadMotion
 from tafel.modules.motion.status_leds import StatusLeds
@@ -23,6 +24,7 @@ from tafel.representations.game import (
     Datagram,
     GameControllerPackets,
     GameControllerReturn,
+    GamePhase,
     GameState,
     Penalty,
     RobotInfo,
@@ -32,7 +34,8 @@ from tafel.representations.game import (
 from tafel.representations.infrastructure import CognitionStatus, FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion import HEAD_PITCH, HEAD_YAW, HeadJointTargets, JointSensorData, LedRequest
-from tafel.representations.team import OutgoingTeamMessage
+from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType
+from tafel.representations.team import OutgoingTeamMessage, PlayerRole, Role, TeamMates
 from tests.support.simulation import Simulation
 from tests.test_game_controller import packet  # built from the published layout, never from the code under test
 
@@ -168,3 +171,18 @@ def test_the_platform_lets_at_most_two_return_packets_leave_in_any_second_and_re
     for now in refused_at:  # and each refusal was needed: two had left within the second before
         assert sum(now - 1_000_000_000 < t <= now for t in sent) == 2
     assert (network.returns_sent, network.returns_refused) == (len(sent), len(refused_at))
+
+
+# ------------------------------------------------------------------------------- penalty shoot-out
+@pytest.mark.parametrize("penalty", [Penalty.none, Penalty.substitute])
+def test_between_penalty_shots_the_robots_stand_for_the_referee_to_place_them_and_sit_only_when_a_half_ends(penalty: Penalty) -> None:
+    """GameController3 ends each penalty shot with FINISHED; the referee then places the next shot's robots,
+    which must be on their feet for it (a sitting robot put down falls over)."""
+    motions = {}
+    for phase in (GamePhase.penalty_shoot, GamePhase.normal):
+        finished = game(State.finished, penalty=penalty)
+        finished.game_phase = phase
+        harness = ModuleHarness(SoccerBehavior, finished, PlayerRole(role=Role.striker), RobotPose(valid=True, x=2900.0),
+                                BallModel(valid=True, seen=True, x=300.0), TeamMates(), MotionInfo())
+        motions[phase] = harness.execute(3)[MotionRequest].motion
+    assert motions == {GamePhase.penalty_shoot: MotionType.stand, GamePhase.normal: MotionType.sit}

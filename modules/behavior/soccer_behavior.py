@@ -49,7 +49,8 @@ class SoccerBehavior(Module):
       ``keep_out_margin``) until the set play ends; the own free kicks are indirect, so the striker
       plays the ball to ``indirect_target`` (ahead and towards the middle), not at the goal.
     - Penalty shoot-out: the kicking team's robot kicks at a corner of the goal; the defending team's
-      keeps the goal line.
+      keeps the goal line; substitutes (penalized) stand still, and so does everybody between the shots
+      (FINISHED there ends a shot: the referee places the robots for the next).
     - FINISHED: sit.
 
     It walks around the robots in ``Obstacles`` (and around the areas the rules keep it out of) by

@@ -65,6 +65,23 @@ def parse_teams(text: str) -> tuple[int, int]:
     return int(match[1]), int(match[2])
 
 
+#: the free kicks the simulated referee can be told to call (``--call``)
+CALLABLE_SET_PLAYS = ("kick_in", "goal_kick", "corner_kick", "pushing_free_kick")
+
+
+def parse_call(text: str) -> tuple[float, str, int]:
+    """``--call``: SECONDS:SET_PLAY:TEAM, e.g. 20:kick_in:2."""
+    parts = text.strip().lower().split(":")
+    try:
+        seconds, set_play, team = float(parts[0]), parts[1], int(parts[2])
+        if len(parts) != 3 or seconds < 0 or set_play not in CALLABLE_SET_PLAYS or team not in (1, 2):
+            raise ValueError(text)
+    except (ValueError, IndexError):
+        raise argparse.ArgumentTypeError(f"--call takes SECONDS:SET_PLAY:TEAM with SET_PLAY one of {', '.join(CALLABLE_SET_PLAYS)} "
+                                         f"and TEAM 1 or 2 (e.g. 20:kick_in:2), got {text!r}") from None
+    return seconds, set_play, team
+
+
 def add_match_command(commands: Any) -> None:
     from tafel.core.runtime.platform import seed_number
 
@@ -81,6 +98,16 @@ def add_match_command(commands: Any) -> None:
     match.add_argument("--resolution", default="320x240", help="camera image size WIDTHxHEIGHT")
     match.add_argument("--ready-seconds", type=positive(float), default=30.0, help="longest READY (default 30)")
     match.add_argument("--goals", type=positive(int), metavar="N", help="end the game when a team has scored N goals (drills, tests)")
+    match.add_argument("--halves", type=int, choices=[1, 2], default=2, help="play both halves (default) or only the first (drills, tests)")
+    match.add_argument("--shoot-out", dest="shoot_out", nargs="?", choices=["never", "tie", "always", "only"], const="only",
+                       default="never", help="a penalty shoot-out as GameController3 runs it: only (--shoot-out alone) plays just the "
+                                             "shoot-out; tie after the halves when the score is level; always after the halves")
+    match.add_argument("--penalty-shots", type=positive(int), default=3, metavar="N", help="penalty shots per team (the rules: 3)")
+    match.add_argument("--sudden-death-shots", type=int, default=3, metavar="N",
+                       help="at most N more shots per team in sudden death while the shoot-out is level (the rules: 3)")
+    match.add_argument("--call", dest="calls", action="append", default=[], type=parse_call, metavar="S:SET_PLAY:TEAM",
+                       help="the referee calls a free kick for team 1 or 2 at S s of the match, once PLAYING, the ball placed as "
+                            f"the set play places it ({', '.join(CALLABLE_SET_PLAYS)}; repeatable; drills, tests)")
     add_module_path_argument(match)
     match.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                        help="a configuration override for every robot's program (repeatable)")

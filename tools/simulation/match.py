@@ -29,7 +29,8 @@ from typing import Any, TextIO
 
 from tafel.platforms.match_robot import AUTHKEY_ENV
 from tafel.platforms.match_world import TICK_NS, MatchWorld, Side
-from tafel.tools.simulation.referee import Player, Referee
+from tafel.representations.game import GamePhase, SetPlay
+from tafel.tools.simulation.referee import Call, Player, Referee
 from tafel.tools.simulation.rules import MAX_PLAYERS_PER_TEAM
 
 TEAM_NUMBERS = (1, 2)
@@ -92,9 +93,11 @@ class Match:
             self.world.move_robot(player.index, x, y, heading)
         self.ports = {"game_controller_port": free_udp_port(), "return_port": free_udp_port()}
         self.team_ports = (free_udp_port(), free_udp_port())
-        self.referee = Referee(self.world, TEAM_NUMBERS, self.players, args.seconds / 2, self.ports["game_controller_port"],
+        self.referee = Referee(self.world, TEAM_NUMBERS, self.players, args.seconds / args.halves, self.ports["game_controller_port"],
                                self.ports["return_port"], self.team_ports, ready_s=args.ready_seconds,
-                               goals_to_end=args.goals)
+                               goals_to_end=args.goals, halves=args.halves, shoot_out=args.shoot_out, penalty_shots=args.penalty_shots,
+                               sudden_death_shots=max(0, args.sudden_death_shots),
+                               calls=[Call(seconds, SetPlay[name], team) for seconds, name, team in args.calls])
         self.key = secrets.token_hex(16)
         self.listener = Listener(("127.0.0.1", 0), backlog=2 * MAX_PLAYERS_PER_TEAM, authkey=self.key.encode())  # all join at once
         self.robots: list[Robot] = []
@@ -131,7 +134,7 @@ class Match:
                        "--debug-port", "0", "--no-web", "--status-interval", "3600",
                        "--set", "parameters.GameStateProvider.start_state=initial",
                        # the team message budget is paced over the game's halves, here shorter than the SPL's
-                       "--set", f"parameters.TeamMessageSender.half_s={min(3600.0, max(1.0, self.args.seconds / 2)):g}",
+                       "--set", f"parameters.TeamMessageSender.half_s={min(3600.0, max(1.0, self.args.seconds / self.args.halves)):g}",
                        *(a for key, value in settings.items() for a in ("--set", f"game.{key}={json.dumps(value)}")),
                        *(a for folder in self.args.module_path for a in ("--module-path", str(folder))),
                        *(a for override in self.args.overrides for a in ("--set", override)),
@@ -176,7 +179,7 @@ class Match:
     def play(self) -> str:
         """Tick until the game is over; the reason it ended."""
         speed = self.args.speed
-        started, time_ns, last_score, fouls_told = time.monotonic(), 0, self.referee.score(), 0
+        started, time_ns, last_score, fouls_told, shots_told = time.monotonic(), 0, self.referee.score(), 0, 0
         connections = {robot.connection: robot for robot in self.robots}
         while True:
             waiting, commands = set(connections), {}
@@ -203,6 +206,11 @@ class Match:
                 who = f"team {foul.team} player {foul.player}" if foul.player else f"team {foul.team}"
                 print(f"[match] t={foul.time_s:.1f}s foul: {who} {foul.penalty.name if foul.player else ''} ({foul.reason})", flush=True)
             fouls_told = len(self.referee.fouls)
+            for number, shot in enumerate(self.referee.shots[shots_told:], start=shots_told + 1):
+                print(f"[match] t={shot.time_s:.1f}s penalty shot {number}{' (sudden death)' if shot.sudden_death else ''}: team "
+                      f"{shot.team} player {shot.striker} against keeper {shot.keeper or 'none'}: {shot.outcome} "
+                      f"(shoot-out {self.referee.shoot_out_score()})", flush=True)
+            shots_told = len(self.referee.shots)
             if self.referee.over:
                 return "the game is over"
             for robot in self.robots:
@@ -232,7 +240,7 @@ class Match:
         referee = self.referee
         sent = sum(referee.messages)
         return {
-            "teams": [{"team": TEAM_NUMBERS[t], "robots": self.args.teams[t], "score": referee.game.teams[t].score,
+            "teams": [{"team": TEAM_NUMBERS[t], "robots": self.args.teams[t], "score": referee.game.teams[t].score - referee.shoot_out_goals[t],
                        "team_messages": referee.messages[t], "team_messages_heard": referee.messages_heard[t],
                        "message_budget_left": referee.game.teams[t].message_budget,
                        "fouls": sum(f.team == TEAM_NUMBERS[t] for f in referee.fouls),
@@ -240,6 +248,15 @@ class Match:
             "fouls": [{"time_s": round(f.time_s, 2), "team": f.team, "player": f.player, "penalty": f.penalty.name, "reason": f.reason}
                       for f in referee.fouls],
             "score": referee.score(),
+            **({"shoot_out": {"score": referee.shoot_out_score(), "winner": referee.winner,
+                              "shots": [{"time_s": round(s.time_s, 2), "team": s.team, "striker": s.striker, "keeper": s.keeper,
+                                         "outcome": s.outcome, "sudden_death": s.sudden_death} for s in referee.shots]}}
+               if referee.game.game_phase is GamePhase.penalty_shoot else {}),
+            "set_plays": [{"start_s": round(r.start_s, 2), "end_s": round(r.end_s, 2), "set_play": r.set_play, "kicking_team": r.kicking_team,
+                           "ended": r.ended, "nearest_mm": round(r.nearest_mm) if math.isfinite(r.nearest_mm) else None,
+                           "nearest_player": r.nearest_player,
+                           "nearest_at_start_mm": round(r.nearest_at_start_mm) if math.isfinite(r.nearest_at_start_mm) else None}
+                          for r in referee.restrictions],
             "ended": reason,
             "simulated_s": round(self.world.time_ns * 1e-9, 2),
             "events": [{"time_s": round(e.time_s, 2), "event": e.what} for e in referee.events],
@@ -286,6 +303,9 @@ def command_match(args: argparse.Namespace, extra: Sequence[str]) -> int:
     if args.result is not None:
         args.result.write_text(line + "\n")
     fouls = ":".join(str(team["fouls"]) for team in result["teams"])
-    print(f"[match] {reason}; score {TEAM_NUMBERS[0]}:{TEAM_NUMBERS[1]} {result['score']}, fouls {fouls}", flush=True)
+    shoot_out = result.get("shoot_out")
+    decided = "" if shoot_out is None else (f", shoot-out {shoot_out['score']} ("
+                                            + (f"team {shoot_out['winner']} wins)" if shoot_out["winner"] else "undecided: a coin toss)"))
+    print(f"[match] {reason}; score {TEAM_NUMBERS[0]}:{TEAM_NUMBERS[1]} {result['score']}{decided}, fouls {fouls}", flush=True)
     print(line, flush=True)
     return 0 if reason == "the game is over" else 1

@@ -330,14 +330,14 @@ class PlaySoccer(Option["SoccerBehavior"]):
     @common(to=GAME_STATES)
     def follow_the_game_controller(self, b: SoccerBehavior) -> Next:
         game = b.game_state
+        if game.game_phase is GamePhase.penalty_shoot:  # FINISHED there ends a shot, not the game: stand for the next
+            return "penalized" if game.penalized else "shoot_out" if game.state is State.playing else "shoot_out_wait"
         if game.state is State.finished:
             return "finished"
         if game.penalized:
             return "penalized"
         if game.state in (State.initial, State.standby, State.set):
             return game.state.name
-        if game.game_phase is GamePhase.penalty_shoot:
-            return "shoot_out" if game.state is State.playing else "shoot_out_wait"
         if game.state is State.ready:
             return "ready"
         if self.state == "set" and game.set_play is SetPlay.none and game.kicking_team not in (game.team_number, 255):
@@ -391,7 +391,7 @@ class PlaySoccer(Option["SoccerBehavior"]):
 
     @state
     def shoot_out_wait(self, b: SoccerBehavior) -> None:
-        """A penalty shoot-out before PLAYING: stand."""
+        """A penalty shoot-out before a shot's PLAYING and after it (FINISHED): stand, to be placed for the next shot."""
         b.stand()
 
     @state
