@@ -32,14 +32,15 @@ def match(tmp_path: Path, *args: str, timeout: float = 600.0) -> tuple[dict, sub
 
 
 def robot_programs_running() -> list[str]:
-    """Command lines of match robots still running on this machine."""
+    """Command lines of match robots of this environment still running on this machine (another checkout's
+    matches, run at the same time, are not this test's business)."""
     found = []
     for entry in Path("/proc").iterdir():
         try:
             command = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode()
         except (OSError, ValueError):
             continue
-        if "--platform match" in command and "tafel.tools.cli run" in command:
+        if "--platform match" in command and "tafel.tools.cli run" in command and command.startswith(sys.prefix):
             found.append(command)
     return found
 

@@ -69,6 +69,8 @@ class WorkerSpec:
     #: what the black box keeps of this context (every representation), and where it goes
     blackbox_record: list[Any] = field(default_factory=list)
     blackbox_queue: Any = None
+    #: every context waits here until all are ready, so they start together (a barrier, or None)
+    start_together: Any = None
 
 
 
@@ -80,6 +82,24 @@ def import_definitions(names: Sequence[str]) -> None:
             importlib.import_module(name)
         except Exception as exc:  # noqa: BLE001 - a user's module may raise anything on import
             log.warning("cannot import %s, which defines representations: %s: %s", name, type(exc).__name__, exc)
+
+
+#: s a context waits for the others to be ready before it runs alone (a process that never gets there)
+START_TOGETHER_TIMEOUT_S = 20.0
+
+
+def _wait_for_the_others(barrier: Any, stop: Any) -> None:
+    """Start the loops together: a context process that imports slowly (a loaded machine, a robot's
+    slow disk) would otherwise miss the first frames, and ``--frames N`` would end the main context
+    before the other ran at all. A context that fails to start breaks the barrier; one that never
+    arrives holds the others ``START_TOGETHER_TIMEOUT_S`` at most."""
+    if barrier is None:
+        return
+    try:
+        barrier.wait(timeout=START_TOGETHER_TIMEOUT_S)
+    except threading.BrokenBarrierError:
+        if not stop.is_set():
+            log.warning("not every context started within %g s; the ready ones run without waiting", START_TOGETHER_TIMEOUT_S)
 
 
 def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
@@ -128,12 +148,15 @@ def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
         watch = cognition_watcher(inbox, spec.stall_timeout_s) if spec.plan.name == "motion" and inbox else None
         if spec.plan.name == "motion" and watch is None:
             watch = lambda: (False, 0, 0.0)  # noqa: E731 - no cognition context at all
+        _wait_for_the_others(spec.start_together, stop)
         final = run_context_loop(runner, spec.limits, stop, is_main=spec.is_main, report=send,
                                  cognition_watch=watch, realtime=realtime, stuck_timeout_s=spec.stuck_timeout_s)
         final.digest = state_digest(manager)
         final.record_dropped = sink.dropped if sink else 0
         send(final)
     except Exception as exc:  # noqa: BLE001 - report instead of dying silently
+        if spec.start_together is not None:
+            spec.start_together.abort()  # the others start without this context, at once
         log.exception("%s context failed to start", spec.plan.name)
         send(ContextStats(name=spec.plan.name, finished=True, failure=f"{type(exc).__name__}: {exc}"))
     finally:
@@ -191,6 +214,7 @@ class ConcurrentRuntime:
                 self.record_switch.set()
         self.processes: dict[str, Any] = {}
         self._stopping_since: float | None = None
+        self.start_together = self._mp.Barrier(len(self.plans)) if len(self.plans) > 1 else None
 
     def run(self, limits: Limits) -> dict[str, ContextStats]:
         channels = {name: SharedChannel() for name in self.plans}
@@ -216,6 +240,7 @@ class ConcurrentRuntime:
                     record_switch=self.record_switch, setup=self.worker_setup, clock_origin_ns=clock.origin_ns(),
                     imports=tuple(defining_modules()), module_paths=tuple(loaded_folders()), stuck_timeout_s=self.stuck_timeout_s,
                     blackbox_record=self.blackbox_record.get(name, []), blackbox_queue=box_queue,
+                    start_together=self.start_together,
                 )
                 receiver, sender = self._mp.Pipe(duplex=False)
                 process = self._mp.Process(target=_worker_main, args=(spec, self.stop, sender), name=f"tafel-{name}", daemon=True)
@@ -315,6 +340,8 @@ class ConcurrentRuntime:
         Without the main context nothing drives the robot, so the program ends; without cognition motion
         goes on with its safe motions."""
         self.dead[name] = why
+        if self.start_together is not None:
+            self.start_together.abort()  # whoever still waits for it starts now
         self.stats[name].failure = self.stats[name].failure or why
         consequence = "the program ends" if name == self.main else "the other context keeps running"
         self.notices.append(f"{name} {why}; {consequence}")
