@@ -66,6 +66,16 @@ def test_every_shipped_scenario_file_loads() -> None:
     assert {"find the ball", "walk to the ball", "kick towards the goal", "get up after a push", "striker scores from its own half"} <= set(names)
 
 
+def test_a_scenario_that_judges_perception_renders_like_a_camera_unless_it_says_otherwise(tmp_path: Path) -> None:
+    """Realism is on (mild) where a predicate judges what the robot saw; off where nothing does; a file's own word wins."""
+    judged = GOOD + '\n[[success]]\npredicate = "ball_model_accurate"\nwithin_mm = 300.0\n'
+    assert load_scenario(write(tmp_path, GOOD)).realism == "off"
+    assert load_scenario(write(tmp_path, judged)).realism == "mild"
+    assert load_scenario(write(tmp_path, 'realism = "full"\n' + judged)).realism == "full"
+    with pytest.raises(ScenarioError, match="realism takes 'off', 'mild', 'full'"):
+        load_scenario(write(tmp_path, 'realism = "photo"\n' + GOOD))
+
+
 def test_a_good_file_gives_every_value(tmp_path: Path) -> None:
     scenario = load_scenario(write(tmp_path, GOOD))
     assert scenario.duration_s == 5.0 and scenario.robot_start == (0.0, 0.0, 0.0) and scenario.ball == (1000.0, 0.0)
