@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from tafel.core.framework.contexts import Context
 from tafel.core.framework.errors import TafelError
 from tafel.core.framework.manager import ModuleManager
 from tafel.core.framework.naming import did_you_mean
@@ -154,9 +155,13 @@ class ContextDebug:
         handler = self.handlers.get(command.name)
         if handler is None:
             return "error", f"{command.name} is not a context command"
-        wanted = command.args.get("context")
-        if isinstance(wanted, str) and wanted not in ("", self.context):
-            return "missing", json.dumps(["context", wanted, [self.context]])
+        if "context" in command.args:
+            try:
+                wanted = Context.of(command.args["context"], "-context", CommandError)
+            except CommandError as exc:
+                return "error", str(exc)
+            if wanted != self.context:
+                return "missing", json.dumps(["context", wanted, [self.context]])
         try:
             return "ok", handler(command)
         except NotHere as missing:

@@ -8,6 +8,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from tafel.core.framework.contexts import Context
 from tafel.core.framework.naming import did_you_mean
 from tafel.debug.commands import SPECS, CommandError
 from tafel.debug.protocol import Command
@@ -60,8 +61,19 @@ class DebugRouter:
     #: commands that need no context and change nothing: answered by the network thread on arrival
     IMMEDIATE = frozenset({"ping", "help", "hello"})
 
+    def wanted_context(self, command: Command) -> str | None:
+        """The context ``-context`` names (None without it); ``CommandError`` for a name that is no context
+        (``-context takes cognition or motion, got 'Motion'``) or one this program does not run."""
+        if "context" not in command.args:
+            return None
+        wanted = Context.of(command.args["context"], "-context", CommandError)
+        if self.contexts and wanted not in self.contexts:
+            raise CommandError(f"-context {wanted}: this program runs no {wanted} context; it runs {' and '.join(self.contexts)}")
+        return wanted
+
     def targets(self, command: Command) -> list[str]:
-        """The contexts to ask: the one that has the named module or representation, else all."""
+        """The contexts to ask: the one ``-context`` names, else the one that has the named module or
+        representation, else all (``wanted_context`` has checked the name)."""
         wanted = command.args.get("context")
         if isinstance(wanted, str) and wanted in self.contexts:
             return [wanted]
@@ -110,6 +122,11 @@ class DebugRouter:
 
         for index, command in enumerate(commands):
             if command.name in SPECS:
+                try:
+                    self.wanted_context(command)
+                except CommandError as exc:
+                    results[index] = (True, str(exc))
+                    continue
                 run.append(index)
                 continue
             flush()

@@ -162,3 +162,34 @@ def test_tafel_modules_lists_every_modules_debug_outputs_before_anything_runs() 
     assert "  debug outputs of Striker:\n    request Striker:draw_target  where the striker wants to stand" in cognition
     assert "    modify Kick:behind = 190.0" in cognition
     assert "    modify WalkingEngine:step_duration = 0.25" in motion and "    plot WalkingEngine:phase" in motion
+
+
+def _router(*contexts: str):
+    from tafel.debug.executors import LocalExecutor
+    from tafel.debug.router import DebugRouter
+
+    router = DebugRouter()
+    for context in contexts:
+        router.add_context(context, LocalExecutor(ContextDebug(context, manager_of(DebugUser, name=context))))
+    return router
+
+
+@pytest.mark.parametrize("line", ["modules:list -context Motion", "debug_request:list -context vision",
+                                  "representation:print FrameInfo -context cognition2", "modules:list -context cognition,motion"])
+def test_a_context_that_is_no_context_is_an_error_not_an_empty_answer(line: str) -> None:
+    # modules:list -context Motion answered nothing (every context said "not me", merged to ""): an error now
+    [(is_error, answer)] = _router("cognition", "motion").handle_batch([parse(line)])
+    given = line.split("-context", 1)[1].strip()
+    assert is_error and answer == f"-context takes cognition or motion, got {given!r}"
+
+
+def test_a_context_the_program_does_not_run_is_an_error_naming_those_it_runs() -> None:
+    [(is_error, answer)] = _router("cognition").handle_batch([parse("modules:list -context motion")])
+    assert is_error and answer == "-context motion: this program runs no motion context; it runs cognition"
+    [(is_error, answer)] = _router("cognition", "motion").handle_batch([parse("debug_request:list -context motion")])
+    assert not is_error and "DebugUser:draw" in str(answer)
+
+
+def test_a_context_asked_directly_refuses_a_name_that_is_no_context() -> None:
+    status, answer = ContextDebug("cognition", manager_of(DebugUser)).execute(parse("modify:list -context COGNITION"))
+    assert (status, answer) == ("error", "-context takes cognition or motion, got 'COGNITION'")

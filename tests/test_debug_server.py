@@ -147,7 +147,7 @@ def test_representations_list_print_get_set(program: Program) -> None:
     listing = program.ask("representation:list")
     assert re.search(r"BallModel\s+KalmanBallModeler", listing) and "JointSensorData" in listing
     assert "error: representation:get: the name exists in cognition and motion; add -context NAME" == program.ask("+representation:get -name FrameInfo")
-    assert program.ask("representation:print FrameInfo -context vision").startswith("error: unknown context 'vision'")
+    assert program.ask("representation:print FrameInfo -context vision") == "error: -context takes cognition or motion, got 'vision'"
     printed = program.ask("representation:print BallModel")
     assert printed.startswith("BallModel (cognition, frame") and "  valid: " in printed and "  x: " in printed
     model = deserialize(BallModel, base64.b64decode(program.ask("+representation:get -name BallModel")))

@@ -7,6 +7,7 @@ import re
 import sys
 from pathlib import Path
 
+from tafel.core.framework.contexts import CONTEXT_NAMES
 from tafel.debug.client import DebugClient
 
 HISTORY = Path.home() / ".tafel_history"
@@ -55,7 +56,7 @@ class Completer:
         self.refresh()
 
     def refresh(self) -> None:
-        self.names = {"commands": self.commands, "contexts": ["cognition", "motion"]}
+        self.names = {"commands": self.commands, "contexts": list(CONTEXT_NAMES)}
         for kind, command, pattern in self.LISTS:
             answer = self.client.ask(command)
             found = set() if answer.startswith("error:") else {
