@@ -181,3 +181,20 @@ def test_store_private_keeps_the_users_comments_and_layout(tmp_path: Path) -> No
         assert kept in after
     assert tomllib.loads(after) == {"parameters": {"WalkingEngine": {"odometry_scale": 0.92}, "HeadMotion": {"max_speed": 2.5}},
                                     "cognition": {"disabled": ["GoalPostDetector"]}}
+
+
+@pytest.mark.parametrize("text", ["Motion:WalkingEngine", "vision:BallDetector", ":BallDetector"])
+def test_a_module_edit_for_no_context_is_an_error_naming_the_contexts(text: str) -> None:
+    from tafel.core.framework.config import edit_modules
+
+    with pytest.raises(ConfigError) as error:
+        edit_modules({}, add=[text])
+    assert str(error.value) == f"--add-module {text}: CONTEXT takes cognition or motion, got {text.split(':')[0]!r}"
+
+
+def test_a_module_edit_without_a_context_says_the_form() -> None:
+    from tafel.core.framework.config import edit_modules
+
+    with pytest.raises(ConfigError, match=r"^--remove-module takes CONTEXT:MODULE with CONTEXT cognition or motion, "
+                                          r"e.g. cognition:BallDetector, got 'BallDetector'$"):
+        edit_modules({}, remove=["BallDetector"])

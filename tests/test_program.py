@@ -95,9 +95,18 @@ def test_a_representation_provided_in_both_contexts_is_an_error() -> None:
         plan_program(config, FullTestPlatform)
 
 
-def test_invalid_rates_are_rejected() -> None:
-    with pytest.raises(ConfigError, match="cognition_hz must be positive"):
-        plan_program({"runtime": {"cognition_hz": 0}}, FullTestPlatform)
+@pytest.mark.parametrize(("key", "value", "shown"), [("cognition_hz", 0, "0"), ("motion_hz", -5.0, "-5"),
+                                                     ("motion_hz", 1e9, "1e+09"), ("cognition_hz", "30", "'30'")])
+def test_invalid_rates_are_rejected(key: str, value: object, shown: str) -> None:
+    # 1e9 Hz and "30" were taken before (only rates at or below 0 were refused)
+    with pytest.raises(ConfigError) as error:
+        plan_program({"runtime": {key: value}}, FullTestPlatform)
+    assert str(error.value) == f"runtime.{key} takes a finite number of Hz above 0 and at most 1000, got {shown}"
+
+
+def test_parameters_that_are_no_tables_say_what_would_be_right() -> None:
+    with pytest.raises(ConfigError, match=r"^parameters takes a table of module tables .*, got 3$"):
+        plan_program({"parameters": 3}, FullTestPlatform)
 
 
 def test_lockstep_gives_three_cognition_frames_per_ten_motion_frames() -> None:

@@ -38,11 +38,13 @@ from typing import Any
 
 import tomlkit
 
+from tafel.core.framework.contexts import CONTEXT_NAMES, Context
 from tafel.core.framework.errors import TafelError
 from tafel.core.framework.naming import did_you_mean
 from tafel.core.framework.values import INT_RANGE, Range, convert, refusal
 
-CONTEXTS = ("cognition", "motion")
+#: the contexts' sections, as names (``Context`` converts a name from outside)
+CONTEXTS = CONTEXT_NAMES
 PRIVATE_FILE = "private/private.toml"
 
 
@@ -299,8 +301,9 @@ def edit_modules(config: dict[str, Any], add: Iterable[str] = (), remove: Iterab
     for text, adding in [*((t, True) for t in add), *((t, False) for t in remove)]:
         context, sep, name = str(text).partition(":")
         option = "--add-module" if adding else "--remove-module"
-        if not sep or context not in CONTEXTS or not name:
-            raise ConfigError(f"{option} takes CONTEXT:MODULE with CONTEXT cognition or motion, e.g. cognition:BallDetector; got {text!r}")
+        if not sep or not name:
+            raise refusal(option, "CONTEXT:MODULE with CONTEXT cognition or motion, e.g. cognition:BallDetector", str(text), ConfigError)
+        context = Context.of(context, f"{option} {text}: CONTEXT", ConfigError).value
         section = result.setdefault(context, {})
         modules = list(section.get("modules", []))
         if adding:

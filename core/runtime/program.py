@@ -14,12 +14,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from tafel.core.framework.config import CONTEXTS, ConfigError, context_section
+from tafel.core.framework.config import CONTEXTS, RATE, ConfigError, context_section
 from tafel.core.framework.errors import ConflictingProvidersError, MissingProviderError
 from tafel.core.framework.frame_info import FrameInfo
 from tafel.core.framework.graph import build_plan
 from tafel.core.framework.manager import ModuleManager
 from tafel.core.framework.module import Module, find_module
+from tafel.core.framework.values import convert, refusal
 from tafel.core.runtime.platform import Platform
 from tafel.core.runtime.status import CognitionStatus
 
@@ -117,16 +118,15 @@ def plan_program(config: Mapping[str, Any], platform: type[Platform] | Platform,
     runtime = config.get("runtime", {})
     parameters = config.get("parameters", {})
     if not isinstance(parameters, Mapping):
-        raise ConfigError("[parameters] must be a table of module tables")
+        raise refusal("parameters", "a table of module tables ([parameters.BallDetector] and the like)", parameters, ConfigError)
     plans: dict[str, ContextPlan] = {}
     for context in CONTEXTS:
         section = context_section(config, context)
         modules = [find_module(name) for name in section["modules"]]
         for name in section["disabled"]:
             find_module(name)
-        rate = float(runtime.get(f"{context}_hz", DEFAULT_RATES[context]))
-        if rate <= 0:
-            raise ConfigError(f"runtime.{context}_hz must be positive, got {rate}")
+        rate = float(convert(runtime.get(f"{context}_hz", DEFAULT_RATES[context]), float, where=f"runtime.{context}_hz",
+                             bounds=RATE, unit="Hz", text=False, error=ConfigError))
         plans[context] = ContextPlan(
             name=context,
             rate_hz=rate,
@@ -142,7 +142,7 @@ def plan_program(config: Mapping[str, Any], platform: type[Platform] | Platform,
     for module_name, values in parameters.items():  # after the module lists, which import modules given by path
         find_module(module_name)  # a misspelt module must not silently lose its parameters
         if not isinstance(values, Mapping):
-            raise ConfigError(f"parameters.{module_name} must be a table of parameter values, got {values!r}")
+            raise refusal(f"parameters.{module_name}", "a table of parameter values", values, ConfigError)
     for plan in plans.values():
         from_platform = set(plan.platform_provides)
         for module in plan.modules:
