@@ -241,3 +241,28 @@ def test_a_platform_that_feeds_a_context_only_the_frame_clock_runs_it() -> None:
     assert plans["motion"].runs and plans["motion"].pruned == {}
     LockstepRuntime(plans, ClockOnly()).run(Limits(frames=3, speed=None))
     assert [(c, n) for c, n, _ in CLOCKS_SEEN if c == "motion"] == [("motion", 1), ("motion", 2), ("motion", 3)]
+
+
+def test_a_topic_records_one_contexts_representation_and_a_misspelt_context_is_an_error() -> None:
+    from tafel.core.logs.recording import select
+
+    plans = plan_program(CONFIG, FullTestPlatform)
+    topics = {s.topic for s in select(plans, ["motion/FrameInfo", "cognition/BallModel"], include_sensors=False)}
+    assert topics == {"motion/FrameInfo", "cognition/BallModel"}
+    assert {s.topic for s in select(plans, ["FrameInfo"], include_sensors=False)} == {"motion/FrameInfo", "cognition/FrameInfo"}
+    with pytest.raises(UnknownModuleError) as error:  # before: "no context has it", as if the name were misspelt
+        select(plans, ["Motion/FrameInfo"])
+    assert str(error.value) == "'Motion/FrameInfo': the context before / takes cognition or motion, got 'Motion'"
+    with pytest.raises(UnknownModuleError, match=r"^cannot record 'motion/BallModel': BallModel is in cognition, not in motion$"):
+        select(plans, ["motion/BallModel"])
+    with pytest.raises(UnknownModuleError, match="the context before / takes cognition or motion, got 'vision'"):
+        select(plans, ["vision/BallModel"], strict=False)  # configuration's names too: a wrong context is no missing name
+
+
+def test_recorded_topics_in_configuration_are_checked_for_their_context() -> None:
+    from tafel.core.framework.config import check_config
+
+    check_config({"recording": {"representations": ["motion/FrameInfo"]}}, representations=["FrameInfo"])
+    with pytest.raises(ConfigError) as error:
+        check_config({"recording": {"representations": ["Motion/FrameInfo"]}}, representations=["FrameInfo"])
+    assert str(error.value) == "recording.representations: 'Motion/FrameInfo': the context before / takes cognition or motion, got 'Motion'"

@@ -178,8 +178,11 @@ def check_config(config: Mapping[str, Any], platform_sections: Iterable[str] = (
             continue
         value = convert(table[key], list[str], where=f"{section}.{key}", text=False, error=ConfigError,
                         expected='a list of representation names, e.g. ["BallModel"]')
-        for name in value if names is not None else ():
-            if names is not None and name not in names:  # (the loop is empty when names is None)
+        for entry in value:
+            prefix, slash, name = entry.rpartition("/") if section == "recording" else ("", "", entry)
+            if slash:  # a topic: "motion/FrameInfo" records that context's only
+                Context.of(prefix, f"{section}.{key}: {entry!r}: the context before /", ConfigError)
+            if names is not None and name not in names:
                 raise ConfigError(f"{section}.{key}: no representation named {name!r}; {did_you_mean(name, names)}")
     debug = config.get("debug", {})
     aliases = debug.get("aliases", {})

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
+from tafel.core.framework.contexts import Context
 from tafel.core.framework.errors import UnknownModuleError
 from tafel.core.framework.frame_info import FrameInfo
 from tafel.core.framework.manager import Blackboard
@@ -59,7 +60,8 @@ def select(plans: Mapping[str, ContextPlan], names: Iterable[str] | None, *, inc
            extra: Iterable[type] = (), strict: bool = True) -> list[Selection]:
     """The representations to record; with ``strict``, unknown names fail with the closest known ones
     (names a user typed), otherwise names that this program does not have are skipped (defaults from
-    configuration that another platform's modules provide).
+    configuration that another platform's modules provide). A name may be a topic, ``motion/FrameInfo``:
+    then only that context's (a context that is none, ``Motion/FrameInfo``, is an error either way).
 
     ``extra`` are representations every running context can fill besides its modules (debug data).
     """
@@ -77,17 +79,35 @@ def select(plans: Mapping[str, ContextPlan], names: Iterable[str] | None, *, inc
             chosen = plan.providers.get(rep.__name__)
             provider = chosen or module.__name__
             owners.setdefault(rep.__name__, []).append(Selection(context, rep, "module", provider))
-    chosen_names = list(dict.fromkeys(names or []))
-    if ALL in chosen_names:  # every representation of the program; debug data only when named
-        chosen_names = [n for n, owned in owners.items() if any(o.source != "debug" for o in owned)] + chosen_names
-    for name in chosen_names:
+    #: name -> the contexts it is chosen in (None: every context that has it); "motion/FrameInfo" chooses one
+    chosen: dict[str, set[str] | None] = {}
+    for entry in dict.fromkeys(names or []):
+        prefix, slash, name = entry.rpartition("/")
+        if slash:
+            context = Context.of(prefix, f"{entry!r}: the context before /", UnknownModuleError).value
+            if context not in plans or not plans[context].runs:
+                if strict:
+                    raise UnknownModuleError(f"cannot record {entry!r}: this program runs no {context} context")
+                continue
+            if name in owners and all(o.context != context for o in owners[name]) and strict:
+                raise UnknownModuleError(f"cannot record {entry!r}: {name} is in "
+                                         f"{' and '.join(sorted({o.context for o in owners[name]}))}, not in {context}")
+            here = chosen.setdefault(name, set())
+            if here is not None:
+                here.add(context)
+        else:
+            chosen[entry] = None
+    if ALL in chosen:  # every representation of the program; debug data only when named
+        chosen = {**{n: None for n, owned in owners.items() if any(o.source != "debug" for o in owned)}, **chosen}
+    for name in chosen:
         if name not in owners and name != ALL and strict:
             raise UnknownModuleError(f"cannot record {name!r}: no context has it; {did_you_mean(name, owners)}")
     result: list[Selection] = []
     for name, selections in owners.items():
         for selection in selections:
             sensor = selection.source == "platform" or selection.rep is FrameInfo  # replay needs both
-            if name in chosen_names or (include_sensors and sensor):
+            contexts = chosen.get(name, set())
+            if (name in chosen and (contexts is None or selection.context in contexts)) or (include_sensors and sensor):
                 result.append(selection)
     return list(dict.fromkeys(result))
 

@@ -290,7 +290,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--record-dir", type=Path, default=Path("logs"), metavar="DIR",
                      help="the only folder debug clients may record into with log:start (default: %(default)s)")
     run.add_argument("--record-reps", metavar="A,B",
-                     help="what to record besides the sensor data (default: [recording] representations; 'all': everything)")
+                     help="what to record besides the sensor data (default: [recording] representations; 'all': everything; "
+                          "motion/NAME: that context's only)")
     run.add_argument("--debug-port", type=port_number, default=None, metavar="P", help=f"debug server port (default {DEFAULT_DEBUG_PORT}; 0 takes a free one)")
     run.add_argument("--debug-host", default="127.0.0.1", metavar="H", help="debug server address (default: %(default)s)")
     token = run.add_mutually_exclusive_group()
