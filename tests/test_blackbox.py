@@ -92,16 +92,48 @@ def test_saves_within_the_cooldown_are_counted_not_written(tmp_path: Path) -> No
     assert "1 triggers within a cooldown" in box.status()
 
 
+TRIGGER = "[[blackbox.triggers]] number 1: "
+
+
 @pytest.mark.parametrize(("table", "message"), [
-    (5, "takes tables"),
-    ([{"name": "BallModel"}], "name (a representation) and field"),
-    ([{"name": "BallModel", "field": "valid"}], "give equals, at_least or at_most"),
-    ([{"name": "BallModel", "field": "valid", "equals": False, "for_s": 1e308}], "for_s takes a finite number"),
-    ([{"name": "BallModel", "field": "valid", "equals": False, "when": 1}], "unknown keys when"),
+    (5, "blackbox.triggers takes tables: [[blackbox.triggers]] with name, field and equals, at_least or at_most, got 5"),
+    ([{"name": "BallModel"}], TRIGGER + "field takes a field's name (dotted for nested ones), got None"),
+    ([{"field": "valid"}], TRIGGER + "name takes a representation's name, got None"),
+    ([{"name": "BallModel", "field": "valid"}], TRIGGER + "give equals, at_least or at_most"),
+    ([{"name": "BallModel", "field": "valid", "equals": False, "for_s": 1e308}],
+     TRIGGER + "for_s takes a finite number of seconds of at least 0, got 1e+308"),
+    ([{"name": "BallModel", "field": "valid", "equals": False, "for_s": -1}],
+     TRIGGER + "for_s takes a finite number of seconds of at least 0, got -1"),
+    ([{"name": "BallModel", "field": "x", "at_least": "3"}],  # a string was compared with a number, never held
+     TRIGGER + "at_least takes a finite number of at most 1e+12 in size, got '3'"),
+    ([{"name": "BallModel", "field": "valid", "equals": False, "when": 1}], TRIGGER + "unknown keys when"),
+    ([{"name": "BallModel", "field": "valid", "equals": False, "context": "Cognition"}],  # matched no topic, never fired
+     TRIGGER + "context takes cognition or motion, got 'Cognition'"),
 ])
 def test_bad_trigger_tables_are_clear_errors(table: object, message: str) -> None:
-    with pytest.raises(ConfigError, match=re.escape(message)):
+    with pytest.raises(ConfigError, match="^" + re.escape(message)):
         conditions_from_config(table)
+
+
+def test_a_trigger_of_one_context_keeps_its_context() -> None:
+    [condition] = conditions_from_config([{"name": "FrameInfo", "field": "frame_number", "at_least": 10, "context": "motion"}])
+    assert condition.context == "motion" and condition.at_least == 10.0
+
+
+@pytest.mark.parametrize(("table", "message"), [
+    ({"seconds": 0}, "blackbox.seconds takes a finite number of seconds above 0 and at most 1e+06, got 0"),
+    ({"max_mb": True}, "blackbox.max_mb takes a finite number of MB above 0 and at most 1e+06, got True"),
+    ({"image_period_s": "0.5"}, "blackbox.image_period_s takes a finite number of seconds above 0 and at most 1e+06, got '0.5'"),
+    ({"enabled": "no"}, "blackbox.enabled takes on/off or true/false, got 'no'"),  # a non-empty string was "on"
+])
+def test_bad_blackbox_settings_say_what_would_be_right(table: dict, message: str) -> None:
+    from tafel.tools.launch.errors import UsageError
+    from tafel.tools.launch.recording import make_blackbox
+
+    with pytest.raises(UsageError) as error:
+        make_blackbox(None, {}, {"blackbox": table}, None)  # type: ignore[arg-type]
+    assert str(error.value) == message
+    assert make_blackbox(None, {}, {"blackbox": {"enabled": False}}, None) is None  # type: ignore[arg-type]
 
 
 @pytest.mark.slow

@@ -293,3 +293,22 @@ def test_a_drawn_robot_pose_is_a_triangle_pointing_where_the_robot_faces() -> No
     # at (1000, 0) facing +y: the tip 150 mm ahead, the back corners 100 mm behind and 80 mm to either side
     triangle = _outline("robot_pose", [1000.0, 0.0, math.pi / 2])
     assert np.allclose(triangle, [(1080.0, -100.0), (1000.0, 150.0), (920.0, -100.0), (1080.0, -100.0)])
+
+
+@pytest.mark.parametrize(("key", "value", "message"), [
+    ("jpeg_quality", 0, "foxglove.jpeg_quality takes a whole number from 1 to 100, got 0"),
+    ("jpeg_quality", 80.5, "foxglove.jpeg_quality takes a whole number from 1 to 100, got 80.5"),
+    ("origins", 5, 'foxglove.origins takes a list of web origins such as ["https://app.foxglove.dev"], got 5'),
+    ("origins", ["app.foxglove.dev"], "foxglove.origins takes a list of web origins such as "
+                                      "[\"https://app.foxglove.dev\"], got ['app.foxglove.dev']"),
+])
+def test_foxglove_settings_are_refused_in_the_one_wording(key: str, value: object, message: str) -> None:
+    from tafel.tools.launch.errors import UsageError
+    from tafel.tools.launch.recording import foxglove_origins, jpeg_quality
+
+    check = jpeg_quality if key == "jpeg_quality" else foxglove_origins
+    with pytest.raises(UsageError) as error:
+        check({"foxglove": {key: value}})
+    assert str(error.value) == message
+    assert jpeg_quality({"foxglove": {"jpeg_quality": 90}}) == 90
+    assert foxglove_origins({"foxglove": {"origins": ["https://app.foxglove.dev"]}}) == ["https://app.foxglove.dev"]

@@ -28,6 +28,8 @@ from pathlib import Path
 from typing import Any
 
 from tafel.core.framework.config import ConfigError
+from tafel.core.framework.contexts import Context
+from tafel.core.framework.values import Range, convert
 from tafel.core.logs.serialization import deserialize
 from tafel.core.logs.writer import LogWriter, PendingMessage
 
@@ -72,8 +74,8 @@ def conditions_from_config(table: Any) -> list[Condition]:
     """The ``[[blackbox.triggers]]`` tables; ``ConfigError`` with what would be right."""
     if table is None:
         return []
-    if not isinstance(table, list) or not all(isinstance(t, Mapping) for t in table):
-        raise ConfigError("blackbox.triggers takes tables: [[blackbox.triggers]] with name, field and equals, at_least or at_most")
+    convert(table, list[dict[str, Any]], where="blackbox.triggers", text=False, error=ConfigError,
+            expected="tables: [[blackbox.triggers]] with name, field and equals, at_least or at_most")
     known = {"name", "field", "equals", "at_least", "at_most", "for_s", "context"}
     result = []
     for index, entry in enumerate(table, 1):
@@ -81,19 +83,17 @@ def conditions_from_config(table: Any) -> list[Condition]:
         unknown = sorted(set(entry) - known)
         if unknown:
             raise ConfigError(f"{where}: unknown keys {', '.join(unknown)}; a trigger takes {', '.join(sorted(known))}")
-        if not isinstance(entry.get("name"), str) or not isinstance(entry.get("field"), str):
-            raise ConfigError(f"{where}: name (a representation) and field (a field name, dotted for nested ones) are required")
+        for key, what in (("name", "a representation's name"), ("field", "a field's name (dotted for nested ones)")):
+            convert(entry.get(key), str, where=f"{where}: {key}", text=False, expected=what, error=ConfigError)
         tests = [key for key in ("equals", "at_least", "at_most") if key in entry]
         if not tests:
             raise ConfigError(f"{where}: give equals, at_least or at_most")
-        for key in ("at_least", "at_most", "for_s"):
-            value = entry.get(key, 0.0)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or abs(value) > 1e12:
-                raise ConfigError(f"{where}: {key} takes a finite number, got {value!r}")
-        if entry.get("for_s", 0.0) < 0:
-            raise ConfigError(f"{where}: for_s takes seconds >= 0")
-        result.append(Condition(entry["name"], entry["field"], entry.get("equals"), entry.get("at_least"), entry.get("at_most"),
-                                float(entry.get("for_s", 0.0)), str(entry.get("context", ""))))
+        at_least, at_most = (convert(entry.get(key), float | None, where=f"{where}: {key}", text=False, error=ConfigError)
+                             for key in ("at_least", "at_most"))
+        for_s = convert(entry.get("for_s", 0.0), float, where=f"{where}: for_s", bounds=Range(0.0), unit="seconds",
+                        text=False, error=ConfigError)
+        context = "" if "context" not in entry else Context.of(entry["context"], f"{where}: context", ConfigError).value
+        result.append(Condition(entry["name"], entry["field"], entry.get("equals"), at_least, at_most, for_s, context))
     return result
 
 

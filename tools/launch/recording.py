@@ -7,6 +7,7 @@ import re
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
+from tafel.core.framework.values import Range, convert, refusal
 from tafel.core.logs.blackbox import MAX_MB, SECONDS, BlackBox, conditions_from_config
 from tafel.core.logs.recording import Recorder, select
 from tafel.core.runtime import (
@@ -18,7 +19,7 @@ from tafel.debug.executors import (
     DEBUG_REPRESENTATIONS,
 )
 from tafel.tools.launch.debugging import ProgramDebug
-from tafel.tools.launch.errors import fail
+from tafel.tools.launch.errors import UsageError, fail
 from tafel.tools.launch.status import status_print
 
 
@@ -82,6 +83,12 @@ def add_blackbox_commands(debug: ProgramDebug | None, box: tuple[BlackBox, Recor
                           lambda _command: blackbox.status())
 
 
+#: what ``[blackbox]``'s numbers may be (seconds, MB): above 0 and at most a million
+BLACKBOX_RANGE = Range(0.0, 1e6, low_open=True)
+#: a JPEG quality
+JPEG_QUALITY = (1, 100)
+
+
 def make_blackbox(args: argparse.Namespace, plans: dict[str, ContextPlan], config: dict[str, Any],
                   platform: Platform) -> tuple[BlackBox, Recorder] | None:
     """The black-box recorder (``[blackbox]``, on by default) and the recorder that feeds it everything."""
@@ -90,12 +97,11 @@ def make_blackbox(args: argparse.Namespace, plans: dict[str, ContextPlan], confi
     unknown = sorted(set(table) - known)
     if unknown:
         fail(f"[blackbox] {unknown[0]} is not a setting; [blackbox] takes {', '.join(sorted(known))}")
-    if not table.get("enabled", True):
+    if not convert(table.get("enabled", True), bool, where="blackbox.enabled", text=False, error=UsageError):
         return None
-    numbers = {key: table.get(key, default) for key, default in (("seconds", SECONDS), ("max_mb", MAX_MB), ("image_period_s", 0.5))}
-    for key, value in numbers.items():
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 < value <= 1e6:
-            fail(f"blackbox.{key} takes a positive number, got {value!r}")
+    numbers = {key: convert(table.get(key, default), float, where=f"blackbox.{key}", bounds=BLACKBOX_RANGE, unit=unit,
+                            text=False, error=UsageError)
+               for key, default, unit in (("seconds", SECONDS, "seconds"), ("max_mb", MAX_MB, "MB"), ("image_period_s", 0.5, "seconds"))}
     feeder = program_recorder(plans, config, platform, ["all"], blocking=False)
     feeder.translate_factory = None
     box = BlackBox(args.record_dir, seconds=float(numbers["seconds"]), max_bytes=int(numbers["max_mb"] * 1e6),
@@ -126,9 +132,8 @@ def program_recorder(plans: dict[str, ContextPlan], config: dict[str, Any], plat
 
 def jpeg_quality(config: dict[str, Any]) -> int:
     """``[foxglove] jpeg_quality`` (1 to 100); anything else exits with status 2 and says so."""
-    value = config.get("foxglove", {}).get("jpeg_quality", 80)
-    if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 100:
-        fail(f"foxglove.jpeg_quality takes a whole number from 1 to 100 (JPEG quality of the images), got {value!r}")
+    value: int = convert(config.get("foxglove", {}).get("jpeg_quality", 80), int, where="foxglove.jpeg_quality",
+                         bounds=JPEG_QUALITY, text=False, error=UsageError)
     return value
 
 
@@ -136,9 +141,11 @@ def foxglove_origins(config: dict[str, Any]) -> list[str]:
     """``[foxglove] origins``: web pages (``"https://app.foxglove.dev"``) whose WebSockets the live server takes besides
     clients that send no Origin (desktop apps); anything but a list of such origins exits with status 2."""
     value = config.get("foxglove", {}).get("origins", [])
-    if not isinstance(value, list) or not all(isinstance(o, str) and re.fullmatch(r"https?://[^/\s]+/?", o) for o in value):
-        fail(f'foxglove.origins takes a list of web origins such as ["https://app.foxglove.dev"], got {value!r}')
-    return value
+    expected = 'a list of web origins such as ["https://app.foxglove.dev"]'
+    origins: list[str] = convert(value, list[str], where="foxglove.origins", text=False, expected=expected, error=UsageError)
+    if not all(re.fullmatch(r"https?://[^/\s]+/?", o) for o in origins):
+        raise refusal("foxglove.origins", expected, value, UsageError)
+    return origins
 
 
 def foxglove_recording(recorder: Recorder, quality: int) -> Callable[[], Any]:
