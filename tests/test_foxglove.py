@@ -162,7 +162,7 @@ def test_log_convert_gives_an_old_log_wall_clock_times_and_refuses_bad_input(tmp
         times = [(m.log_time, m.publish_time) for _, _, m in make_reader(stream).iter_messages()]
     assert all(log_time > 1_600_000_000 * 10**9 and publish_time < 10**12 for log_time, publish_time in times)
     assert "/scene" in foxglove_topics(converted)
-    for args, message in ((["--jpeg-quality", "0"], "--jpeg-quality takes 1 to 100"), ([], "cannot read log")):
+    for args, message in ((["--jpeg-quality", "0"], "--jpeg-quality takes a whole number from 1 to 100, got 0"), ([], "cannot read log")):
         source = old if args else tmp_path / "missing.mcap"
         result = tafel("log", "convert", str(source), "--out", str(tmp_path / "x.mcap"), *args)
         assert result.returncode != 0 and message in result.stderr

@@ -531,3 +531,31 @@ def test_replay_keeps_the_recorded_frame_clock(tmp_path: Path, clock_source: str
     CLOCKS_SEEN.clear()
     LockstepRuntime(plans, platform).run(Limits(speed=None))
     assert CLOCKS_SEEN == [("motion", 100 + k, 7_000_000_000 + k * 10_000_000) for k in range(1, 6)]
+
+
+@pytest.mark.parametrize(("action", "options", "message"), [
+    ("slice", {"start": -1.0, "seconds": None}, "--start takes a finite number of seconds of at least 0, got -1"),
+    ("slice", {"start": 0.0, "seconds": 0.0}, "--seconds takes a finite number of seconds above 0, got 0"),
+    ("slice", {"start": float("inf"), "seconds": None}, "--start takes a finite number of seconds of at least 0, got inf"),
+    ("convert", {"jpeg_quality": 101}, "--jpeg-quality takes a whole number from 1 to 100, got 101"),
+])
+def test_log_slice_and_convert_refuse_bad_numbers_in_the_one_wording(action: str, options: dict, message: str, capsys) -> None:
+    import argparse
+
+    from tafel.tools.logs.log_tools import run_slice
+
+    args = argparse.Namespace(log_command=action, file=Path("in.mcap"), out=Path("out.mcap"), rep=None, **options)
+    assert run_slice(args) == 2
+    assert capsys.readouterr().err == f"tafel log {action}: error: {message}\n"
+
+
+def test_log_export_takes_a_context_as_written(capsys) -> None:
+    from tafel.tools.cli.dispatch import build_parser
+
+    parser = build_parser()
+    args = parser.parse_args(["log", "export", "x.mcap", "--rep", "FrameInfo", "--format", "csv", "--out", "x.csv", "--context", "motion"])
+    assert args.context == "motion"
+    with pytest.raises(SystemExit) as exited:
+        parser.parse_args(["log", "export", "x.mcap", "--rep", "FrameInfo", "--format", "csv", "--out", "x.csv", "--context", "Motion"])
+    assert exited.value.code == 2
+    assert "argument --context: takes cognition or motion, got 'Motion'" in capsys.readouterr().err

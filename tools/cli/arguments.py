@@ -50,6 +50,13 @@ def port_number(text: str) -> int:
                    error=argparse.ArgumentTypeError)
 
 
+def context_name(text: str) -> str:
+    """A context's name, as written: cognition or motion."""
+    from tafel.core.framework.contexts import Context
+
+    return Context.of(text, "", argparse.ArgumentTypeError).value
+
+
 def add_module_path_argument(parser: argparse.ArgumentParser) -> None:
     """``--module-path DIR``: folders of module files of one's own, imported at start (repeatable)."""
     parser.add_argument("--module-path", dest="module_path", action="append", default=[], type=Path, metavar="DIR",
@@ -174,7 +181,7 @@ def add_log_commands(commands: Any) -> None:
     export = actions.add_parser("export", help="representations as CSV or JSON lines, images as PNG files")
     export.add_argument("file", type=Path)
     export.add_argument("--rep", required=True, help="representation name (tafel log info lists them)")
-    export.add_argument("--context", choices=["cognition", "motion"], help="only this context's channel")
+    export.add_argument("--context", type=context_name, metavar="CONTEXT", help="only this context's channel (cognition or motion)")
     export.add_argument("--format", required=True, choices=["csv", "jsonl", "png"])
     export.add_argument("--out", required=True, type=Path, help="output file (csv, jsonl) or folder (png)")
     compare = actions.add_parser("compare", help="where two logs differ: per channel, the first differing frame and field",

@@ -19,6 +19,7 @@ import numpy as np
 from google.protobuf import descriptor_pool, message_factory
 
 from tafel.core.framework.naming import did_you_mean
+from tafel.core.framework.values import Range, ValueCheckError, convert
 from tafel.core.logs import LogError, LogReader, write_slice
 
 
@@ -45,12 +46,14 @@ def run_slice(args: argparse.Namespace) -> int:
     """``tafel log slice`` and ``tafel log convert`` (a whole copy with Foxglove's channels added)."""
     name = f"tafel log {args.log_command}"
     converting = args.log_command == "convert"
-    start, seconds = (0.0, None) if converting else (args.start, args.seconds)
-    if start < 0 or not np.isfinite(start) or (seconds is not None and not (np.isfinite(seconds) and seconds > 0)):
-        print(f"{name}: error: --start takes seconds from 0 on, --seconds a positive number", file=sys.stderr)
-        return 2
-    if converting and not 1 <= args.jpeg_quality <= 100:
-        print(f"{name}: error: --jpeg-quality takes 1 to 100, got {args.jpeg_quality}", file=sys.stderr)
+    try:
+        start, seconds = (0.0, None) if converting else (
+            convert(args.start, float, where="--start", bounds=Range(0.0), unit="seconds", text=False),
+            convert(args.seconds, float | None, where="--seconds", bounds=Range(0.0, low_open=True), unit="seconds", text=False))
+        if converting:
+            convert(args.jpeg_quality, int, where="--jpeg-quality", bounds=(1, 100), text=False)
+    except ValueCheckError as exc:
+        print(f"{name}: error: {exc}", file=sys.stderr)
         return 2
     if args.out.resolve() == args.file.resolve():
         print(f"{name}: error: --out must be another file than the log it reads", file=sys.stderr)
