@@ -366,11 +366,11 @@ def test_the_tools_package_knows_no_representation_by_name() -> None:
     offenders = []
     for path in (REPO / "tools").rglob("*.py"):
         # the tools whose job is to know them: Foxglove's schema for each, the scenes that feed perception
-        # modules the images and camera matrices they read, the simulated GameController, whose
-        # packets are the protocol's GameState, the scenario predicates that judge a belief (BallModel)
+        # modules the images and camera matrices they read, the simulated GameController (and the state its
+        # parts share), whose packets are the protocol's GameState, the scenario predicates that judge a belief (BallModel)
         # against ground truth, TeamControl (the team's messages and the game), the robot's links for the
         # 3D view (from the joints and the torso's pose), and the ball classifier's trainer (the images)
-        if path.name in ("foxglove_channels.py", "scene_frames.py", "referee.py", "scenario_predicates.py", "team.py",
+        if path.name in ("foxglove_channels.py", "scene_frames.py", "referee.py", "officiating.py", "scenario_predicates.py", "team.py",
                          "robot_links.py", "view.py", "train_ball_classifier.py"):
             continue
         text = path.read_text()

@@ -19,6 +19,8 @@ SMALL_LOG = REPO / "tests" / "data" / "ball_situation.mcap"
 #: what no light command may import: the simulators, OpenCV, Ray and the match and scenario code
 HEAVY = ("mujoco", "pybullet", "cv2", "ray", "tafel.platforms.match_world", "tafel.platforms.match_robot",
          "tafel.platforms.mujoco_sim", "tafel.platforms.pybullet_sim", "tafel.tools.simulation.match", "tafel.tools.simulation.referee",
+         "tafel.tools.simulation.officiating", "tafel.tools.simulation.fouls", "tafel.tools.simulation.set_plays",
+         "tafel.tools.simulation.shoot_out",
          "tafel.tools.simulation.scenarios", "tafel.tools.simulation.scenario_file", "tafel.tools.simulation.scenario_predicates", "tafel.tools.simulation.replay_batch")
 
 PROBE = """

@@ -13,7 +13,9 @@ from tafel.platforms.match_world import MatchWorld, Side
 from tafel.platforms.network import listening_socket
 from tafel.representations.game import Penalty, SetPlay, State
 from tafel.tools.simulation.match import free_udp_port
-from tafel.tools.simulation.referee import Call, Player, Referee
+from tafel.tools.simulation.officiating import Player
+from tafel.tools.simulation.referee import Referee
+from tafel.tools.simulation.set_plays import Call
 from tests.test_game_controller import GAME, TEAM  # the published layout, never the code under test
 
 TICK = 0.01

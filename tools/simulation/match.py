@@ -30,8 +30,10 @@ from typing import Any, TextIO
 from tafel.platforms.match_robot import AUTHKEY_ENV
 from tafel.platforms.match_world import TICK_NS, MatchWorld, Side
 from tafel.representations.game import GamePhase, SetPlay
-from tafel.tools.simulation.referee import Call, Player, Referee
+from tafel.tools.simulation.officiating import Player
+from tafel.tools.simulation.referee import Referee
 from tafel.tools.simulation.rules import MAX_PLAYERS_PER_TEAM
+from tafel.tools.simulation.set_plays import Call
 
 TEAM_NUMBERS = (1, 2)
 #: where robots enter (team frame, mm and rad): on the own half's touchline, facing the field
