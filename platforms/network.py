@@ -24,10 +24,11 @@ import time
 from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Literal
 
 from tafel.core.framework.config import ConfigError
 from tafel.core.framework.manager import Blackboard
+from tafel.core.framework.values import convert
 from tafel.representations.game import GAME_CONTROLLER_PORT, RETURN_PORT, Datagram, GameControllerPackets, GameControllerReturn
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.team import MAX_MESSAGE_BYTES, TEAM_PORT_BASE, IncomingTeamMessages, OutgoingTeamMessage
@@ -40,6 +41,19 @@ NETWORK_OUTPUTS = (GameControllerReturn, OutgoingTeamMessage)
 RETURNS_PER_SECOND = 2  # the rules: at most two return packets in any second
 MAX_DATAGRAMS_PER_FRAME = 64  # more in one frame is a flood: the rest waits (or is dropped by the kernel)
 NETWORK_MODES = ("auto", "udp", "simulated")
+
+
+#: what each ``[game]`` setting takes: (type, range, what would be right in words or None for the type's)
+GAME_SETTINGS: dict[str, tuple[Any, tuple[int, int] | None, str | None]] = {
+    "team_number": (int, (1, 254), "a team number from 1 to 254 (the GameController's)"),
+    "player_number": (int, (1, 20), None),
+    "enabled": (bool, None, None),
+    "game_controller_port": (int, (0, 65535), "a UDP port from 0 to 65535"),
+    "return_port": (int, (0, 65535), "a UDP port from 0 to 65535"),
+    "team_port": (int, (0, 65535), "a UDP port from 0 to 65535 (0: 10000 + team number)"),
+    "broadcast": (str, None, "an IPv4 address such as 255.255.255.255"),
+    "network": (Literal["auto", "udp", "simulated"], None, None),
+}
 
 
 @dataclass(frozen=True)
@@ -65,21 +79,9 @@ class NetworkSettings:
         extra = sorted(set(table) - known)
         if extra:
             raise ConfigError(f"[game] has unknown keys {', '.join(extra)}; it knows {', '.join(sorted(known))}")
-        values = {key: table[key] for key in known if key in table}
-        for key in ("team_number", "player_number", "game_controller_port", "return_port", "team_port"):
-            if key in values and (not isinstance(values[key], int) or isinstance(values[key], bool)):
-                raise ConfigError(f"game.{key} takes a whole number, got {values[key]!r}")
-        if "network" in values and values["network"] not in NETWORK_MODES:
-            raise ConfigError(f"game.network takes one of {', '.join(repr(m) for m in NETWORK_MODES)}, got {values['network']!r}")
-        settings = cls(**values)
-        if not 1 <= settings.team_number <= 254:
-            raise ConfigError(f"game.team_number takes 1 to 254 (the GameController's team numbers), got {settings.team_number}")
-        if not 1 <= settings.player_number <= 20:
-            raise ConfigError(f"game.player_number takes 1 to 20, got {settings.player_number}")
-        for key in ("game_controller_port", "return_port", "team_port"):
-            if not 0 <= getattr(settings, key) <= 65535:
-                raise ConfigError(f"game.{key} takes a UDP port (0 to 65535), got {getattr(settings, key)}")
-        return settings
+        values = {key: convert(table[key], kind, where=f"game.{key}", bounds=bounds, text=False, expected=expected, error=ConfigError)
+                  for key, (kind, bounds, expected) in GAME_SETTINGS.items() if key in table}
+        return cls(**values)
 
     @property
     def team_messages_port(self) -> int:

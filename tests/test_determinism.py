@@ -107,5 +107,5 @@ def test_a_simulated_network_echoes_the_own_message_next_frame_and_opens_no_sock
 
 
 def test_an_unknown_network_mode_is_a_clear_error() -> None:
-    with pytest.raises(ConfigError, match="game.network takes one of 'auto', 'udp', 'simulated', got 'tcp'"):
+    with pytest.raises(ConfigError, match="^game.network takes one of auto, udp, simulated, got 'tcp'$"):
         NetworkSettings.from_config({"network": "tcp"})

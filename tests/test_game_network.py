@@ -12,7 +12,7 @@ from collections.abc import Iterator
 import pytest
 
 from tafel.core.framework.manager import Blackboard
-from tafel.platforms.network import GameNetwork, NetworkSettings
+from tafel.platforms.network import GAME_SETTINGS, GameNetwork, NetworkSettings
 from tafel.representations.game import GameControllerReturn
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.team import OutgoingTeamMessage
@@ -159,12 +159,20 @@ def test_the_network_refuses_what_the_rules_forbid_and_survives_a_taken_port(por
 def test_bad_game_settings_are_clear_errors() -> None:
     from tafel.core.framework.config import ConfigError
 
-    with pytest.raises(ConfigError, match="game.team_number takes 1 to 254"):
+    with pytest.raises(ConfigError, match=r"^game.team_number takes a team number from 1 to 254 \(the GameController's\), got 0$"):
         NetworkSettings.from_config({"team_number": 0})
     with pytest.raises(ConfigError, match="unknown keys team; it knows"):
         NetworkSettings.from_config({"team": 3})
-    with pytest.raises(ConfigError, match="game.return_port takes a whole number"):
+    with pytest.raises(ConfigError, match="^game.return_port takes a UDP port from 0 to 65535, got '3939'$"):
         NetworkSettings.from_config({"return_port": "3939"})
+    with pytest.raises(ConfigError, match="^game.player_number takes a whole number from 1 to 20, got 21$"):
+        NetworkSettings.from_config({"player_number": 21})
+    # a string was taken as on, a number as an address: refused now
+    with pytest.raises(ConfigError, match="^game.enabled takes on/off or true/false, got 'no'$"):
+        NetworkSettings.from_config({"enabled": "no"})
+    with pytest.raises(ConfigError, match="^game.broadcast takes an IPv4 address such as 255.255.255.255, got 5$"):
+        NetworkSettings.from_config({"broadcast": 5})
+    assert set(GAME_SETTINGS) == set(NetworkSettings.__dataclass_fields__)  # every setting is checked
     assert struct.calcsize("<4s4B6f") == 32
 
 
