@@ -27,16 +27,21 @@ import cv2
 import numpy as np
 
 from tafel.core.framework.manager import Blackboard
+from tafel.core.framework.values import Range, convert, refusal
 from tafel.core.runtime import clock
 from tafel.core.runtime.platform import EndOfData, Platform, PlatformError, PlatformOptionError
 from tafel.platforms.images import IMAGE_SUFFIXES, RAW_SUFFIXES, ImageSourceError, PosedImage, image_files, options_pose, posed_image
 from tafel.platforms.v4l2 import image_time_ns
 from tafel.representations.motion import CameraMatrixBottom, CameraMatrixBuffer, CameraMatrixTop
 from tafel.representations.motion_control import Odometry
-from tafel.representations.perception import CameraImageBottom, CameraImageTop
+from tafel.representations.perception import Camera, CameraImageBottom, CameraImageTop
 
 #: images per second a folder of images plays at without --fps
 IMAGES_FPS = 2.0
+
+
+#: what ``--fov`` takes
+FOV = "a finite number of degrees above 0 and below 180 (the horizontal field of view)"
 
 
 class VideoPlatform(Platform):
@@ -62,18 +67,15 @@ class VideoPlatform(Platform):
                                     f"({', '.join(IMAGE_SUFFIXES + RAW_SUFFIXES)})")
         elif path.suffix.lower() in IMAGE_SUFFIXES + RAW_SUFFIXES and path.is_file():
             self.images = [path]
-        camera = self.options.get("camera")
-        if camera not in (None, "", "top", "bottom"):
-            raise PlatformOptionError(f"--camera must be top or bottom, got {camera!r}")
-        self.camera: str | None = camera or None
+        camera = self.options.get("camera") or None
+        self.camera: str | None = None if camera is None else convert(camera, Camera, where="--camera", text=False,
+                                                                       error=PlatformOptionError).value
         try:
             self.pose = options_pose(self.options)
         except ImageSourceError as error:
             raise PlatformOptionError(str(error)) from error
         ball_color = self.options.get("ball_color") or ("spl" if self.images is not None or self.pose is not None else "orange")
-        if ball_color not in ("spl", "orange"):
-            raise PlatformOptionError(f"--ball-color must be spl or orange, got {ball_color!r}")
-        self.ball_color = str(ball_color)
+        self.ball_color: str = convert(ball_color, str, where="--ball-color", choices=("spl", "orange"), error=PlatformOptionError)
         if self.images is not None or self.pose is not None:  # the camera's pose is known: matrices for every detector
             # the robot stands where the images were taken: no odometry, so the localization runs as well
             self.provides = {"cognition": (CameraImageTop, CameraImageBottom, CameraMatrixBuffer, Odometry)}
@@ -81,15 +83,15 @@ class VideoPlatform(Platform):
         self.steps = 0
         self.current: PosedImage | None = None
         self.loop = bool(self.options.get("loop"))
-        fps = self.options.get("fps")
-        self.fps_override = float(fps) if fps else None
-        if self.fps_override is not None and self.fps_override <= 0:
-            raise PlatformOptionError(f"--fps must be positive, got {fps}")
+        self.fps_override: float | None = convert(self.options.get("fps"), float | None, where="--fps", bounds=Range(0.0, low_open=True),
+                                                  unit="frames per second", error=PlatformOptionError)
         fov = self.options.get("fov")
         self.fov_given = fov is not None
-        self.horizontal_fov = math.radians(float(fov or 60.0))
-        if not 0 < self.horizontal_fov < math.pi:
-            raise PlatformOptionError(f"--fov must lie between 0 and 180 degrees, got {fov}")
+        degrees = convert(60.0 if fov is None else fov, float, where="--fov", bounds=Range(0.0, 180.0, low_open=True),
+                          expected=FOV, error=PlatformOptionError)
+        if degrees >= 180.0:  # a pinhole camera sees less than half the world
+            raise refusal("--fov", FOV, fov, PlatformOptionError)
+        self.horizontal_fov = math.radians(degrees)
         self.capture: Any = None
         self.frame_index = 0
         self.time_ns = 0

@@ -94,3 +94,20 @@ def test_bad_sources_get_clear_errors(tmp_path: Path, source: str, message: str)
     assert "Traceback" not in result.stderr
     missing = tafel("run", "--platform", "video", "--no-debug")
     assert missing.returncode == 2 and "needs --source FILE" in missing.stderr
+
+
+@pytest.mark.parametrize(("options", "message"), [
+    ({"camera": "Top"}, "--camera takes one of top, bottom, got 'Top'"),  # as the Camera enum: names as written
+    ({"ball_color": "red"}, "--ball-color takes one of spl, orange, got 'red'"),
+    ({"fps": 0.0}, "--fps takes a finite number of frames per second above 0, got 0"),  # 0 was taken as "the file's rate"
+    ({"fps": -5.0}, "--fps takes a finite number of frames per second above 0, got -5"),
+    ({"fov": 180.0}, "--fov takes a finite number of degrees above 0 and below 180 (the horizontal field of view), got 180"),
+    ({"fov": float("nan")}, "--fov takes a finite number of degrees above 0 and below 180 (the horizontal field of view), got nan"),
+])
+def test_bad_video_options_are_refused_in_the_one_wording(options: dict, message: str) -> None:
+    from tafel.core.runtime.platform import PlatformOptionError
+    from tafel.platforms.video import VideoPlatform
+
+    with pytest.raises(PlatformOptionError) as error:
+        VideoPlatform({"source": "missing.avi", **options})
+    assert str(error.value) == message
