@@ -253,3 +253,63 @@ def test_the_bulk_decoder_splits_lines_exactly_as_the_byte_rules_say(data: list[
 def test_a_long_subnegotiation_without_end_gives_way_to_data_at_the_same_byte_as_byte_rules() -> None:
     stream = bytes([255, 250]) + b"y" * 512 + b"ping\n"
     assert TelnetDecoder().feed(stream) == ByteByByteDecoder(64 * 1024).feed(stream) == [b"ping"]
+
+
+@pytest.fixture
+def aliased(tmp_path):
+    """The program-wide commands with the shipped aliases, and a stand-in for the context command they run."""
+    import tomllib
+
+    from tafel.tools.launch.debugging import ProgramDebug
+    from tests.test_cli_runtime import REPO
+
+    debug = ProgramDebug(host="127.0.0.1", port=0, token=None, config_dir=tmp_path, recorder=None)
+    ran: list = []
+
+    class Recording:
+        def start(self, commands):
+            ran.extend(commands)
+            return [("ok", "done")] * len(commands)
+
+        def finish(self, started):
+            return started
+
+    debug.router.add_context("motion", Recording())
+    debug.add_aliases(tomllib.loads((REPO / "config" / "general.toml").read_text())["debug"]["aliases"])
+    return debug, ran
+
+
+@pytest.mark.parametrize(("line", "message"), [
+    ("motion:walk -x abc", "motion:walk: -x takes a finite number of at most 1e+12 in size, got 'abc'"),
+    ("motion:walk -x inf", "motion:walk: -x takes a finite number of at most 1e+12 in size, got 'inf'"),
+    ("motion:kick -foot Left", "motion:kick: -foot takes left or right, got 'Left'"),
+    ("motion:walk -context Motion", "motion:walk: -context takes cognition or motion, got 'Motion'"),  # was ignored
+    ("motion:walk -context cognition", "motion:walk runs in motion: leave -context out or give -context motion"),  # was ignored
+])
+def test_alias_arguments_are_refused_in_the_one_wording(aliased, line: str, message: str) -> None:
+    debug, ran = aliased
+    assert debug.router.handle_batch([parse(line)]) == [(True, message)]
+    assert ran == []
+
+
+def test_an_alias_runs_its_command_with_the_numbers_and_the_context_given(aliased) -> None:
+    debug, ran = aliased
+    assert debug.router.handle_batch([parse("motion:walk -x 200 -context motion")]) == [(False, "done")]
+    [command] = ran
+    assert command.args["context"] == "motion" and '"walk_x":200.0' in command.args["fields"]
+
+
+def test_replay_stepping_takes_whole_numbers() -> None:
+    from tafel.debug.commands import CommandError
+    from tafel.tools.launch.debugging import ProgramDebug
+
+    class Replay:
+        def step(self, count):
+            self.count = count
+
+    replay = Replay()
+    assert ProgramDebug._replay_step(replay, parse("log:step -count -3")) == "stepping -3" and replay.count == -3
+    with pytest.raises(CommandError, match=r"^-count takes a whole number that fits in 64 bits, got '1.5'$"):
+        ProgramDebug._replay_step(replay, parse("log:step -count 1.5"))
+    with pytest.raises(CommandError, match=r"^-frame takes a whole number that fits in 64 bits, got 'x'$"):
+        ProgramDebug._replay_goto(replay, parse("log:goto -frame x"))

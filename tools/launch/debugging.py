@@ -6,15 +6,16 @@ reach each context live in ``tafel.debug.executors``.
 from __future__ import annotations
 
 import json
-import math
 import string
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from tafel.core.framework.config import store_private
+from tafel.core.framework.contexts import Context
 from tafel.core.framework.dot import contexts_dot
 from tafel.core.framework.errors import TafelError
+from tafel.core.framework.values import convert
 from tafel.core.logs import LogExistsError
 from tafel.core.logs.recording import Recorder
 from tafel.core.runtime.program import ContextPlan
@@ -97,22 +98,21 @@ class ProgramDebug:
         for key, default in arguments.items():
             given = command.args.get(key)
             text = given if isinstance(given, str) and given != "" else _default(default)
-            if isinstance(default, list):
-                if text not in default:
-                    raise CommandError(f"{name}: -{key} takes {' or '.join(default)}, got {text!r}")
+            if isinstance(default, list):  # one of its words, as written
+                values[key] = convert(text, Literal[tuple(map(str, default))], where=f"{name}: -{key}", text=False,
+                                      expected=" or ".join(map(str, default)), error=CommandError)
             else:
-                try:
-                    number = float(text)
-                except ValueError:
-                    raise CommandError(f"{name}: -{key} takes a number, got {text!r}") from None
-                if not math.isfinite(number):
-                    raise CommandError(f"{name}: -{key} takes a finite number, got {text!r}")
-                text = repr(number)
-            values[key] = text
+                values[key] = repr(convert(text, float, where=f"{name}: -{key}", text=True, error=CommandError))
         unknown = set(command.args) - set(arguments) - {"context"}
         if unknown:
             raise CommandError(f"{name} has no argument -{sorted(unknown)[0]}; usage: {self.router.globals[name].usage}")
-        ((is_error, answer),) = self.router.handle_batch([parse(template.substitute(values))])
+        expanded = parse(template.substitute(values))
+        if "context" in command.args:  # the alias's command runs in that context; a context it names itself must be the same
+            wanted = Context.of(command.args["context"], f"{name}: -context", CommandError)
+            own = expanded.args.setdefault("context", wanted.value)
+            if own != wanted:
+                raise CommandError(f"{name} runs in {own}: leave -context out or give -context {own}")
+        ((is_error, answer),) = self.router.handle_batch([expanded])
         if is_error:
             raise CommandError(str(answer))
         return answer
@@ -140,21 +140,13 @@ class ProgramDebug:
 
     @staticmethod
     def _replay_step(platform: Any, command: Command) -> str:
-        text = argument(command, "count", required=False) or "1"
-        try:
-            count = int(text)
-        except ValueError:
-            raise CommandError(f"-count takes a whole number, got {text!r}") from None
+        count: int = convert(argument(command, "count", required=False) or "1", int, where="-count", text=True, error=CommandError)
         platform.step(count)
         return f"stepping {count}"
 
     @staticmethod
     def _replay_goto(platform: Any, command: Command) -> str:
-        text = argument(command, "frame")
-        try:
-            frame = int(text)
-        except ValueError:
-            raise CommandError(f"-frame takes a whole number, got {text!r}") from None
+        frame: int = convert(argument(command, "frame"), int, where="-frame", text=True, error=CommandError)
         try:
             platform.goto(frame)
         except TafelError as exc:
