@@ -72,7 +72,7 @@ def test_a_scenario_that_judges_perception_renders_like_a_camera_unless_it_says_
     assert load_scenario(write(tmp_path, GOOD)).realism == "off"
     assert load_scenario(write(tmp_path, judged)).realism == "mild"
     assert load_scenario(write(tmp_path, 'realism = "full"\n' + judged)).realism == "full"
-    with pytest.raises(ScenarioError, match="realism takes 'off', 'mild', 'full'"):
+    with pytest.raises(ScenarioError, match="realism takes one of off, mild, full, got 'photo'"):
         load_scenario(write(tmp_path, 'realism = "photo"\n' + GOOD))
 
 
@@ -104,6 +104,11 @@ def test_a_good_file_gives_every_value(tmp_path: Path) -> None:
     (("required_success_rate = 0.5", "required_success_rate = 1.5"), 3, "required_success_rate in the file's top level takes a number from 0 to 1"),
     (('set = ["parameters.KalmanBallModeler.friction=0.4"]', 'set = ["friction"]'), 4, "--set takes KEY=VALUE with a dotted key"),
     (("position = [1000.0, 0.0]", "position = 1000.0, 0.0"), 10, "not TOML"),
+    (("robot_x_mm = 100.0", "robot_x_mm = -5.0"), 13, "robot_x_mm in [perturbation] takes a spread (plus or minus), 0 or more, got -5"),
+    (("sensor_noise = [0.5, 2.0]", "sensor_noise = [0.5, 200.0]"), 14,
+     "sensor_noise takes [low, high] factors from 0 to 100 (1: the NAO's noise), got [0.5, 200.0]"),
+    (("within_mm = 400.0", "within_mm = 400.0\nfor_s = -1.0"), 19, "for_s takes a time of 0 s or more, got -1"),
+    (("within_mm = 400.0", "within_mm = 400.0\nafter_s = 9.0"), 19, "after_s takes a time from 0 to below within_s (5 s), got 9"),
 ])
 def test_a_bad_file_is_an_error_that_names_the_file_the_line_and_what_would_be_right(
         tmp_path: Path, change: tuple[str, str], line: int, message: str) -> None:
@@ -122,7 +127,7 @@ def test_a_file_nested_thousands_of_levels_deep_is_a_clear_error(tmp_path: Path)
 
 def test_a_push_outside_the_run_or_too_strong_is_refused(tmp_path: Path) -> None:
     event = '\n[[events]]\nat_s = {at}\npush_n = [{force}, 0.0]\n'
-    with pytest.raises(ScenarioError, match=r"scenario.toml:24: at_s is a time within the run, 0 to 5 s; got 7"):
+    with pytest.raises(ScenarioError, match=r"scenario.toml:24: at_s takes a time within the run, from 0 to below 5 s, got 7$"):
         load_scenario(write(tmp_path, GOOD + event.format(at=7.0, force=300.0)))
     with pytest.raises(ScenarioError, match=r"scenario.toml:25: push_n takes \[fx, fy\] up to 500 N, got \[900.0, 0.0\]"):
         load_scenario(write(tmp_path, GOOD + event.format(at=1.0, force=900.0)))
@@ -140,6 +145,11 @@ def test_predicates_over_representations_are_checked_against_the_representations
     path = write(tmp_path, GOOD + entry.format(name="BallModel", field="valid").replace("equals = true\n", ""))
     with pytest.raises(ScenarioError, match=r"scenario.toml:23: a representation predicate needs equals, at_least or at_most"):
         load_scenario(path)
+    path = write(tmp_path, GOOD + entry.format(name="BallModel", field="valid") + 'context = "Cognition"\n')
+    with pytest.raises(ScenarioError, match=r"scenario.toml:28: context takes cognition or motion, got 'Cognition'$"):
+        load_scenario(path)
+    path = write(tmp_path, GOOD + entry.format(name="BallModel", field="valid") + 'context = "cognition"\n')
+    assert load_scenario(path).success[-1].parameters["context"] == "cognition"
 
 
 @pytest.mark.slow  # worker processes / a subprocess: end to end

@@ -16,14 +16,16 @@ from pathlib import Path
 from typing import Any
 
 from tafel.core.framework.config import ConfigError, apply_overrides, check_config
+from tafel.core.framework.contexts import CONTEXT_NAMES, Context
 from tafel.core.framework.naming import did_you_mean
 from tafel.core.framework.representation import fields_of, get_representation
+from tafel.core.framework.values import Range, ValueCheckError, convert, refusal
 from tafel.platforms.realism import LEVELS as REALISM_LEVELS
 from tafel.representations.field import BORDER_STRIP, LENGTH, WIDTH
 from tafel.tools.simulation.scenario_predicates import PREDICATES, REQUIRED, TIMING, Parameter
 
 PLATFORMS = ("mujoco", "pybullet")
-CONTEXTS = ("cognition", "motion")
+CONTEXTS = CONTEXT_NAMES
 #: predicates that judge what the robot perceived: a scenario with one of them and cameras renders with
 #: ``realism = "mild"`` unless its file says otherwise (a camera's light, noise, blur and compression,
 #: the hall, without shadows: ``full`` is for judging the detectors, where today's recall is 0.34)
@@ -107,6 +109,7 @@ class Scenario:
 #: kind -> (what a file must write, check) for the values of scenario files
 KINDS: dict[str, str] = {
     "number": "a number",
+    "spread": "a spread (plus or minus), 0 or more",
     "positive": "a number above 0",
     "rate": "a number from 0 to 1",
     "string": "a string in quotes",
@@ -121,50 +124,32 @@ KINDS: dict[str, str] = {
 }
 
 
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+#: kind -> the type its values convert to (``convert``) and the range of its numbers
+TYPES: dict[str, tuple[Any, Range | None]] = {
+    "number": (float, None), "positive": (float, Range(0.0, low_open=True)), "rate": (float, Range(0.0, 1.0)),
+    "spread": (float, Range(0.0)), "string": (str, None), "bool": (bool, None), "pair": (tuple[float, float], None),
+    "pose": (tuple[float, float, float], None), "place": (tuple[float, float], None),
+    "duration": (float, Range(0.0, MAX_DURATION_S, low_open=True)), "range": (tuple[float, float], None),
+    "strings": (tuple[str, ...], None), "value": (Any, None),
+}
 
 
 def _on_carpet(x: float, y: float) -> bool:
     return abs(x) <= CARPET_X_MM and abs(y) <= CARPET_Y_MM
 
 
-def _fits(kind: str, value: Any) -> bool:
-    if kind == "number":
-        return _is_number(value)
-    if kind == "duration":
-        return _is_number(value) and 0 < value <= MAX_DURATION_S
-    if kind == "place":
-        return _fits("pair", value) and _on_carpet(*value)
-    if kind == "pose" and _fits("pair", value[:2] if isinstance(value, list) else None) and not _on_carpet(*value[:2]):
-        return False
-    if kind == "positive":
-        return _is_number(value) and value > 0
-    if kind == "rate":
-        return _is_number(value) and 0 <= value <= 1
-    if kind == "string":
-        return isinstance(value, str)
-    if kind == "bool":
-        return isinstance(value, bool)
-    if kind in ("pair", "range", "pose"):
-        size = 3 if kind == "pose" else 2
-        fits = isinstance(value, list) and len(value) == size and all(_is_number(v) for v in value)
-        return fits and (kind != "range" or value[0] <= value[1])
-    if kind == "strings":
-        return isinstance(value, list) and all(isinstance(v, str) for v in value)
-    if kind == "value":
-        return isinstance(value, (bool, str)) or _is_number(value)
-    raise AssertionError(kind)
-
-
-def _convert(kind: str, value: Any) -> Any:
-    if kind in ("number", "positive", "rate", "duration"):
-        return float(value)
-    if kind in ("pair", "range", "pose", "place"):
-        return tuple(float(v) for v in value)
-    if kind == "strings":
-        return tuple(value)
-    return value
+def _convert(kind: str, value: Any, where: str) -> Any:
+    """``value`` of a scenario file as ``kind`` says (``TYPES``), else ``ValueCheckError`` in the one wording."""
+    kind_type, bounds = TYPES[kind]
+    expected = KINDS[kind]
+    if kind == "value":  # as written: a number, true or false, or a string
+        if not isinstance(value, (bool, str)):
+            convert(value, float, where=where, text=False, expected=expected)
+        return value
+    result = convert(value, kind_type, where=where, bounds=bounds, text=False, expected=expected)
+    if (kind in ("pose", "place") and not _on_carpet(*result[:2])) or (kind == "range" and result[0] > result[1]):
+        raise refusal(where, expected, value)
+    return result
 
 
 # ---------------------------------------------------------------------------------------- reading
@@ -222,10 +207,14 @@ class _File:
             if default is REQUIRED:
                 raise self.error(table, None, f"{where} needs {key} ({KINDS[kind]})")
             return default
-        value = values[key]
-        if not _fits(kind, value):
-            raise self.error(table, key, f"{key} in {where} takes {KINDS[kind]}, got {value!r}")
-        return _convert(kind, value)
+        try:
+            return _convert(kind, values[key], f"{key} in {where}")
+        except ValueCheckError as exc:
+            raise self.error(table, key, str(exc)) from None
+
+    def refuse(self, table: tuple[Any, ...], key: str, expected: str, value: Any) -> ScenarioError:
+        """The error for ``key`` of ``table`` that does not fit: ``<key> takes <expected>, got <value>``, at its line."""
+        return self.error(table, key, str(refusal(key, expected, value)))
 
     def only(self, table: tuple[Any, ...], values: dict[str, Any], known: list[str]) -> None:
         for key in values:
@@ -243,8 +232,8 @@ def _table_name(table: tuple[Any, ...]) -> str:
 
 TOP_KEYS = ["name", "description", "platform", "cameras", "realism", "duration_s", "required_success_rate", "set",
             "robots", "ball", "perturbation", "events", "success"]
-PERTURBATION_KINDS = {"robot_x_mm": "number", "robot_y_mm": "number", "robot_rotation_deg": "number", "ball_x_mm": "number",
-                      "ball_y_mm": "number", "ball_velocity_mm_s": "number", "sensor_noise": "range"}
+PERTURBATION_KINDS = {"robot_x_mm": "spread", "robot_y_mm": "spread", "robot_rotation_deg": "spread", "ball_x_mm": "spread",
+                      "ball_y_mm": "spread", "ball_velocity_mm_s": "spread", "sensor_noise": "range"}
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -255,7 +244,7 @@ def load_scenario(path: str | Path) -> Scenario:
     duration = f.take((), top, "duration_s", "duration")
     platform = f.take((), top, "platform", "string", "mujoco")
     if platform not in PLATFORMS:
-        raise f.error((), "platform", f"platform takes {' or '.join(map(repr, PLATFORMS))}, got {platform!r}")
+        raise f.refuse((), "platform", " or ".join(PLATFORMS), platform)
     overrides = f.take((), top, "set", "strings", ())
     try:
         check_config(apply_overrides({}, overrides))
@@ -279,7 +268,7 @@ def load_scenario(path: str | Path) -> Scenario:
     judges_perception = cameras and any(c.predicate in PERCEPTION_PREDICATES for c in conditions)
     realism = f.take((), top, "realism", "string", "mild" if judges_perception else "off")
     if realism not in REALISM_LEVELS:
-        raise f.error((), "realism", f"realism takes {', '.join(map(repr, REALISM_LEVELS))}, got {realism!r}")
+        raise f.refuse((), "realism", "one of " + ", ".join(REALISM_LEVELS), realism)
     return Scenario(
         name=f.take((), top, "name", "string", f.path.stem),
         path=str(f.path),
@@ -313,12 +302,9 @@ def _perturbation(f: _File, top: dict[str, Any]) -> Perturbation:
         raise f.error((), "perturbation", "perturbation is a table: [perturbation]")
     f.only(table, values, list(PERTURBATION_KINDS))
     taken = {key: f.take(table, values, key, kind, getattr(Perturbation(), key)) for key, kind in PERTURBATION_KINDS.items()}
-    for key, value in taken.items():
-        if key != "sensor_noise" and value < 0:
-            raise f.error(table, key, f"{key} is a spread (plus or minus), 0 or more; got {value:g}")
     low, high = taken["sensor_noise"]
     if low < 0 or high > 100:
-        raise f.error(table, "sensor_noise", f"sensor_noise takes [low, high] factors from 0 to 100 (1: the NAO's noise), got [{low:g}, {high:g}]")
+        raise f.refuse(table, "sensor_noise", "[low, high] factors from 0 to 100 (1: the NAO's noise)", [low, high])
     return Perturbation(**taken)
 
 
@@ -326,10 +312,10 @@ def _push(f: _File, table: tuple[Any, ...], values: dict[str, Any], duration: fl
     f.only(table, values, ["at_s", "push_n"])
     force = f.take(table, values, "push_n", "pair")
     if math.hypot(*force) > MAX_PUSH_N:
-        raise f.error(table, "push_n", f"push_n takes [fx, fy] up to {MAX_PUSH_N:g} N, got {list(force)}")
+        raise f.refuse(table, "push_n", f"[fx, fy] up to {MAX_PUSH_N:g} N", list(force))
     at = f.take(table, values, "at_s", "number")
     if not 0 <= at < duration:
-        raise f.error(table, "at_s", f"at_s is a time within the run, 0 to {duration:g} s; got {at:g}")
+        raise f.refuse(table, "at_s", f"a time within the run, from 0 to below {duration:g} s", at)
     return Push(at_s=at, force_n=force)
 
 
@@ -343,11 +329,11 @@ def _condition(f: _File, table: tuple[Any, ...], values: dict[str, Any], duratio
     timing = {key: _parameter(f, table, values, key, spec) for key, spec in TIMING.items()}
     within = min(timing["within_s"], duration)
     if not 0 <= timing["after_s"] < within:
-        raise f.error(table, "after_s", f"after_s must lie between 0 and within_s ({within:g} s), got {timing['after_s']:g}")
+        raise f.refuse(table, "after_s", f"a time from 0 to below within_s ({within:g} s)", timing["after_s"])
     if timing["for_s"] < 0:
-        raise f.error(table, "for_s", f"for_s is a time, 0 or more; got {timing['for_s']:g}")
+        raise f.refuse(table, "for_s", "a time of 0 s or more", timing["for_s"])
     if name == "ball_in_goal" and parameters["goal"] not in ("opponent", "own"):
-        raise f.error(table, "goal", f"goal takes 'opponent' or 'own', got {parameters['goal']!r}")
+        raise f.refuse(table, "goal", "opponent or own", parameters["goal"])
     if name == "representation":
         _check_representation(f, table, parameters)
     return Condition(name, parameters, timing["after_s"], within, timing["for_s"])
@@ -369,7 +355,9 @@ def _check_representation(f: _File, table: tuple[Any, ...], p: dict[str, Any]) -
     first = p["field"].split(".")[0]
     if first not in names:
         raise f.error(table, "field", f"{p['name']} has no field {first!r}; {did_you_mean(first, names)}")
-    if p["context"] not in CONTEXTS:
-        raise f.error(table, "context", f"context takes 'cognition' or 'motion', got {p['context']!r}")
+    try:
+        p["context"] = Context.of(p["context"], "context").value
+    except ValueCheckError as exc:
+        raise f.error(table, "context", str(exc)) from None
     if all(p[k] is None for k in ("equals", "at_least", "at_most")):
         raise f.error(table, None, "a representation predicate needs equals, at_least or at_most")
