@@ -138,10 +138,14 @@ def test_a_robot_that_does_not_answer_is_a_clear_error(tmp_path: Path) -> None:
 @pytest.mark.parametrize(("text", "message"), [
     ('[[robots]]\nname = "a"\n', "'address' is required"),
     ('[[robots]]\nname = "a"\naddress = "x"\nprot = 22\n', "unknown keys prot"),
-    ('[[robots]]\nname = "a"\naddress = "x"\nport = "22"\n', "port takes a int"),
-    ('[[robots]]\nname = "a"\naddress = "x"\nport = 70000\n', "port takes 1 to 65535"),
-    ('[[robots]]\nname = "a"\naddress = "x"\nservice = "cron"\n', "service 'systemd' or 'process'"),
-    ('robots = 5\n', "must be [[robots]] tables"),
+    ('[[robots]]\nname = "a"\naddress = "x"\nport = "22"\n', "robot 1: port takes an SSH port from 1 to 65535, got '22'"),
+    ('[[robots]]\nname = "a"\naddress = "x"\nport = 70000\n', "robot 1: port takes an SSH port from 1 to 65535, got 70000"),
+    ('[[robots]]\nname = "a"\naddress = "x"\nservice = "cron"\n', "robot 1: service takes one of systemd, process, got 'cron'"),
+    ('[[robots]]\nname = "a"\naddress = "x"\ndependencies = "pip"\n', "robot 1: dependencies takes one of wheels, robot, got 'pip'"),
+    ('[[robots]]\nname = "a"\naddress = ""\n', "robot 1: address takes a host name or IP address (text, not empty), got ''"),
+    ('[[robots]]\nname = "a"\naddress = "x"\nstart_check_s = 0\n', "start_check_s takes a finite number above 0, got 0"),
+    ('[[robots]]\nname = "a"\naddress = "x"\nplayer = 21\n', "player takes a player number from 1 to 20, or 0 for none, got 21"),
+    ('robots = 5\n', "robots takes [[robots]] tables, got 5"),
     ('[[robots\n', "robots.toml"),
 ])
 def test_bad_robot_tables_are_clear_errors(tmp_path: Path, text: str, message: str) -> None:

@@ -31,9 +31,12 @@ import time
 import tomllib
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
+from typing import Any, Literal
+
+from tafel.core.framework.values import Range, convert, refusal
 
 #: the shipped configuration (the repository's config/ folder)
 REPOSITORY = Path(__file__).resolve().parents[2]  # tools/robot/deploy.py: the project, what the wheel is built from
@@ -80,10 +83,20 @@ class Robot:
         return f"{self.user}@{self.address}"
 
 
+#: what each key of a ``[[robots]]`` table takes: (type, range, what would be right in words or None for the type's)
+ROBOT_KEYS: dict[str, tuple[Any, Range | None, str | None]] = {
+    "name": (str, None, "a robot's name (text, not empty)"), "address": (str, None, "a host name or IP address (text, not empty)"),
+    "port": (int, Range(1, 65535), "an SSH port from 1 to 65535"), "user": (str, None, None), "target": (str, None, None),
+    "player": (int, Range(0, 20), "a player number from 1 to 20, or 0 for none"),
+    "team": (int, Range(0, 254), "a team number from 1 to 254, or 0 for none"), "python": (str, None, None),
+    "dependencies": (Literal["wheels", "robot"], None, None), "service": (Literal["systemd", "process"], None, None),
+    "command": (str, None, None), "start_check_s": (float, Range(0.0, low_open=True), None), "min_free_mb": (int, Range(0), None),
+}
+
+
 def load_robots(config_dirs: Sequence[Path]) -> dict[str, Robot]:
-    """The robots of every layer's ``robots.toml``, by name; a wrong key or type is a ``DeployError``."""
+    """The robots of every layer's ``robots.toml``, by name; a wrong key or value is a ``DeployError``."""
     robots: dict[str, Robot] = {}
-    known = {f.name: f.type for f in fields(Robot)}
     for folder in config_dirs:
         path = folder / "robots.toml"
         if not path.is_file():
@@ -92,25 +105,21 @@ def load_robots(config_dirs: Sequence[Path]) -> dict[str, Robot]:
             tables = tomllib.loads(path.read_text()).get("robots", [])
         except (tomllib.TOMLDecodeError, OSError) as exc:
             raise DeployError(f"{path}: {exc}") from None
-        if not isinstance(tables, list):
-            raise DeployError(f"{path}: robots must be [[robots]] tables, got {type(tables).__name__}")
+        convert(tables, list[dict[str, Any]], where=f"{path}: robots", text=False, expected="[[robots]] tables", error=DeployError)
         for index, table in enumerate(tables):
             where = f"{path}: robot {index + 1}"
-            unknown = sorted(set(table) - set(known))
+            unknown = sorted(set(table) - set(ROBOT_KEYS))
             if unknown:
-                raise DeployError(f"{where}: unknown keys {', '.join(unknown)}; a robot knows {', '.join(known)}")
+                raise DeployError(f"{where}: unknown keys {', '.join(unknown)}; a robot knows {', '.join(ROBOT_KEYS)}")
             for required in ("name", "address"):
-                if not isinstance(table.get(required), str) or not table[required]:
-                    raise DeployError(f"{where}: '{required}' is required (a non-empty string)")
-            for key, value in table.items():
-                kind = {"str": str, "int": int, "float": (int, float)}[str(known[key])]
-                if isinstance(value, bool) or not isinstance(value, kind):
-                    raise DeployError(f"{where}: {key} takes a {known[key]}, got {value!r}")
-            robot = Robot(**table)
-            if robot.dependencies not in ("wheels", "robot") or robot.service not in ("systemd", "process"):
-                raise DeployError(f"{where}: dependencies takes 'wheels' or 'robot', service 'systemd' or 'process'")
-            if not 1 <= robot.port <= 65535:
-                raise DeployError(f"{where}: port takes 1 to 65535, got {robot.port}")
+                if required not in table:
+                    raise DeployError(f"{where}: '{required}' is required ({ROBOT_KEYS[required][2]})")
+            values = {key: convert(table[key], kind, where=f"{where}: {key}", bounds=bounds, text=False, expected=expected,
+                                   error=DeployError) for key, (kind, bounds, expected) in ROBOT_KEYS.items() if key in table}
+            for required in ("name", "address"):
+                if not values[required]:
+                    raise refusal(f"{where}: {required}", str(ROBOT_KEYS[required][2]), values[required], DeployError)
+            robot = Robot(**values)
             robots[robot.name] = robot
     return robots
 
