@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from tafel.core.framework.contexts import Context
 from tafel.core.framework.errors import TafelError
 from tafel.core.framework.frame_info import FrameInfo
 from tafel.core.framework.manager import Blackboard
@@ -305,7 +306,7 @@ class LogPlatform(Platform):
 
     def goto(self, frame_number: int, context: str = "") -> None:
         """Replay the step holding ``frame_number`` of the main context (or of ``context``) and pause there."""
-        context = context or ("motion" if "motion" in self._by_context else "cognition")
+        context = Context.of(context, "context").value if context else ("motion" if "motion" in self._by_context else "cognition")
         frames = self._by_context.get(context, np.zeros(0, np.int64))
         numbers = self.frame_number[frames]
         found = frames[numbers == frame_number]

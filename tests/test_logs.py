@@ -262,6 +262,8 @@ def test_stepping_the_replay(recorded: Path) -> None:
     assert platform.timeline()["frame"] == 100 and platform.timeline()["frame_range"] == [1, 600]
     with pytest.raises(PlatformError, match="no motion frame 5000; its motion frames are 1..600"):
         platform.goto(5000)
+    with pytest.raises(ValueError, match=r"^context takes cognition or motion, got 'Motion'$"):
+        platform.goto(100, "Motion")  # looked for frames of no context before
     with pytest.raises(PlatformOptionError):
         LogPlatform({})
 

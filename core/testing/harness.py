@@ -8,6 +8,7 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, TypeVar
 
+from tafel.core.framework.contexts import Context
 from tafel.core.framework.frame_info import FrameInfo
 from tafel.core.framework.manager import Blackboard, ModuleManager
 from tafel.core.framework.module import Module
@@ -41,7 +42,7 @@ class ModuleHarness:
                  context: str | None = None, rate_hz: float | None = None, start_ns: int = 0) -> None:
         declared = module.requirements()
         self.module_class = module
-        self.context = context or context_of(module)
+        self.context = Context.of(context, "context").value if context is not None else context_of(module)
         self.rate_hz = float(rate_hz or CONTEXT_RATES_HZ.get(self.context, 30.0))
         if not (math.isfinite(self.rate_hz) and self.rate_hz > 0):
             raise ValueError(f"rate_hz must be a positive number, got {rate_hz!r}")
