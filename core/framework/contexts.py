@@ -24,7 +24,8 @@ class Context(enum.StrEnum):
     @classmethod
     def of(cls, name: object, where: str = "context", error: type[Exception] = ValueCheckError) -> Context:
         """``name`` as a ``Context``, else ``error``: ``<where> takes cognition or motion, got 'Motion'``."""
-        return convert(name, cls, where=where, text=False, expected=" or ".join(cls.__members__), error=error)  # type: ignore[no-any-return]
+        context: Context = convert(name, cls, where=where, text=False, expected=" or ".join(cls.__members__), error=error)
+        return context
 
     @property
     def other(self) -> Context:

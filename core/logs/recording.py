@@ -76,8 +76,7 @@ def select(plans: Mapping[str, ContextPlan], names: Iterable[str] | None, *, inc
             owners.setdefault(rep.__name__, []).append(Selection(context, rep, "platform"))
         providers = {rep: m for m in plan.active_modules() for rep in m.requirements().provides}
         for rep, module in providers.items():
-            chosen = plan.providers.get(rep.__name__)
-            provider = chosen or module.__name__
+            provider = plan.providers.get(rep.__name__) or module.__name__
             owners.setdefault(rep.__name__, []).append(Selection(context, rep, "module", provider))
     #: name -> the contexts it is chosen in (None: every context that has it); "motion/FrameInfo" chooses one
     chosen: dict[str, set[str] | None] = {}
