@@ -137,10 +137,10 @@ class FieldBoundary:
     top: np.ndarray = array((None,), np.float32)
     bottom: np.ndarray = array((None,), np.float32)
 
-    def rows(self, camera: str) -> np.ndarray:
-        return np.asarray(self.top if camera == "top" else self.bottom)
+    def rows(self, camera: Camera | str) -> np.ndarray:
+        return np.asarray(self.top if Camera.of(camera) is Camera.top else self.bottom)
 
-    def inside(self, camera: str, x: float, y: float) -> bool:
+    def inside(self, camera: Camera | str, x: float, y: float) -> bool:
         """Whether the pixel (x, y) lies on the field (below the boundary)."""
         rows = self.rows(camera)
         if rows.size == 0:

@@ -204,3 +204,9 @@ def test_a_wrong_canvas_or_camera_name_is_an_error_not_a_silent_fallback() -> No
     with pytest.raises(ValueError, match="no camera 'Top': the cameras are 'top' and 'bottom'"):
         image.hsv("Top")
     assert image.hsv("top").max() == 1 and image.hsv(Camera.bottom).max() == 0
+    from tafel.representations.perception import FieldBoundary
+
+    boundary = FieldBoundary(top=np.full(4, 10.0, np.float32), bottom=np.full(4, 20.0, np.float32))
+    with pytest.raises(ValueError, match="no camera 'Top'"):  # the bottom camera's rows before
+        boundary.rows("Top")
+    assert boundary.rows("top")[0] == 10.0 and boundary.inside(Camera.bottom, 1, 25)
