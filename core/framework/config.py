@@ -188,7 +188,7 @@ def check_config(config: Mapping[str, Any], platform_sections: Iterable[str] = (
     aliases = debug.get("aliases", {})
     convert(aliases, dict[str, dict[str, Any]], where="debug.aliases", text=False, error=ConfigError,
             expected='tables, one per alias ([debug.aliases."motion:walk"] with command = ...)')
-    for section in ("cognition", "motion"):
+    for section in CONTEXTS:
         context_section(config, section)
 
 
