@@ -109,7 +109,7 @@ class ProgramDebug:
         expanded = parse(template.substitute(values))
         if "context" in command.args:  # the alias's command runs in that context; a context it names itself must be the same
             wanted = Context.of(command.args["context"], f"{name}: -context", CommandError)
-            own = expanded.args.setdefault("context", wanted.value)
+            own = str(expanded.args.setdefault("context", wanted.value))
             if own != wanted:
                 raise CommandError(f"{name} runs in {own}: leave -context out or give -context {own}")
         ((is_error, answer),) = self.router.handle_batch([expanded])
