@@ -381,6 +381,7 @@ def test_the_tools_package_knows_no_representation_by_name() -> None:
 SLOWER = "slower than real time"
 
 
+@pytest.mark.alone
 @pytest.mark.slow
 def test_a_run_slower_than_real_time_says_so_once_with_its_real_time_factor() -> None:
     # 30 cognition frames a second of 60 ms each: 1.8 s of work for every second
@@ -391,6 +392,7 @@ def test_a_run_slower_than_real_time_says_so_once_with_its_real_time_factor() ->
     assert 0.3 < factor < 0.8, result.stderr  # about 1 / 1.8
 
 
+@pytest.mark.alone
 @pytest.mark.slow
 def test_a_run_that_keeps_up_says_nothing_about_its_pace() -> None:
     result = dummy("--seconds", "4", "--speed", "1", "--status-interval", "1")

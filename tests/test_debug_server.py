@@ -343,6 +343,7 @@ def test_replay_commands(tmp_path: Path) -> None:
         replay.stop()
 
 
+@pytest.mark.alone
 def test_concurrent_runtime_answers_commands_from_both_processes() -> None:
     concurrent = Program("--concurrent")
     try:

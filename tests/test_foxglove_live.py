@@ -97,6 +97,7 @@ def test_the_command_service_answers_as_the_console_would(clients: tuple[Foxglov
     assert client.call_service("/tafel/command", b"no:such").decode().startswith("error: unknown command")
 
 
+@pytest.mark.alone
 @pytest.mark.slow
 def test_with_everything_subscribed_the_loops_keep_their_rates(clients: tuple[FoxgloveClient, Any]) -> None:
     client, debug = clients
@@ -245,16 +246,16 @@ def test_a_subscriber_that_goes_away_costs_one_line() -> None:
     program = Program("--platform", "mujoco", "--foxglove", "0")
     try:
         url = foxglove_url(program)
-        for how in ("closed", "reset", "closed", "closed", "closed", "closed"):
+        for how in ("closed", "reset", "closed", "closed"):
             before = len(program.errors)
             client = FoxgloveClient(url)
             client.subscribe(*sorted(client.wait_for(client.topics)))
-            client.pump(1.0)
+            client.pump(0.6)
             raw = client.socket.socket
             if how == "reset":
                 raw.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
             raw.close()  # under the client's reading thread, as when its process dies
-            time.sleep(2.0)
+            time.sleep(1.5)
             lines = [line for line in program.errors[before:] if "foxglove" in line and "[tafel]" not in line]
             assert len(lines) <= 1, f"{how}: {len(lines)} lines, " + "".join(lines[:3])
     finally:

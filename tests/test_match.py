@@ -31,16 +31,16 @@ def match(tmp_path: Path, *args: str, timeout: float = 600.0) -> tuple[dict, sub
     return json.loads(result.read_text()), done
 
 
-def robot_programs_running() -> list[str]:
-    """Command lines of match robots of this environment still running on this machine (another checkout's
-    matches, run at the same time, are not this test's business)."""
+def robot_programs_running(record_dir: Path) -> list[str]:
+    """Command lines of this match's robots (those recording into ``record_dir``) still running on this
+    machine; other tests' matches, run at the same time by another worker, are not this test's business."""
     found = []
     for entry in Path("/proc").iterdir():
         try:
             command = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode()
         except (OSError, ValueError):
             continue
-        if "--platform match" in command and "tafel.tools.cli run" in command and command.startswith(sys.prefix):
+        if "--platform match" in command and "tafel.tools.cli run" in command and str(record_dir) in command:
             found.append(command)
     return found
 
@@ -90,7 +90,7 @@ def test_a_two_against_two_match_ends_cleanly_with_readable_logs(tmp_path: Path)
                          "--ready-seconds", "6", "--record-dir", str(tmp_path / "logs"), *LEAN)
     assert done.returncode == 0 and result["ended"] == "the game is over", done.stdout[-2000:] + done.stderr[-3000:]
     assert result["simulated_s"] >= TWO_AGAINST_TWO_S - 10.0
-    assert robot_programs_running() == []
+    assert robot_programs_running(tmp_path / "logs") == []
     assert [e["event"] for e in result["events"]].count("PLAYING") >= 2  # both halves (and kickoffs after goals)
     assert len(result["robots"]) == 4 and all(r["exit_status"] == 0 for r in result["robots"])
     for robot in result["robots"]:

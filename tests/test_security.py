@@ -99,6 +99,7 @@ def often_reporting(tmp_path: Path):
     running.stop()
 
 
+@pytest.mark.alone
 @pytest.mark.slow
 def test_a_client_streaming_bytes_without_newlines_cannot_slow_the_loops(often_reporting: Program) -> None:
     """Before the fix the decoder went byte by byte holding the interpreter lock: loops fell to a fraction."""
@@ -420,6 +421,7 @@ def _file_size_limit(limit: int) -> Any:
     return apply
 
 
+@pytest.mark.alone
 @pytest.mark.slow
 def test_a_full_disk_stops_recording_cleanly_and_the_run_goes_on(tmp_path: Path) -> None:
     log = tmp_path / "run.mcap"
@@ -466,6 +468,7 @@ def test_a_closed_standard_output_does_not_stop_the_program(tmp_path: Path) -> N
 
 
 # ---------------------------------------------------------------------------------- all at once
+@pytest.mark.alone
 @pytest.mark.slow
 def test_the_default_simulation_holds_its_rates_under_every_attack_at_once(tmp_path: Path) -> None:
     """20 clients pipelining, one streaming 50 MB without newlines, 40 connections over the limit, an

@@ -125,6 +125,7 @@ def wait_until_standing(robot: Robot, seconds: float) -> None:
     pytest.fail(f"still {robot.status()['posture']} after {seconds} s")
 
 
+@pytest.mark.alone
 @pytest.mark.slow
 @pytest.mark.parametrize("side", ["front", "back"])
 def test_getting_up_from_lying(robot: Robot, side: str) -> None:
@@ -136,6 +137,7 @@ def test_getting_up_from_lying(robot: Robot, side: str) -> None:
     assert set(postures) == {"upright"}, postures  # and stays up
 
 
+@pytest.mark.alone
 @pytest.mark.slow
 def test_a_push_that_topples_the_robot_is_detected_as_a_fall_and_it_gets_up(robot: Robot) -> None:
     robot.ask("sim:push -x 400")

@@ -155,6 +155,7 @@ def test_the_modify_panel_pins_a_value_of_the_walk(page: Any, program: WebProgra
         time.sleep(0.2)
 
 
+@pytest.mark.alone
 def test_the_image_view_updates_at_least_ten_times_a_second(page: Any) -> None:
     before = page.evaluate("[tafel.state.images.top.drawn, tafel.state.images.bottom.drawn, performance.now()]")
     time.sleep(3.0)
