@@ -118,7 +118,7 @@ def test_tafel_team_shows_two_robots_of_a_team_at_the_poses_their_messages_give(
         for robot in ROBOTS:
             assert (drawn[robot.player]["x"], drawn[robot.player]["y"]) == (robot.x, robot.y)
             # the canvas holds the robot's role colour in the disc around where its pose puts it
-            share = page.evaluate("""([x, y, colour]) => {
+            disc_share = """([x, y, colour]) => {
                 const t = tafel.state.team.transform, c = document.querySelector('[data-view=team] canvas');
                 const ratio = c.width / c.clientWidth, r = tafel.state.team.radius * t.scale * ratio;
                 const px = (t.cx + x * t.scale) * ratio, py = (t.cy - y * t.scale) * ratio;
@@ -130,7 +130,11 @@ def test_tafel_team_shows_two_robots_of_a_team_at_the_poses_their_messages_give(
                     all++;
                     if (Math.abs(d[i] - colour[0]) < 40 && Math.abs(d[i + 1] - colour[1]) < 40 && Math.abs(d[i + 2] - colour[2]) < 40) near++;
                 }
-                return near / all; }""", [robot.x, robot.y, list(COLOURS[robot.role.name] if robot.player == 1 else (0x9C, 0xA3, 0xAF))])
+                return near / all; }"""
+            colour = list(COLOURS[robot.role.name] if robot.player == 1 else (0x9C, 0xA3, 0xAF))
+            deadline = time.monotonic() + 10.0  # the canvas is painted on the next animation frame after the state
+            while (share := page.evaluate(disc_share, [robot.x, robot.y, colour])) <= 0.2 and time.monotonic() < deadline:
+                time.sleep(0.1)
             assert share > 0.2, f"player {robot.player}: {share:.0%} of its disc in its colour"
         rows = {row.get_attribute("data-player"): row.inner_text() for row in page.locator("[data-view=team] tr[data-player]").all()}
         assert "goalkeeper" in rows["1"] and "keep_goal" in rows["1"] and "playing" in rows["1"]
