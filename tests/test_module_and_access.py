@@ -229,7 +229,7 @@ def test_provider_writes_reach_the_blackboard_and_unknown_fields_fail() -> None:
 
 def test_module_may_keep_its_own_state() -> None:
     @provides(AccSink)
-    class Counter(Module):
+    class OwnStateCounter(Module):  # a name no other test file's module has: module names are global
         def __init__(self) -> None:
             self.count = 0
 
@@ -237,10 +237,10 @@ def test_module_may_keep_its_own_state() -> None:
             self.count += 1
             self.acc_sink.value = self.count
 
-    manager = ModuleManager([Counter], strict=True)
+    manager = ModuleManager([OwnStateCounter], strict=True)
     for _ in range(3):
         manager.execute()
-    assert manager.blackboard[AccSink].value == 3 and manager.module("Counter").count == 3
+    assert manager.blackboard[AccSink].value == 3 and manager.module("OwnStateCounter").count == 3
 
 
 @representation

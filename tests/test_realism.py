@@ -78,11 +78,12 @@ def test_the_pipeline_keeps_shape_and_dtype_and_clips_instead_of_wrapping(height
     assert settings_ is not None
     out = CameraRealism(settings_, seed)(image, shift)
     assert out.shape == image.shape and out.dtype == np.uint8 and out.flags.c_contiguous
-    # uint8 holds 0..255 by its type; what can go wrong is wrapping round: white must stay bright, black dark
+    # uint8 holds 0..255 by its type; what can go wrong is wrapping round (white past 255 comes out near 0,
+    # black below 0 near 255). A tiny image is all corner, where vignetting and a cast darken white to ~130.
     if fill == "white":
-        assert out.mean() > 140
+        assert out.mean() > 100
     if fill == "black":
-        assert out.mean() < 80
+        assert out.mean() < 100
 
 
 def test_yuv422_halves_the_chroma_resolution_and_keeps_the_luma() -> None:
