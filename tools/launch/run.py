@@ -93,6 +93,16 @@ def stop_servers(debug: Any, *viewers: Any) -> None:
         debug.server.stop()
 
 
+def end_run(recorder: Recorder | None, box: Any, stats: dict[str, ContextStats]) -> int:
+    """After either runtime: what was recorded, the black box's last saves, and the exit status
+    (1 when a context failed)."""
+    report_recording(recorder)
+    if box is not None:
+        box[0].finish()
+        print(box[0].status(), flush=True)
+    return 1 if any(s.failure for s in stats.values()) else 0
+
+
 def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, ContextPlan], recorder: Recorder | None,
                  limits: Limits, config: dict[str, Any]) -> int:
     # The loops share the interpreter with the debug server's network thread: hand the lock over within
@@ -153,11 +163,7 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
         stop_servers(debug, live, web, watcher)
     print_summary(type(platform).name, "lockstep", stats, runtime.wall_s, runtime.time_ns * 1e-9, stop_reason(signals, runtime.end_reason),
                   simulated=True)
-    report_recording(recorder)
-    if box is not None:
-        box[0].finish()
-        print(box[0].status(), flush=True)
-    return 1 if any(s.failure for s in stats.values()) else 0
+    return end_run(recorder, box, stats)
 
 
 def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[str, Any], plans: dict[str, ContextPlan],
@@ -225,10 +231,6 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
     ran = max((s.wall_s for s in stats.values()), default=0.0)
     print_summary(platform_class.name, "concurrent", stats, time.monotonic() - started, ran, stop_reason(signals, ""), simulated=False,
                   notes=notes)
-    report_recording(recorder)
-    if box is not None:
-        box[0].finish()
-        print(box[0].status(), flush=True)
-    return 1 if any(s.failure for s in stats.values()) else 0
+    return end_run(recorder, box, stats)
 
 
