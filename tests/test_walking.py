@@ -140,15 +140,15 @@ def test_getting_up_from_lying(robot: Robot, side: str) -> None:
 @pytest.mark.alone
 @pytest.mark.slow
 def test_a_push_that_topples_the_robot_is_detected_as_a_fall_and_it_gets_up(robot: Robot) -> None:
-    robot.ask("sim:push -x 400")
+    robot.ask("sim:push -x 500")  # the most sim:push gives: at 400 N PyBullet's robot caught itself in 2 of 3 runs
     phases, postures = set(), set()
     deadline = robot.status()["time"] + 6.0  # simulated s: a loaded machine samples the phases less often
     while robot.status()["time"] < deadline:
         phases.add(re.search(r"phase: (\w+)", robot.ask("representation:print FallState -context motion")).group(1))
         postures.add(robot.status()["posture"])
         time.sleep(0.02)
-    assert "falling" in phases and ("lying_back" in phases or "lying_front" in phases or "getting_up" in phases), phases
-    assert postures - {"upright"}, postures  # ground truth: it did go down
+    assert postures - {"upright"}, (postures, phases)  # ground truth first: the push did topple it
+    assert "falling" in phases and ("lying_back" in phases or "lying_front" in phases or "getting_up" in phases), (phases, postures)
     wait_until_standing(robot, 15.0)
 
 
