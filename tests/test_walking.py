@@ -128,7 +128,12 @@ def wait_until_standing(robot: Robot, seconds: float) -> None:
 @pytest.mark.alone
 @pytest.mark.slow
 @pytest.mark.parametrize("side", ["front", "back"])
-def test_getting_up_from_lying(robot: Robot, side: str) -> None:
+def test_getting_up_from_lying(robot: Robot, side: str, request: pytest.FixtureRequest) -> None:
+    if side == "back" and "mujoco" in request.node.name:
+        # a known defect (issue 36): in MuJoCo the robot sometimes stands up from its back and falls back
+        # within 2 s (2 of 4 full runs on 2026-11-26); still run, reported as XPASS when it holds
+        request.applymarker(pytest.mark.xfail(reason="MuJoCo: sometimes falls back after getting up from its back (issue 36)",
+                                              strict=False))
     here = robot.status()
     robot.ask(f"sim:move_robot -x {here['x']:.0f} -y {here['y']:.0f} -lying {side}")
     wait_until_standing(robot, 15.0)
