@@ -25,10 +25,20 @@ import tempfile
 from multiprocessing.connection import Connection
 from typing import Any
 
+import cv2
 import numpy as np
 
 from tafel.core.runtime.platform import PlatformError, PlatformOptionError
-from tafel.platforms.field_world import NET_FRICTION, FieldPart, ball_mesh, ball_texture_png, cylinder_mesh, field_parts
+from tafel.platforms.field_world import (
+    NET_FRICTION,
+    FieldPart,
+    SceneLook,
+    ball_mesh,
+    ball_texture_png,
+    carpet_texture,
+    cylinder_mesh,
+    field_parts,
+)
 from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, fsr_sites, joint_motor, sun_direction, urdf
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.field import BALL_RADIUS
@@ -63,6 +73,10 @@ pybullet = _import_quietly()
 POSITION_GAIN = 0.1  # PyBullet's position motors: share of the position error corrected per step
 ROBOT_RGBA = (0.87, 0.87, 0.9, 1.0)
 M = 0.001
+#: m of carpet one copy of its texture covers (``field_world.carpet_texture`` paints one metre)
+CARPET_TILE = 1.0
+#: how much darker the carpet's darker strips are, as a share of ``SceneLook.texture`` (mild 2.5 %, full 6 %)
+STRIPE_SHADE = 0.5
 
 
 def _quaternion_yaw(yaw: float) -> tuple[float, float, float, float]:
@@ -71,6 +85,37 @@ def _quaternion_yaw(yaw: float) -> tuple[float, float, float, float]:
 
 def _matrix(quaternion: tuple[float, ...]) -> np.ndarray:
     return np.array(pybullet.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
+
+
+def carpet_mesh(half_x: float, half_y: float, strips: int | None = None, tile: float = CARPET_TILE) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The carpet's top (half extents in m, at z = 0) as squares of ``tile`` m, each with the whole texture
+    on it (one metre of ``carpet_texture``): vertices, texture coordinates and triangles (counter-clockwise
+    from above). ``strips`` 0 or 1: only every other strip across the field (those whose index along x
+    has that parity), for the mowing stripes; None: all. Small squares, not two triangles: the CPU
+    renderer's texture follows them without wrapping coordinates, and none reaches far behind the camera."""
+    xs = np.append(np.arange(-half_x, half_x, tile), half_x)
+    ys = np.append(np.arange(-half_y, half_y, tile), half_y)
+    vertices: list[tuple[float, float, float]] = []
+    uvs: list[tuple[float, float]] = []
+    triangles: list[tuple[int, int, int]] = []
+    for strip, (x0, x1) in enumerate(zip(xs[:-1], xs[1:])):
+        if strips is not None and strip % 2 != strips:
+            continue
+        for y0, y1 in zip(ys[:-1], ys[1:]):
+            if x1 - x0 < 1e-9 or y1 - y0 < 1e-9:
+                continue
+            k = len(vertices)
+            u, v = (x1 - x0) / tile, (y1 - y0) / tile
+            vertices += [(x0, y0, 0.0), (x1, y0, 0.0), (x1, y1, 0.0), (x0, y1, 0.0)]
+            uvs += [(0.0, 0.0), (u, 0.0), (u, v), (0.0, v)]
+            triangles += [(k, k + 1, k + 2), (k, k + 2, k + 3)]
+    return np.array(vertices), np.array(uvs), np.array(triangles, dtype=np.int64)
+
+
+def stripe_shade(look: SceneLook) -> tuple[int, float]:
+    """Which strips of the carpet (parity along x) look darker, and by what factor: a seeded phase, and
+    half the texture's strength (a pile laid or brushed the other way)."""
+    return int(np.random.default_rng([look.seed, 67]).integers(2)), 1.0 - STRIPE_SHADE * look.texture
 
 
 #: s a render worker may take to build its world, and to answer one image, before this process renders alone
@@ -238,6 +283,9 @@ class PybulletPlatform(SimulatedRobotPlatform):
             vertices, normals, triangles = cylinder_mesh(part.size[0], part.size[1])
             visual = pybullet.createVisualShape(pybullet.GEOM_MESH, vertices=vertices.tolist(), normals=normals.tolist(),
                                                 indices=triangles.ravel().tolist(), rgbaColor=part.rgba, physicsClientId=c)
+        elif part.kind == "plane" and part.material == "carpet" and self.scene_look is not None:
+            dark, _ = stripe_shade(self.scene_look)
+            visual = self._carpet_visual(part, 1 - dark, 1.0)  # the lighter strips; the body "carpet_stripes" has the others
         elif part.kind == "plane":
             visual = pybullet.createVisualShape(pybullet.GEOM_BOX, halfExtents=[part.size[0], part.size[1], 0.0005],
                                                 rgbaColor=part.rgba, visualFramePosition=[0, 0, -0.0005], physicsClientId=c)
@@ -252,6 +300,14 @@ class PybulletPlatform(SimulatedRobotPlatform):
                                         basePosition=position, baseOrientation=orientation, physicsClientId=c)
         if part.texture:
             pybullet.changeVisualShape(body, -1, textureUniqueId=self._ball_texture(), physicsClientId=c)
+        elif part.kind == "plane" and part.material == "carpet" and self.scene_look is not None:
+            texture = self._carpet_texture(self.scene_look)
+            pybullet.changeVisualShape(body, -1, textureUniqueId=texture, physicsClientId=c)
+            dark, shade = stripe_shade(self.scene_look)
+            stripes = pybullet.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=-1, baseVisualShapeIndex=self._carpet_visual(part, dark, shade),
+                                               basePosition=position, physicsClientId=c)
+            pybullet.changeVisualShape(stripes, -1, textureUniqueId=texture, physicsClientId=c)
+            self.bodies[f"{part.name}_stripes"] = stripes
         if part.name == "ball":
             sliding, spinning, rolling = (float(v) for v in BALL_FRICTION.split())
             pybullet.changeDynamics(body, -1, lateralFriction=sliding, spinningFriction=spinning, rollingFriction=rolling,
@@ -261,6 +317,14 @@ class PybulletPlatform(SimulatedRobotPlatform):
         elif part.absorbs:
             pybullet.changeDynamics(body, -1, lateralFriction=NET_FRICTION, restitution=0.0, physicsClientId=c)
         return body
+
+    def _carpet_visual(self, part: FieldPart, strips: int, shade: float) -> int:
+        """Every other strip of the realistic carpet as a textured mesh, its texture darkened by ``shade``
+        (the CPU renderer multiplies a texture by the shape's colour)."""
+        vertices, uvs, triangles = carpet_mesh(part.size[0], part.size[1], strips)
+        return pybullet.createVisualShape(pybullet.GEOM_MESH, vertices=vertices.tolist(), normals=[[0.0, 0.0, 1.0]] * len(vertices),
+                                          uvs=uvs.tolist(), indices=triangles.ravel().tolist(), rgbaColor=(shade, shade, shade, 1.0),
+                                          physicsClientId=self.client)
 
     def _draw_net(self, part: FieldPart, mesh: float = 0.1) -> None:
         """A box the cameras must not see (a goal net) as a grid of debug lines, which only the GUI draws."""
@@ -277,8 +341,19 @@ class PybulletPlatform(SimulatedRobotPlatform):
 
     def _ball_texture(self) -> int:
         """The SPL ball's pattern, through a temporary PNG (PyBullet loads textures only from files)."""
+        return self._load_texture(ball_texture_png())
+
+    def _carpet_texture(self, look: SceneLook) -> int:
+        """One seeded metre of the realistic carpet, MuJoCo's (``field_world.carpet_texture``)."""
+        ok, png = cv2.imencode(".png", cv2.cvtColor(carpet_texture(look), cv2.COLOR_RGB2BGR))
+        if not ok:
+            raise RuntimeError("OpenCV could not encode the carpet's texture")
+        return self._load_texture(png.tobytes())
+
+    def _load_texture(self, png: bytes) -> int:
+        """A texture from PNG bytes, through a temporary file (PyBullet loads textures only from files)."""
         with tempfile.NamedTemporaryFile(suffix=".png", delete=False) as handle:
-            handle.write(ball_texture_png())
+            handle.write(png)
         try:
             return pybullet.loadTexture(handle.name, physicsClientId=self.client)
         finally:
