@@ -4,7 +4,12 @@ posts over the field's edge, dark corners). The real-image figures are benchmark
 
 from __future__ import annotations
 
+import csv
 import math
+from collections.abc import Iterator
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
 
 import cv2
 import numpy as np
@@ -14,12 +19,23 @@ from hypothesis import strategies as st
 from tafel.core.framework.manager import make_module
 from tafel.modules.perception.field_boundary_detector import cell_shares
 from tafel.modules.perception.field_color_provider import below, byte_median, white_pixels
-from tafel.modules.perception.image_geometry import ImageProjection, own_body_mask
+from tafel.modules.perception.goal_post_detector import GoalPostDetector, edge_peaks
+from tafel.modules.perception.image_geometry import ImageProjection, camera_views, own_body_mask
 from tafel.modules.perception.line_detector import CIRCLE_RADIUS, LineDetector, green_on_both_sides, longest_arc, white_runs
 from tafel.modules.perception.spl_ball_detector import SPLBallDetector, Spot, carpet, carpet_sample
-from tafel.representations.field import BALL_RADIUS
+from tafel.platforms.images import posed_image
+from tafel.representations.field import BALL_RADIUS, GOAL_HEIGHT, GOAL_POST_DIAMETER
 from tafel.representations.motion import CameraMatrix
-from tafel.representations.perception import BallCandidate, BallImagePercept, FieldBoundary, GoalPost, GoalPostPercept, LinePercept
+from tafel.representations.perception import (
+    BallCandidate,
+    BallImagePercept,
+    FieldBoundary,
+    GoalPost,
+    GoalPostPercept,
+    LinePercept,
+    SegmentedImage,
+)
+from tafel.tools.simulation.scene_frames import Perception
 
 
 def level_projection(width: int, height: int, pitch: float) -> ImageProjection:
@@ -389,3 +405,249 @@ def test_the_centre_circle_is_found_as_before(seed: int, count: int, on_circle: 
         percept = self.line_percept  # type: ignore[attr-defined]
         found.append((rest.tobytes(), percept.circle_seen, percept.circle_x, percept.circle_y))
     assert found[0] == found[1]
+
+
+# -------------------------------------------------------------- GoalPostDetector: the loops as they were
+def reference_running_sums(values: np.ndarray) -> np.ndarray:
+    return np.concatenate([np.zeros((1, *values.shape[1:]), np.float32), np.cumsum(values, axis=0, dtype=np.float32)])
+
+
+def reference_edge_profile(summed: np.ndarray, top: np.ndarray, band: int, first_row: int, step: int = 1) -> np.ndarray:
+    rows, width = summed.shape[0] - 1, summed.shape[1]
+    columns = np.arange(step, width - step)
+    low = np.clip(top[columns] - first_row, 0, rows)
+    high = np.clip(top[columns] - band - first_row, 0, rows)
+    change = (summed[low, columns + step] - summed[high, columns + step] - summed[low, columns - step] + summed[high, columns - step])
+    profile = np.zeros(width, np.float32)
+    profile[columns] = np.linalg.norm(change, axis=1) / np.maximum(low - high, 1)
+    return profile
+
+
+def reference_band_means(summed: np.ndarray, top: np.ndarray, band: int, first_row: int) -> np.ndarray:
+    rows, width = summed.shape[0] - 1, summed.shape[1]
+    columns = np.arange(width)
+    low = np.clip(top - first_row, 0, rows)
+    high = np.clip(top - band - first_row, 0, rows)
+    count = np.maximum(low - high, 1).reshape((width,) + (1,) * (summed.ndim - 2))
+    return np.asarray((summed[low, columns] - summed[high, columns]) / count)
+
+def reference_posts(self: GoalPostDetector, camera: str, image: np.ndarray, boundary: np.ndarray, projection: ImageProjection) -> list[GoalPost]:
+    p = self.parameters
+    hsv, green = self.segmented_image.hsv(camera), self.segmented_image.green(camera)
+    height, width = green.shape
+    if image.shape[:2] != green.shape:
+        return []
+    white = (hsv[..., 1] <= p.saturation_max) & ~green & (hsv[..., 2] >= p.white_share * self.segmented_image.white(camera))
+    band = max(3, int(round(p.band * height)))
+    top = np.round(boundary).astype(int)
+    room = top > band
+    if not room.any():
+        return []
+    self.colour = cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2YCrCb).astype(np.float32)
+    first_row, last_row = int(top[room].min()) - band, int(top[room].max())
+    colour = self.colour[first_row:last_row]
+    summed = reference_running_sums(colour)
+    profile = np.where(room, reference_edge_profile(summed, top, band, first_row, max(1, width // 320)), 0.0)
+    edges = edge_peaks(profile, p.edge_min)
+    # the least width a post can have at each edge: the one it has standing on the boundary (its foot is no farther)
+    ground, hit = projection.to_ground(edges + 0.5, top[edges] + 0.5)
+    distance = np.linalg.norm(np.column_stack([ground, np.zeros(len(edges))]) - projection.translation, axis=1)
+    least = np.where(hit, p.width_low * projection.fx * GOAL_POST_DIAMETER / np.maximum(distance, 1.0) - 1.0, 0.0)
+    self.band_colour = reference_band_means(summed, top, band, first_row)
+    self.band_white = reference_band_means(reference_running_sums(white[first_row:last_row].astype(np.float32)), top, band, first_row)
+    found: list[GoalPost] = []
+    for i, left in enumerate(edges):
+        best: tuple[float, GoalPost] | None = None
+        for right in edges[i + 1 : i + 5]:  # one of the next edges (stickers, dents and shadows on a post make more)
+            if right - left < least[i]:
+                continue
+            post = reference_post(self, camera, int(left), int(right), top, white, green, projection)
+            if post is not None:
+                distance = float(np.linalg.norm(np.array([post.x, post.y, 0.0]) - projection.translation))
+                misfit = abs(math.log(post.image_width * distance / (projection.fx * GOAL_POST_DIAMETER)))
+                if best is None or misfit < best[0]:
+                    best = (misfit, post)
+        if best is not None:
+            found.append(best[1])
+    return self.nearest(self.distinct(found))
+
+
+def reference_post(self: GoalPostDetector, camera: str, left: int, right: int, top: np.ndarray, white: np.ndarray, green: np.ndarray,
+         projection: ImageProjection) -> GoalPost | None:
+    p = self.parameters
+    height, width = green.shape
+    post_width = right - left
+    side = max(2, post_width // 2)
+    if post_width < 2 or left < 1 or right > width - 2:
+        return None  # too thin to tell, or cut by the image's edge: its width is not known
+    centre = (left + right) / 2
+    column = int(centre)
+    margin = post_width // 4
+    inner = slice(left + 1 + margin // 2, max(left + 2 + margin // 2, right - margin // 2))
+    # between the edges, in the band above the boundary: white, and unlike both sides
+    if self.band_white[inner].mean() < 0.6:
+        return None
+    inside = self.band_colour[inner].mean(axis=0)
+    for outside in (self.band_colour[max(0, left - side) : left], self.band_colour[right + 1 : right + 1 + side]):
+        if np.linalg.norm(inside - outside.mean(axis=0)) < p.contrast_min:
+            return None
+    # the foot: down between the edges to where the carpet begins (a few rows of it: the carpet's
+    # light makes green spots on a post's lower part)
+    start = max(0, int(top[column]) - 1)
+    carpet = (green[start:, inner].mean(axis=1) >= 0.5).astype(np.int32)
+    run = max(2, post_width // 6)
+    lasting = np.convolve(carpet, np.ones(run, np.int32), mode="valid") == run
+    if not lasting.any():
+        return None  # the foot is not in the image
+    foot = start + int(np.argmax(lasting)) - 1
+    if foot < start:
+        foot = start
+    ground, hit = projection.to_ground(np.array([centre]), np.array([foot + 0.5]))
+    if not hit[0]:
+        return None
+    distance = float(np.linalg.norm(np.append(ground[0], 0.0) - projection.translation))
+    expected = projection.fx * GOAL_POST_DIAMETER / distance
+    if post_width - expected > p.width_tolerance * expected + 1.5 or post_width < p.width_low * expected - 1.0:
+        return None
+    # the foot near the boundary: the boundary no farther behind it than max_behind
+    eye = projection.translation[:2]
+    direction = (ground[0] - eye) / max(float(np.linalg.norm(ground[0] - eye)), 1.0)
+    behind, front = projection.to_image(np.array([[*(ground[0] + direction * p.max_behind), 0.0]]))
+    if front[0] and top[column] < behind[0, 1] - 2.0 - 0.01 * height:
+        return None
+    # the post rises from the foot along its projected axis: white, of one colour, unlike what is beside it
+    post_centre = ground[0] + direction * GOAL_POST_DIAMETER / 2
+    summit, front = projection.to_image(np.array([[*post_centre, p.rise * GOAL_HEIGHT]]))
+    if not front[0] or summit[0, 1] >= foot:
+        return None
+    upper = max(0, int(summit[0, 1]))
+    if foot - upper < p.min_height * post_width:
+        return None
+    def axis(ys: np.ndarray) -> np.ndarray:
+        return np.round(centre + (summit[0, 0] - centre) * (foot - ys) / max(foot - summit[0, 1], 1.0)).astype(int)
+
+    ys = np.unique(np.linspace(upper, foot, min(foot - upper + 1, 48)).round().astype(int))  # at most 48 rows: enough to judge
+    if reference_post_rows(self, ys, axis(ys), post_width, white).mean() < p.white_rows:
+        return None
+    # down to the foot (above the line it stands on): a thing behind the field's edge stands on the hall's
+    # floor (or its reflection on a glossy floor continues it), with something else between it and the carpet
+    line = max(2, post_width // 3)
+    ys = np.arange(max(upper, foot - 3 * line), foot - line + 1)
+    if ys.size and reference_post_rows(self, ys, axis(ys), post_width, white).mean() < 0.5:
+        return None
+    x, y = post_centre
+    return GoalPost(float(x), float(y), camera, float(centre), float(post_width), float(foot))
+
+
+def reference_post_rows(self: GoalPostDetector, ys: np.ndarray, xs: np.ndarray, post_width: int, white: np.ndarray) -> np.ndarray:
+    p = self.parameters
+    height, width = white.shape
+    half = max(1, post_width // 4)
+    side = max(2, post_width // 2)
+
+    def strip(first: int, last: int) -> np.ndarray:
+        columns = np.clip(xs[:, None] + np.arange(first, last + 1)[None, :], 0, width - 1)
+        return np.asarray(self.colour[ys[:, None], columns].mean(axis=1))
+
+    columns = np.clip(xs[:, None] + np.arange(-half, half + 1)[None, :], 0, width - 1)
+    inside = strip(-half, half)
+    edge = (post_width + 1) // 2
+    left, right = strip(-edge - side, -edge - 1), strip(edge + 1, edge + side)
+    unlike = np.maximum(np.linalg.norm(inside - left, axis=1), np.linalg.norm(inside - right, axis=1)) >= p.contrast_min
+    same = np.linalg.norm(inside - np.median(inside, axis=0), axis=1) <= p.uniform_max
+    return np.asarray((white[ys[:, None], columns].mean(axis=1) >= 0.5) & unlike & same)
+
+
+SHARED_IMAGES = Path(__file__).resolve().parent.parent.parent / "shared" / "real-images"
+
+
+def post_tuples(posts: list[GoalPost]) -> list[tuple[float, float, str, float, float, float]]:
+    return [(post.x, post.y, post.camera, post.image_x, post.image_width, post.image_foot) for post in posts]
+
+
+def same_posts_as_the_loops(self: GoalPostDetector, camera: str, image: np.ndarray, boundary: np.ndarray,
+                            projection: ImageProjection) -> list[GoalPost]:
+    """The detector's posts in one image, asserted bit for bit those of the loops (and its band measures too)."""
+    self.band_colour, self.band_white = np.zeros((0, 3)), np.zeros(0)
+    before = reference_posts(self, camera, image, boundary, projection)
+    band_colour, band_white = self.band_colour, self.band_white
+    self.band_colour, self.band_white = np.zeros((0, 3)), np.zeros(0)
+    after = self.posts(camera, image, boundary, projection)
+    assert post_tuples(after) == post_tuples(before)
+    for ours, theirs in ((self.band_colour, band_colour), (self.band_white, band_white)):
+        assert ours.dtype == theirs.dtype
+        np.testing.assert_array_equal(ours, theirs)
+    return after
+
+
+def recorded_frames() -> Iterator[dict[str, Any]]:
+    """Both cameras' frames for the perception: each real image of ../shared/real-images at 640x480 and
+    shrunk to 320x240 (the other camera empty); MuJoCo renders of random scenes where those are absent."""
+    empty = SimpleNamespace(image=np.zeros((0, 0, 3), np.uint8), horizontal_fov=0.0, vertical_fov=0.0, matrix=CameraMatrix())
+    if not (SHARED_IMAGES / "labels.csv").is_file():
+        from tafel.tools.simulation.scene_frames import SceneRenderer
+
+        with SceneRenderer("mujoco", resolution="640x480") as renderer:
+            for frame in renderer.random_frames(24, seed=3):
+                yield {"top": empty, "bottom": empty, frame.camera: frame}
+        return
+    with open(SHARED_IMAGES / "labels.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    for row in rows:
+        camera = row.get("camera") or "top"
+        posed = posed_image(SHARED_IMAGES / row["image"], camera=camera)
+        for scale in (1.0, 0.5):
+            image = posed.image if scale == 1.0 else cv2.resize(posed.image, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
+            view = SimpleNamespace(image=image, horizontal_fov=posed.horizontal_fov, vertical_fov=posed.vertical_fov, matrix=posed.matrix)
+            yield {"top": empty, "bottom": empty, camera: view}
+
+
+def test_goal_posts_in_recorded_frames_are_the_loops() -> None:
+    """On every real image (at both resolutions; renders where the set is absent), after the perception
+    before it has run: the same posts as the loops, bit for bit."""
+    found = 0
+    for frames in recorded_frames():
+        perception = Perception()
+        perception(frames)  # type: ignore[arg-type]
+        self = perception.manager.module("GoalPostDetector")
+        for camera, image, projection in camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer):
+            boundary = self.field_boundary.rows(camera)
+            if boundary.size == projection.width:
+                found += len(same_posts_as_the_loops(self, camera, np.asarray(image.image), boundary, projection))
+    assert found > 0  # the frames held posts, so the whole of the check ran
+
+
+def post_scene(seed: int, width: int, height: int, pitch: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, np.ndarray, ImageProjection]:
+    """(image, hsv, green, white, boundary rows, projection) of a painted field seen by a standing robot:
+    carpet below a wavy edge, a hall above, white posts of about a post's width at their foot's distance
+    (some too thin or too wide, some standing on a goal line, some cut by the image's edge), noise."""
+    rng = np.random.default_rng(seed)
+    projection = level_projection(width, height, pitch)
+    image = np.empty((height, width, 3), np.uint8)
+    image[:] = (40 + rng.integers(-15, 15), 140 + rng.integers(-30, 30), 50 + rng.integers(-15, 15))
+    edge = int(rng.integers(height // 10, height // 2))
+    image[:edge] = rng.integers(60, 230, 3)
+    for _ in range(int(rng.integers(0, 5))):
+        x, foot = float(rng.uniform(-10, width + 10)), int(rng.integers(edge - 2, min(height - 1, edge + height // 4)))
+        ground, hit = projection.to_ground(np.array([x]), np.array([foot + 0.5]))
+        distance = float(np.linalg.norm(np.append(ground[0], 0.0) - projection.translation)) if hit[0] else 5000.0
+        half = max(1.0, projection.fx * GOAL_POST_DIAMETER / distance * float(rng.uniform(0.4, 1.8)) / 2)
+        shade = int(rng.integers(170, 256))
+        cv2.rectangle(image, (int(x - half), int(rng.integers(0, max(1, edge // 2)))), (int(x + half), foot), (shade, shade, shade - 10), -1)
+        if rng.random() < 0.5:  # the goal line it stands on
+            cv2.line(image, (0, foot + 1), (width - 1, foot + 1 + int(rng.integers(-3, 4))), (235, 235, 235), int(rng.integers(1, 5)))
+    image = np.clip(image.astype(int) + rng.integers(-10, 11, image.shape), 0, 255).astype(np.uint8)
+    hsv = cv2.cvtColor(image, cv2.COLOR_RGB2HSV)
+    green = (hsv[..., 0] > 35) & (hsv[..., 0] < 85) & (hsv[..., 1] > 60) & (hsv[..., 2] > 40)
+    boundary = np.clip(edge + rng.normal(0, 2, width), 0, height).astype(np.float32)
+    return image, hsv, green, float(hsv[..., 2].max()), boundary, projection
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([(640, 480), (320, 240), (160, 120), (96, 72)]), st.floats(0.0, 0.5))
+def test_goal_posts_in_painted_scenes_are_the_loops(seed: int, size: tuple[int, int], pitch: float) -> None:
+    """Posts of many widths over a wavy field edge, at the image's edges too: the same posts as the loops."""
+    image, hsv, green, white, boundary, projection = post_scene(seed, *size, pitch)
+    self = make_module(GoalPostDetector, parameters=GoalPostDetector.Parameters(),
+                       segmented_image=SegmentedImage(top_hsv=hsv, top_green=green, top_white=white))
+    same_posts_as_the_loops(self, "top", image, boundary, projection)  # type: ignore[arg-type]

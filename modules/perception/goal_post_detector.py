@@ -10,6 +10,7 @@ import numpy as np
 
 from tafel.core import Module, bounded, provides, requires
 from tafel.debug import Canvas, DebugRequest
+from tafel.modules.perception.field_color_provider import white_pixels
 from tafel.modules.perception.image_geometry import ImageProjection, camera_views
 from tafel.representations.field import GOAL_DEPTH, GOAL_HEIGHT, GOAL_POST_DIAMETER
 from tafel.representations.motion import CameraMatrixBuffer
@@ -31,36 +32,42 @@ def column_groups(flags: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.nonzero(change == 1)[0], np.nonzero(change == -1)[0] - 1))
 
 
-def running_sums(values: np.ndarray) -> np.ndarray:
-    """``values`` (rows first) summed down the rows, with a row of zeros on top: a band's sum is a difference."""
-    return np.concatenate([np.zeros((1, *values.shape[1:]), np.float32), np.cumsum(values, axis=0, dtype=np.float32)])
+def band_sums(integral: np.ndarray, low: np.ndarray, high: np.ndarray, columns: np.ndarray) -> np.ndarray:
+    """For each of ``columns``, the sum of its pixels in the rows ``high`` up to (not with) ``low`` (of the
+    image whose ``cv2.integral`` is ``integral``): exact integers, where a cumulative sum down the rows
+    costs a pass over every pixel of the band's rows (and numpy's is slow along them)."""
+    return np.asarray(integral[low, columns + 1] - integral[high, columns + 1] - integral[low, columns] + integral[high, columns])
 
 
-def edge_profile(summed: np.ndarray, top: np.ndarray, band: int, first_row: int, step: int = 1) -> np.ndarray:
-    """For each column, the strength of a vertical edge in the ``band`` rows above its row ``top``: the
-    length of the colour change from ``step`` px left of it to ``step`` px right of it, averaged over those
-    rows (``summed``: ``running_sums`` of the colour from ``first_row`` on). Averaged before its length is
-    taken, so an edge that runs straight up through the band adds up and noise cancels; over a few px,
-    so that the soft edge of a shaded round post counts as much as a sharp one."""
-    rows, width = summed.shape[0] - 1, summed.shape[1]
+def edge_profile(integral: np.ndarray, low: np.ndarray, high: np.ndarray, step: int = 1) -> np.ndarray:
+    """For each column, the strength of a vertical edge in its band (rows ``high`` up to ``low`` of the
+    image whose ``cv2.integral`` is ``integral``): the length of the colour change from ``step`` px left
+    of it to ``step`` px right of it, averaged over those rows. Averaged before its length is taken, so
+    an edge that runs straight up through the band adds up and noise cancels; over a few px, so that the
+    soft edge of a shaded round post counts as much as a sharp one."""
+    width = integral.shape[1] - 1
     columns = np.arange(step, width - step)
-    low = np.clip(top[columns] - first_row, 0, rows)
-    high = np.clip(top[columns] - band - first_row, 0, rows)
-    change = (summed[low, columns + step] - summed[high, columns + step] - summed[low, columns - step] + summed[high, columns - step])
+    low, high = low[columns], high[columns]
+    # float32 as the running sums this replaced: the integers are exact in it, the length rounds the same
+    change = (band_sums(integral, low, high, columns + step) - band_sums(integral, low, high, columns - step)).astype(np.float32)
     profile = np.zeros(width, np.float32)
     profile[columns] = np.linalg.norm(change, axis=1) / np.maximum(low - high, 1)
     return profile
 
 
-def band_means(summed: np.ndarray, top: np.ndarray, band: int, first_row: int) -> np.ndarray:
-    """For each column, the mean over the ``band`` rows above its row ``top`` of what ``summed`` (``running_sums``
-    from ``first_row`` on) sums."""
-    rows, width = summed.shape[0] - 1, summed.shape[1]
-    columns = np.arange(width)
-    low = np.clip(top - first_row, 0, rows)
-    high = np.clip(top - band - first_row, 0, rows)
-    count = np.maximum(low - high, 1).reshape((width,) + (1,) * (summed.ndim - 2))
-    return np.asarray((summed[low, columns] - summed[high, columns]) / count)
+def band_means(integral: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """For each column, the mean of its pixels in its band (rows ``high`` up to ``low`` of the image whose
+    ``cv2.integral`` is ``integral``), channels last where the image has them."""
+    width = integral.shape[1] - 1
+    count = np.maximum(low - high, 1).reshape((width,) + (1,) * (integral.ndim - 2))
+    return np.asarray(band_sums(integral, low, high, np.arange(width)).astype(np.float32) / count)
+
+
+def window_means(prefix: np.ndarray, first: np.ndarray, stop: np.ndarray) -> np.ndarray:
+    """The means of ``values[first:stop]`` for each pair of bounds, ``prefix`` being ``values``' running sum
+    with a zero in front (up to rounding: for the checks that only let through what may pass)."""
+    count = (stop - first).reshape((-1,) + (1,) * (prefix.ndim - 1))
+    return np.asarray((prefix[stop] - prefix[first]) / count)
 
 
 def edge_peaks(profile: np.ndarray, minimum: float) -> np.ndarray:
@@ -130,7 +137,7 @@ class GoalPostDetector(Module):
     parameters: Parameters
 
     def __init__(self) -> None:
-        self.colour = np.zeros((0, 0, 3), np.float32)
+        self.colour = np.zeros((0, 0, 3), np.uint8)
         """the image being searched, in YCrCb"""
         self.band_colour = np.zeros((0, 3), np.float32)
         """each column's mean colour (YCrCb) in the band above the boundary"""
@@ -155,31 +162,40 @@ class GoalPostDetector(Module):
         height, width = green.shape
         if image.shape[:2] != green.shape:
             return []
-        white = (hsv[..., 1] <= p.saturation_max) & ~green & (hsv[..., 2] >= p.white_share * self.segmented_image.white(camera))
+        white = white_pixels(hsv, p.saturation_max, p.white_share * self.segmented_image.white(camera)) & ~green
         band = max(3, int(round(p.band * height)))
         top = np.round(boundary).astype(int)
         room = top > band
         if not room.any():
             return []
-        self.colour = cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2YCrCb).astype(np.float32)
+        self.colour = cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2YCrCb)
         first_row, last_row = int(top[room].min()) - band, int(top[room].max())
-        colour = self.colour[first_row:last_row]
-        summed = running_sums(colour)
-        profile = np.where(room, edge_profile(summed, top, band, first_row, max(1, width // 320)), 0.0)
+        # each column's band: its rows from high up to low (in the rows from first_row on)
+        low = np.clip(top - first_row, 0, last_row - first_row)
+        high = np.clip(top - band - first_row, 0, last_row - first_row)
+        colour = cv2.integral(self.colour[first_row:last_row], sdepth=cv2.CV_32S)
+        profile = np.where(room, edge_profile(colour, low, high, max(1, width // 320)), 0.0)
         edges = edge_peaks(profile, p.edge_min)
         # the least width a post can have at each edge: the one it has standing on the boundary (its foot is no farther)
         ground, hit = projection.to_ground(edges + 0.5, top[edges] + 0.5)
         distance = np.linalg.norm(np.column_stack([ground, np.zeros(len(edges))]) - projection.translation, axis=1)
         least = np.where(hit, p.width_low * projection.fx * GOAL_POST_DIAMETER / np.maximum(distance, 1.0) - 1.0, 0.0)
-        self.band_colour = band_means(summed, top, band, first_row)
-        self.band_white = band_means(running_sums(white[first_row:last_row].astype(np.float32)), top, band, first_row)
+        self.band_colour = band_means(colour, low, high)
+        self.band_white = band_means(cv2.integral(white[first_row:last_row].view(np.uint8), sdepth=cv2.CV_32S), low, high)
+        # each edge with one of the next edges (stickers, dents and shadows on a post make more)
+        lefts, rights = (np.concatenate(ends).astype(int) for ends in
+                         zip(*((np.arange(len(edges) - k), np.arange(k, len(edges))) for k in range(1, 5))))
+        wide = ~(edges[rights] - edges[lefts] < least[lefts])
+        lefts, rights = lefts[wide], rights[wide]
+        possible = np.zeros((len(edges), len(edges)), bool)
+        possible[lefts, rights] = self.possible(edges[lefts], edges[rights], top, green, projection)
         found: list[GoalPost] = []
         for i, left in enumerate(edges):
             best: tuple[float, GoalPost] | None = None
-            for right in edges[i + 1 : i + 5]:  # one of the next edges (stickers, dents and shadows on a post make more)
-                if right - left < least[i]:
+            for j in range(i + 1, min(i + 5, len(edges))):
+                if not possible[i, j]:
                     continue
-                post = self.post(camera, int(left), int(right), top, white, green, projection)
+                post = self.post(camera, int(left), int(edges[j]), top, white, green, projection)
                 if post is not None:
                     distance = float(np.linalg.norm(np.array([post.x, post.y, 0.0]) - projection.translation))
                     misfit = abs(math.log(post.image_width * distance / (projection.fx * GOAL_POST_DIAMETER)))
@@ -193,6 +209,52 @@ class GoalPostDetector(Module):
                 self.draw.canvas(Canvas.image(camera)).line(post.image_x, 0, post.image_x, post.image_foot, color="yellow", width=2)
                 self.draw.canvas(Canvas.ROBOT).circle(post.x, post.y, GOAL_POST_DIAMETER / 2, color="yellow", width=2)
         return found
+
+    def possible(self, left: np.ndarray, right: np.ndarray, top: np.ndarray, green: np.ndarray, projection: ImageProjection) -> np.ndarray:
+        """Which of the pairs of edges at columns ``left`` and ``right`` may hold a post: ``post``'s first
+        checks (white between the edges, unlike both sides, a foot, a post's width at its distance), all
+        pairs at once. Its means and distances may differ from ``post``'s in the last bits, so a pair is
+        dropped only when it misses a threshold by more than that; ``post`` decides the rest."""
+        p = self.parameters
+        height, width = green.shape
+        slack = 1e-6  # far more than the rounding, far less than any real difference
+        post_width = right - left
+        keep = (post_width >= 2) & (left >= 1) & (right <= width - 2)
+        left, right, post_width = left[keep], right[keep], post_width[keep]
+        possible = np.zeros(len(keep), bool)
+        if not len(left):
+            return possible
+        margin = post_width // 4
+        first = left + 1 + margin // 2
+        stop = np.maximum(left + 2 + margin // 2, right - margin // 2)
+        white_prefix = np.concatenate([[0.0], np.cumsum(self.band_white)])
+        colour_prefix = np.concatenate([np.zeros((1, 3)), np.cumsum(self.band_colour, axis=0)])
+        inside = window_means(colour_prefix, first, stop)
+        side = np.maximum(2, post_width // 2)
+        unlike = np.ones(len(left), bool)
+        for outside_first, outside_stop in ((np.maximum(0, left - side), left), (right + 1, np.minimum(width, right + 1 + side))):
+            unlike &= np.linalg.norm(inside - window_means(colour_prefix, outside_first, outside_stop), axis=1) >= p.contrast_min - slack
+        chosen = (window_means(white_prefix, first, stop) >= 0.6 - slack) & unlike
+        # the foot: the first of ``run`` rows of carpet between the edges, down from the boundary
+        start = np.maximum(0, top[(left + right) // 2] - 1)
+        rows = cv2.integral(green.view(np.uint8), sdepth=cv2.CV_32S)
+        carpet_columns = (rows[1:, stop] - rows[:-1, stop] - rows[1:, first] + rows[:-1, first]).T  # pairs x rows
+        carpet = (2 * carpet_columns >= (stop - first)[:, None]) & (np.arange(height)[None, :] >= start[:, None])
+        run = np.maximum(2, post_width // 6)
+        lasting = np.concatenate([np.zeros((len(left), 1), np.int32), np.cumsum(carpet, axis=1, dtype=np.int32)], axis=1)
+        ends = np.arange(height)[None, :] + run[:, None]
+        lasting = np.take_along_axis(lasting, np.minimum(ends, height), axis=1) - lasting[:, :height] == run[:, None]
+        lasting &= ends <= height
+        chosen &= lasting.any(axis=1)
+        foot = np.maximum(start, np.argmax(lasting, axis=1) - 1)
+        # the width a post has at that foot's distance
+        ground, hit = projection.to_ground((left + right) / 2, foot + 0.5)
+        distance = np.linalg.norm(np.column_stack([ground, np.zeros(len(left))]) - projection.translation, axis=1)
+        expected = projection.fx * GOAL_POST_DIAMETER / np.where(hit, distance, 1.0)
+        misfit = (post_width - expected > p.width_tolerance * expected + 1.5 + slack) | (post_width < p.width_low * expected - 1.0 - slack)
+        chosen &= ~(hit & misfit)
+        possible[np.nonzero(keep)[0][chosen]] = True
+        return possible
 
     def post(self, camera: str, left: int, right: int, top: np.ndarray, white: np.ndarray, green: np.ndarray,
              projection: ImageProjection) -> GoalPost | None:
@@ -272,7 +334,7 @@ class GoalPostDetector(Module):
 
         def strip(first: int, last: int) -> np.ndarray:
             columns = np.clip(xs[:, None] + np.arange(first, last + 1)[None, :], 0, width - 1)
-            return np.asarray(self.colour[ys[:, None], columns].mean(axis=1))
+            return np.asarray(self.colour[ys[:, None], columns].astype(np.float32).mean(axis=1))
 
         columns = np.clip(xs[:, None] + np.arange(-half, half + 1)[None, :], 0, width - 1)
         inside = strip(-half, half)
