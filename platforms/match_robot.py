@@ -8,6 +8,8 @@ world, and with it every robot, moves in lockstep, so a match with a seed comes 
   (``SimulatedRobotPlatform``); the field is seen in the team's own frame (its goal at -x).
 - With cameras, each robot renders its own images from the world's positions (a copy of the world's
   model in its process), so rendering is spread over the cores.
+- ``--realism LEVEL`` (``tafel match --realism``) runs each robot's images through its camera pipeline,
+  seeded by its own ``--seed``; the hall (clutter, carpet, shadows) is the world's, one for every robot.
 - ``--cameras off`` gives the program perception from ground truth instead: ``BallPercept`` (the ball
   while it is within the top camera's view and 6 m, with noise) and ``RobotPose`` (the truth, with
   noise); the image modules are then left out. Matches run faster so, and test the play, not the eyes.
@@ -85,18 +87,24 @@ class MatchRobotPlatform(SimulatedRobotPlatform):
         try:
             self.connection = Client(self.address, authkey=key)
             self.connection.send(("hello", self.index, self.cameras and "cognition" in contexts))
-            _, xml, ball_color, robots = self.connection.recv()
+            _, xml, ball_color, robots, look = self.connection.recv()
         except (OSError, EOFError, ValueError) as exc:
             raise PlatformError(f"cannot join the match's world at {self.address[0]}:{self.address[1]} ({exc}); "
                                 "robots of a match are started by tafel match") from None
         if self.cameras and "cognition" in contexts:
-            self.model = mujoco.MjModel.from_xml_string(xml, mjcf_assets(ball_color))
+            # the world's hall (tafel match --realism): every robot sees the same one, whatever its own seed
+            self.scene_look = look
+            self.model = mujoco.MjModel.from_xml_string(xml, mjcf_assets(ball_color, look))
             self.data = mujoco.MjData(self.model)
             self.robot = MujocoRobot(self.model, robot_prefix(self.index, robots))
             try:
                 self.renderers = {camera: mujoco.Renderer(self.model, self.height, self.width) for camera in ("top", "bottom")}
             except Exception as exc:  # noqa: BLE001 - the GL stack raises several kinds
                 raise PlatformError(f"MuJoCo cannot render headless with MUJOCO_GL={GL_BACKEND} ({exc}); use --cameras off") from None
+            if self.realism_level is not None:  # as the MuJoCo platform renders with --realism; off renders as it always did
+                for renderer in self.renderers.values():
+                    renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = int(self.shadows)
+                    renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
         if "cognition" in contexts:
             self.network.open()
 
@@ -190,6 +198,10 @@ class MatchRobotPlatform(SimulatedRobotPlatform):
         renderer = self.renderers[camera]
         renderer.update_scene(self.data, camera=self.robot.camera(camera))
         return renderer.render().copy()
+
+    def camera_rotation(self, camera: str) -> np.ndarray | None:
+        """The camera's orientation at the last rendered tick (``--realism``'s motion blur); None without cameras."""
+        return self.robot.camera_rotation(self.data, camera) if self.model is not None else None
 
     def drive(self, targets: np.ndarray, stiffness: np.ndarray) -> None:
         self.command = (np.asarray(targets, dtype=float).copy(), np.asarray(stiffness, dtype=float).copy())

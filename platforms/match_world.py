@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tafel.platforms.field_world import SceneLook
 from tafel.platforms.mujoco_sim import MujocoBall, MujocoRobot, TorqueLimits, mujoco
 from tafel.platforms.robot_model import STANDING_HEIGHT, mjcf, mjcf_assets, robot_prefix
 from tafel.platforms.simulated import TIMESTEP
@@ -60,12 +61,16 @@ class Snapshot:
 
 
 class MatchWorld:
-    """The MuJoCo world of a match: ``robots`` start at the given world places (mm)."""
+    """The MuJoCo world of a match: ``robots`` start at the given world places (mm). ``look`` and
+    ``shadows``: the realistic hall of ``tafel match --realism`` (one hall for every robot; none of it
+    collides), which the robots' renderers build from ``xml`` and ``look``."""
 
-    def __init__(self, places: list[tuple[float, float]], ball_color: str = "spl", offscreen: tuple[int, int] = (640, 480)) -> None:
-        self.xml = mjcf(offscreen=offscreen, timestep=TIMESTEP, ball_color=ball_color, robots=[(x / 1000.0, y / 1000.0) for x, y in places])
-        self.ball_color = ball_color
-        self.model = mujoco.MjModel.from_xml_string(self.xml, mjcf_assets(ball_color))
+    def __init__(self, places: list[tuple[float, float]], ball_color: str = "spl", offscreen: tuple[int, int] = (640, 480),
+                 look: SceneLook | None = None, shadows: bool = False) -> None:
+        self.xml = mjcf(offscreen=offscreen, timestep=TIMESTEP, ball_color=ball_color, robots=[(x / 1000.0, y / 1000.0) for x, y in places],
+                        look=look, shadows=shadows)
+        self.ball_color, self.look = ball_color, look
+        self.model = mujoco.MjModel.from_xml_string(self.xml, mjcf_assets(ball_color, look))
         self.data = mujoco.MjData(self.model)
         self.robots = [MujocoRobot(self.model, robot_prefix(k, len(places))) for k in range(len(places))]
         self.torque_limits = TorqueLimits(self.model, self.robots)

@@ -89,6 +89,10 @@ def parse_call(text: str) -> tuple[float, str, int]:
     return seconds, set_play, team
 
 
+#: tafel match --realism: ``platforms.realism.LEVELS``, named here so that building the parser imports no OpenCV
+REALISM_LEVELS = ("off", "mild", "full")
+
+
 def add_match_command(commands: Any) -> None:
     from tafel.core.runtime.platform import seed_number
 
@@ -99,6 +103,9 @@ def add_match_command(commands: Any) -> None:
                        help="on: every robot renders its cameras and sees through them; off: perception from ground truth")
     match.add_argument("--speed", type=parse_speed, default=1.0, help="pace against the wall clock: a factor, or 'max'")
     match.add_argument("--seed", type=seed_number, default=0, help="seed of every robot's sensor noise")
+    match.add_argument("--realism", nargs="?", const="full", default="off", choices=REALISM_LEVELS, metavar="LEVEL",
+                       help="every robot's cameras deliver what a real NAO camera would, each seeded by its own seed, in one "
+                            "realistic hall: off (default), mild or full (the bare option), as tafel run --realism")
     match.add_argument("--record-dir", type=Path, metavar="DIR", help="every robot records its log here (TEAM_PLAYER.mcap)")
     match.add_argument("--record-reps", metavar="A,B", help="record only these representations (as tafel run --record-reps)")
     match.add_argument("--result", type=Path, metavar="FILE.json", help="also write the result's JSON object here")

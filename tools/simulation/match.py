@@ -27,8 +27,10 @@ from multiprocessing.connection import Connection, Listener, wait
 from pathlib import Path
 from typing import Any, TextIO
 
+from tafel.platforms.field_world import scene_look
 from tafel.platforms.match_robot import AUTHKEY_ENV
 from tafel.platforms.match_world import TICK_NS, MatchWorld, Side
+from tafel.platforms.realism import parse_realism, realism_level
 from tafel.representations.game import GamePhase, SetPlay
 from tafel.tools.simulation.officiating import Player
 from tafel.tools.simulation.referee import Referee
@@ -90,7 +92,12 @@ class Match:
             player.index = index
         places = [player.side.to_world(*ENTRY[player.number - 1]) for player in self.players]
         width, height = (int(v) for v in str(args.resolution).lower().split("x"))
-        self.world = MatchWorld([(x, y) for x, y, _ in places], offscreen=(max(width, 640), max(height, 480)))
+        #: --realism: every robot's camera pipeline (seeded by its own seed) and the world's hall (seeded by --seed)
+        self.realism = parse_realism(getattr(args, "realism", "off"))
+        level = realism_level(self.realism)
+        look = scene_look(args.seed, level.carpet_greens, level.carpet_texture, level.hall_clutter, level.goal_nets) if level else None
+        self.world = MatchWorld([(x, y) for x, y, _ in places], offscreen=(max(width, 640), max(height, 480)), look=look,
+                                shadows=bool(level and level.shadows))
         for player, (x, y, heading) in zip(self.players, places):
             self.world.move_robot(player.index, x, y, heading)
         self.ports = {"game_controller_port": free_udp_port(), "return_port": free_udp_port()}
@@ -124,23 +131,32 @@ class Match:
                 "cpu_count": os.cpu_count(), "limit_realtime_factor": round((os.cpu_count() or 1) / total, 3) if total > 0 else None}
 
     # ---------------------------------------------------------------------------------- robots
-    def start_robots(self) -> None:
+    def robot_seed(self, player: Player) -> int:
+        """A robot's ``--seed`` (its sensor noise and camera pipeline): the match's plus its index, so each differs."""
+        return int(self.args.seed) + player.index
+
+    def robot_command(self, player: Player) -> list[str]:
+        """The command line of a robot's program (``tafel run --platform match``)."""
         host, port = self.listener.address
+        team = TEAM_NUMBERS[player.team]
+        settings = {**self.ports, "team_port": self.team_ports[player.team], "team_number": team, "player_number": player.number,
+                    "broadcast": "127.255.255.255"}
+        return [sys.executable, "-m", "tafel.tools.cli", "run", "--platform", "match", "--world", f"{host}:{port}",
+                "--index", str(player.index), f"--side={'+x' if player.side.sign > 0 else '-x'}", "--cameras", self.args.cameras,
+                "--resolution", self.args.resolution, "--seed", str(self.robot_seed(player)), f"--realism={self.realism}", "--speed", "max",
+                "--debug-port", "0", "--no-web", "--status-interval", "3600",
+                "--set", "parameters.GameStateProvider.start_state=initial",
+                # the team message budget is paced over the game's halves, here shorter than the SPL's
+                "--set", f"parameters.TeamMessageSender.half_s={min(3600.0, max(1.0, self.args.seconds / self.args.halves)):g}",
+                *(a for key, value in settings.items() for a in ("--set", f"game.{key}={json.dumps(value)}")),
+                *(a for folder in self.args.module_path for a in ("--module-path", str(folder))),
+                *(a for override in self.args.overrides for a in ("--set", override)),
+                *(a for override in getattr(self.args, f"team{player.team + 1}_overrides") for a in ("--set", override))]
+
+    def start_robots(self) -> None:
         for player in self.players:
             team = TEAM_NUMBERS[player.team]
-            settings = {**self.ports, "team_port": self.team_ports[player.team], "team_number": team, "player_number": player.number,
-                        "broadcast": "127.255.255.255"}
-            command = [sys.executable, "-m", "tafel.tools.cli", "run", "--platform", "match", "--world", f"{host}:{port}",
-                       "--index", str(player.index), f"--side={'+x' if player.side.sign > 0 else '-x'}", "--cameras", self.args.cameras,
-                       "--resolution", self.args.resolution, "--seed", str(self.args.seed + player.index), "--speed", "max",
-                       "--debug-port", "0", "--no-web", "--status-interval", "3600",
-                       "--set", "parameters.GameStateProvider.start_state=initial",
-                       # the team message budget is paced over the game's halves, here shorter than the SPL's
-                       "--set", f"parameters.TeamMessageSender.half_s={min(3600.0, max(1.0, self.args.seconds / self.args.halves)):g}",
-                       *(a for key, value in settings.items() for a in ("--set", f"game.{key}={json.dumps(value)}")),
-                       *(a for folder in self.args.module_path for a in ("--module-path", str(folder))),
-                       *(a for override in self.args.overrides for a in ("--set", override)),
-                       *(a for override in getattr(self.args, f"team{player.team + 1}_overrides") for a in ("--set", override))]
+            command = self.robot_command(player)
             log = None
             if self.args.record_dir is not None:
                 self.args.record_dir.mkdir(parents=True, exist_ok=True)
@@ -170,7 +186,7 @@ class Match:
                 raise RuntimeError(f"robots {', '.join(late)} did not join within {CONNECT_TIMEOUT_S:g} s") from None
             _, index, cameras = connection.recv()
             by_index[index].connection = connection
-            connection.send(("model", self.world.xml, self.world.ball_color, len(self.robots)))
+            connection.send(("model", self.world.xml, self.world.ball_color, len(self.robots), self.world.look))
             by_index[index].cameras = cameras
 
     @staticmethod
@@ -260,12 +276,13 @@ class Match:
                            "nearest_at_start_mm": round(r.nearest_at_start_mm) if math.isfinite(r.nearest_at_start_mm) else None}
                           for r in referee.restrictions],
             "ended": reason,
+            "realism": self.realism,
             "simulated_s": round(self.world.time_ns * 1e-9, 2),
             "events": [{"time_s": round(e.time_s, 2), "event": e.what} for e in referee.events],
             "bytes_per_team_message": round(referee.message_bytes / sent, 1) if sent else 0,
             **self.cpu_figures(),
             "robots": [{"team": TEAM_NUMBERS[r.player.team], "player": r.player.number, "debug": r.debug, "returns": r.player.returns,
-                        "exit_status": r.process.returncode, **({"log": str(r.log)} if r.log else {})} for r in self.robots],
+                        "seed": self.robot_seed(r.player), "exit_status": r.process.returncode, **({"log": str(r.log)} if r.log else {})} for r in self.robots],
         }
 
 
@@ -283,6 +300,10 @@ def command_match(args: argparse.Namespace, extra: Sequence[str]) -> int:
         for robot in match.robots:
             print(f"[match] team {TEAM_NUMBERS[robot.player.team]} player {robot.player.number}: debug server {robot.debug}"
                   + (f", log {robot.log}" if robot.log else ""), flush=True)
+        if match.realism != "off":
+            print(f"[match] realism {match.realism}: every robot's camera pipeline seeded by its own seed "
+                  f"({', '.join(str(match.robot_seed(r.player)) for r in match.robots)}), one hall from --seed {args.seed}"
+                  + ("" if args.cameras == "on" else " (no effect: --cameras off)"), flush=True)
         for side, team in enumerate(TEAM_NUMBERS):  # what `tafel team` listens to, to watch a team of this match
             print(f"[match] team {team} talks on UDP {match.team_ports[side]}, the GameController on "
                   f"{match.ports['game_controller_port']}: tafel team --team {team} --port {match.team_ports[side]} "
@@ -308,6 +329,7 @@ def command_match(args: argparse.Namespace, extra: Sequence[str]) -> int:
     shoot_out = result.get("shoot_out")
     decided = "" if shoot_out is None else (f", shoot-out {shoot_out['score']} ("
                                             + (f"team {shoot_out['winner']} wins)" if shoot_out["winner"] else "undecided: a coin toss)"))
-    print(f"[match] {reason}; score {TEAM_NUMBERS[0]}:{TEAM_NUMBERS[1]} {result['score']}{decided}, fouls {fouls}", flush=True)
+    realism = "" if match.realism == "off" else f", realism {match.realism}"
+    print(f"[match] {reason}; score {TEAM_NUMBERS[0]}:{TEAM_NUMBERS[1]} {result['score']}{decided}, fouls {fouls}{realism}", flush=True)
     print(line, flush=True)
     return 0 if reason == "the game is over" else 1
