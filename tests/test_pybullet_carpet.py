@@ -114,3 +114,16 @@ def test_the_realistic_carpet_is_textured_seeded_and_the_lines_stay_white_where_
         assert (found & carpet).mean() < 0.001, f"{level} seed {seed}: no white in the carpet"
     assert not np.array_equal(textured["mild", 1], textured["mild", 2]), "another seed, another carpet"
     assert np.array_equal(textured["mild", 1], images("mild", 1)), "the same seed, the same carpet"
+
+
+@pytest.mark.slow  # starts a render worker process
+def test_the_render_worker_draws_the_same_realistic_carpet() -> None:
+    """The worker builds its own copy of the world from the options: the same seeded carpet and strips."""
+    p = PybulletPlatform({"realism": "mild", "seed": 4, "render_worker": "on", "resolution": "160x120"})
+    p.start(frozenset({"motion", "cognition"}))
+    try:
+        assert p.worker is not None, "the render worker did not start"
+        p.worker.request(p.moving_state(), "top")
+        np.testing.assert_array_equal(p.worker.image(), p.render("top"))
+    finally:
+        p.stop()
