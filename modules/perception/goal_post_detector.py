@@ -77,6 +77,44 @@ def edge_peaks(profile: np.ndarray, minimum: float) -> np.ndarray:
     return np.nonzero(peak)[0]
 
 
+Rows = tuple[np.ndarray, np.ndarray, int]
+"""rows of the image (``ys``), a post's centre column in each (``xs``) and the post's width (px)"""
+
+
+def strip_sums(integral: np.ndarray, image: np.ndarray, ys: np.ndarray, first_row: int, first: np.ndarray, last: np.ndarray) -> np.ndarray:
+    """For each row ``ys`` the sum of ``image``'s pixels in the columns ``first`` to ``last`` (both kept), a
+    column left of the image counting as its first one and right of it as its last (as clipped indices
+    do); ``integral`` is ``cv2.integral`` of ``image``'s rows from ``first_row`` on. Exact integers."""
+    width = image.shape[1]
+    count = last - first + 1
+    out_left, out_right = np.clip(-first, 0, count), np.clip(last - width + 1, 0, count)
+    low = np.clip(first, 0, width)
+    high = low + count - out_left - out_right
+    y = ys - first_row
+    sums = integral[y + 1, high] - integral[y, high] - integral[y + 1, low] + integral[y, low]
+    shape = (-1,) + (1,) * (image.ndim - 2)
+    return np.asarray(sums + out_left.reshape(shape) * image[ys, 0] + out_right.reshape(shape) * image[ys, width - 1])
+
+
+def strip_means(integral: np.ndarray, image: np.ndarray, ys: np.ndarray, first_row: int, first: np.ndarray, last: np.ndarray) -> np.ndarray:
+    """The means of ``strip_sums`` (float32): what numpy's mean of those pixels as float32 gives, as their
+    sum is an exact integer in float32 and numpy divides it by the count in float64."""
+    count = (last - first + 1)[:, None]
+    return np.asarray((strip_sums(integral, image, ys, first_row, first, last) / count).astype(np.float32))
+
+
+def segment_medians(values: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """The median of each channel of ``values`` (float32, rows x channels) in each run of ``lengths``
+    rows, as ``np.median`` gives it (of two middle values their float32 sum halved)."""
+    segment = np.repeat(np.arange(len(lengths)), lengths)
+    order = np.argsort(segment[:, None] * 1024.0 + values, axis=0, kind="stable")  # the segments in turn, each sorted
+    ordered = np.take_along_axis(values, order, axis=0)
+    starts = np.cumsum(lengths) - lengths
+    upper = ordered[starts + lengths // 2]
+    lower = ordered[starts + (lengths - 1) // 2]
+    return np.asarray(np.where((lengths % 2 == 1)[:, None], upper, ((lower + upper) / 2).astype(np.float32)))
+
+
 @requires(CameraImageTop, CameraImageBottom, SegmentedImage, FieldColor, FieldBoundary, CameraMatrixBuffer)
 @provides(GoalPostPercept)
 class GoalPostDetector(Module):
@@ -187,22 +225,28 @@ class GoalPostDetector(Module):
                          zip(*((np.arange(len(edges) - k), np.arange(k, len(edges))) for k in range(1, 5))))
         wide = ~(edges[rights] - edges[lefts] < least[lefts])
         lefts, rights = lefts[wide], rights[wide]
-        possible = np.zeros((len(edges), len(edges)), bool)
-        possible[lefts, rights] = self.possible(edges[lefts], edges[rights], top, green, projection)
+        possible, feet = self.possible(edges[lefts], edges[rights], top, green, projection)
+        # the pairs that may hold a post, each edge with the edges after it in their order: their shapes
+        shapes: list[tuple[int, GoalPost, Rows, Rows]] = []
+        for k in np.lexsort((rights, lefts)):
+            if possible[k]:
+                shape = self.shape(camera, int(edges[lefts[k]]), int(edges[rights[k]]), int(feet[k]), top, projection)
+                if shape is not None:
+                    shapes.append((int(lefts[k]), *shape))
+        # and whether the white rises along each one's axis (all the rows of all of them judged at once)
+        shares = iter(self.upright([rows for _, _, rising, down in shapes for rows in (rising, down) if len(rows[0])], white))
         found: list[GoalPost] = []
-        for i, left in enumerate(edges):
-            best: tuple[float, GoalPost] | None = None
-            for j in range(i + 1, min(i + 5, len(edges))):
-                if not possible[i, j]:
-                    continue
-                post = self.post(camera, int(left), int(edges[j]), top, white, green, projection)
-                if post is not None:
-                    distance = float(np.linalg.norm(np.array([post.x, post.y, 0.0]) - projection.translation))
-                    misfit = abs(math.log(post.image_width * distance / (projection.fx * GOAL_POST_DIAMETER)))
-                    if best is None or misfit < best[0]:
-                        best = (misfit, post)
-            if best is not None:
-                found.append(best[1])
+        best: dict[int, tuple[float, GoalPost]] = {}
+        for i, post, _, foot_rows in shapes:
+            upright = next(shares) >= p.white_rows
+            if len(foot_rows[0]) and next(shares) < 0.5:  # below: the white reaches down to the foot
+                upright = False
+            if upright:
+                distance = float(np.linalg.norm(np.array([post.x, post.y, 0.0]) - projection.translation))
+                misfit = abs(math.log(post.image_width * distance / (projection.fx * GOAL_POST_DIAMETER)))
+                if i not in best or misfit < best[i][0]:
+                    best[i] = (misfit, post)
+        found = [best[i][1] for i in sorted(best)]
         found = self.nearest(self.distinct(found))
         if self.draw:
             for post in found:
@@ -210,20 +254,22 @@ class GoalPostDetector(Module):
                 self.draw.canvas(Canvas.ROBOT).circle(post.x, post.y, GOAL_POST_DIAMETER / 2, color="yellow", width=2)
         return found
 
-    def possible(self, left: np.ndarray, right: np.ndarray, top: np.ndarray, green: np.ndarray, projection: ImageProjection) -> np.ndarray:
-        """Which of the pairs of edges at columns ``left`` and ``right`` may hold a post: ``post``'s first
-        checks (white between the edges, unlike both sides, a foot, a post's width at its distance), all
-        pairs at once. Its means and distances may differ from ``post``'s in the last bits, so a pair is
-        dropped only when it misses a threshold by more than that; ``post`` decides the rest."""
+    def possible(self, left: np.ndarray, right: np.ndarray, top: np.ndarray, green: np.ndarray,
+                 projection: ImageProjection) -> tuple[np.ndarray, np.ndarray]:
+        """Which of the pairs of edges at columns ``left`` and ``right`` may hold a post, and the row of
+        each one's foot: the first checks (white between the edges, unlike both sides, a foot, a post's
+        width at its distance), all pairs at once. The means and distances here may differ from
+        ``shape``'s in the last bits, so a pair is dropped only when it misses a threshold by more than
+        that; ``shape`` decides the rest. The feet are exact (counts)."""
         p = self.parameters
         height, width = green.shape
         slack = 1e-6  # far more than the rounding, far less than any real difference
         post_width = right - left
         keep = (post_width >= 2) & (left >= 1) & (right <= width - 2)
         left, right, post_width = left[keep], right[keep], post_width[keep]
-        possible = np.zeros(len(keep), bool)
+        possible, feet = np.zeros(len(keep), bool), np.full(len(keep), -1)
         if not len(left):
-            return possible
+            return possible, feet
         margin = post_width // 4
         first = left + 1 + margin // 2
         stop = np.maximum(left + 2 + margin // 2, right - margin // 2)
@@ -236,17 +282,19 @@ class GoalPostDetector(Module):
             unlike &= np.linalg.norm(inside - window_means(colour_prefix, outside_first, outside_stop), axis=1) >= p.contrast_min - slack
         chosen = (window_means(white_prefix, first, stop) >= 0.6 - slack) & unlike
         # the foot: the first of ``run`` rows of carpet between the edges, down from the boundary
+        # (a row is carpet where at least half the columns between the edges are green)
         start = np.maximum(0, top[(left + right) // 2] - 1)
-        rows = cv2.integral(green.view(np.uint8), sdepth=cv2.CV_32S)
-        carpet_columns = (rows[1:, stop] - rows[:-1, stop] - rows[1:, first] + rows[:-1, first]).T  # pairs x rows
-        carpet = (2 * carpet_columns >= (stop - first)[:, None]) & (np.arange(height)[None, :] >= start[:, None])
+        below = int(start.min())  # the rows from here down
+        rows = cv2.integral(green[below:].view(np.uint8), sdepth=cv2.CV_32S)
+        counts = (rows[1:, stop] - rows[:-1, stop] - rows[1:, first] + rows[:-1, first]).T  # pairs x rows
+        row = np.arange(below, height)[None, :]
+        carpet = (2 * counts >= (stop - first)[:, None]) & (row >= start[:, None])
         run = np.maximum(2, post_width // 6)
-        lasting = np.concatenate([np.zeros((len(left), 1), np.int32), np.cumsum(carpet, axis=1, dtype=np.int32)], axis=1)
-        ends = np.arange(height)[None, :] + run[:, None]
-        lasting = np.take_along_axis(lasting, np.minimum(ends, height), axis=1) - lasting[:, :height] == run[:, None]
-        lasting &= ends <= height
+        carpets = np.concatenate([np.zeros((len(left), 1), np.int32), np.cumsum(carpet, axis=1, dtype=np.int32)], axis=1)
+        ends = row - below + run[:, None]  # each run's end (not in it), among those rows
+        lasting = (np.take_along_axis(carpets, np.minimum(ends, height - below), axis=1) - carpets[:, :-1] == run[:, None]) & (ends <= height - below)
         chosen &= lasting.any(axis=1)
-        foot = np.maximum(start, np.argmax(lasting, axis=1) - 1)
+        foot = np.maximum(start, below + np.argmax(lasting, axis=1) - 1)
         # the width a post has at that foot's distance
         ground, hit = projection.to_ground((left + right) / 2, foot + 0.5)
         distance = np.linalg.norm(np.column_stack([ground, np.zeros(len(left))]) - projection.translation, axis=1)
@@ -254,13 +302,17 @@ class GoalPostDetector(Module):
         misfit = (post_width - expected > p.width_tolerance * expected + 1.5 + slack) | (post_width < p.width_low * expected - 1.0 - slack)
         chosen &= ~(hit & misfit)
         possible[np.nonzero(keep)[0][chosen]] = True
-        return possible
+        feet[np.nonzero(keep)[0]] = foot
+        return possible, feet
 
-    def post(self, camera: str, left: int, right: int, top: np.ndarray, white: np.ndarray, green: np.ndarray,
-             projection: ImageProjection) -> GoalPost | None:
-        """The post between the edges at columns ``left`` and ``right``, or None if there is none."""
+    def shape(self, camera: str, left: int, right: int, foot: int, top: np.ndarray,
+              projection: ImageProjection) -> tuple[GoalPost, Rows, Rows] | None:
+        """The post between the edges at columns ``left`` and ``right`` with its foot at row ``foot`` (the
+        first rows of carpet below the boundary between them), if its colour, width and height fit one: with
+        the rows in which the white must rise along its axis and those in which it must reach down to the
+        foot (for ``upright``); None if there is none."""
         p = self.parameters
-        height, width = green.shape
+        height, width = self.colour.shape[:2]
         post_width = right - left
         side = max(2, post_width // 2)
         if post_width < 2 or left < 1 or right > width - 2:
@@ -276,17 +328,6 @@ class GoalPostDetector(Module):
         for outside in (self.band_colour[max(0, left - side) : left], self.band_colour[right + 1 : right + 1 + side]):
             if np.linalg.norm(inside - outside.mean(axis=0)) < p.contrast_min:
                 return None
-        # the foot: down between the edges to where the carpet begins (a few rows of it: the carpet's
-        # light makes green spots on a post's lower part)
-        start = max(0, int(top[column]) - 1)
-        carpet = (green[start:, inner].mean(axis=1) >= 0.5).astype(np.int32)
-        run = max(2, post_width // 6)
-        lasting = np.convolve(carpet, np.ones(run, np.int32), mode="valid") == run
-        if not lasting.any():
-            return None  # the foot is not in the image
-        foot = start + int(np.argmax(lasting)) - 1
-        if foot < start:
-            foot = start
         ground, hit = projection.to_ground(np.array([centre]), np.array([foot + 0.5]))
         if not hit[0]:
             return None
@@ -308,41 +349,41 @@ class GoalPostDetector(Module):
         upper = max(0, int(summit[0, 1]))
         if foot - upper < p.min_height * post_width:
             return None
-        def axis(ys: np.ndarray) -> np.ndarray:
-            """The post's centre column in the rows ``ys``."""
-            return np.round(centre + (summit[0, 0] - centre) * (foot - ys) / max(foot - summit[0, 1], 1.0)).astype(int)
 
-        ys = np.unique(np.linspace(upper, foot, min(foot - upper + 1, 48)).round().astype(int))  # at most 48 rows: enough to judge
-        if self.post_rows(ys, axis(ys), post_width, white).mean() < p.white_rows:
-            return None
+        def axis(ys: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+            """The rows ``ys`` with the post's centre column in each."""
+            return ys, np.round(centre + (summit[0, 0] - centre) * (foot - ys) / max(foot - summit[0, 1], 1.0)).astype(int), post_width
+
+        rising = axis(np.unique(np.linspace(upper, foot, min(foot - upper + 1, 48)).round().astype(int)))  # at most 48 rows: enough to judge
         # down to the foot (above the line it stands on): a thing behind the field's edge stands on the hall's
         # floor (or its reflection on a glossy floor continues it), with something else between it and the carpet
         line = max(2, post_width // 3)
-        ys = np.arange(max(upper, foot - 3 * line), foot - line + 1)
-        if ys.size and self.post_rows(ys, axis(ys), post_width, white).mean() < 0.5:
-            return None
+        down = axis(np.arange(max(upper, foot - 3 * line), foot - line + 1))
         x, y = post_centre
-        return GoalPost(float(x), float(y), camera, float(centre), float(post_width), float(foot))
+        return GoalPost(float(x), float(y), camera, float(centre), float(post_width), float(foot)), rising, down
 
-    def post_rows(self, ys: np.ndarray, xs: np.ndarray, post_width: int, white: np.ndarray) -> np.ndarray:
-        """For each row ``ys`` with the post's centre at ``xs``: whether the post's middle is white, of the
-        post's colour (the median along it) and unlike at least one side."""
+    def upright(self, posts: list[Rows], white: np.ndarray) -> np.ndarray:
+        """For each post's rows (``ys``, the post's centre column ``xs`` in each, its width): the share of the
+        rows in which its middle is white, of the post's colour (the median along those rows) and unlike at
+        least one side. All posts' rows at once: the strips' means from the image's integral (their sums are
+        exact integers, so the means are the ones the strips' pixels give)."""
         p = self.parameters
-        height, width = white.shape
-        half = max(1, post_width // 4)
-        side = max(2, post_width // 2)
-
-        def strip(first: int, last: int) -> np.ndarray:
-            columns = np.clip(xs[:, None] + np.arange(first, last + 1)[None, :], 0, width - 1)
-            return np.asarray(self.colour[ys[:, None], columns].astype(np.float32).mean(axis=1))
-
-        columns = np.clip(xs[:, None] + np.arange(-half, half + 1)[None, :], 0, width - 1)
-        inside = strip(-half, half)
-        edge = (post_width + 1) // 2
-        left, right = strip(-edge - side, -edge - 1), strip(edge + 1, edge + side)
+        if not posts:
+            return np.zeros(0)
+        lengths = np.array([len(ys) for ys, _, _ in posts])
+        ys, xs = np.concatenate([ys for ys, _, _ in posts]), np.concatenate([xs for _, xs, _ in posts])
+        post_width = np.repeat([width for _, _, width in posts], lengths)
+        half, side, edge = np.maximum(1, post_width // 4), np.maximum(2, post_width // 2), (post_width + 1) // 2
+        first_row = int(ys.min())
+        block = slice(first_row, int(ys.max()) + 1)
+        colour = cv2.integral(self.colour[block], sdepth=cv2.CV_32S)
+        inside = strip_means(colour, self.colour, ys, first_row, xs - half, xs + half)
+        left, right = (strip_means(colour, self.colour, ys, first_row, xs + a, xs + b) for a, b in ((-edge - side, -edge - 1), (edge + 1, edge + side)))
         unlike = np.maximum(np.linalg.norm(inside - left, axis=1), np.linalg.norm(inside - right, axis=1)) >= p.contrast_min
-        same = np.linalg.norm(inside - np.median(inside, axis=0), axis=1) <= p.uniform_max
-        return np.asarray((white[ys[:, None], columns].mean(axis=1) >= 0.5) & unlike & same)
+        same = np.linalg.norm(inside - np.repeat(segment_medians(inside, lengths), lengths, axis=0), axis=1) <= p.uniform_max
+        whites = strip_sums(cv2.integral(white[block].view(np.uint8), sdepth=cv2.CV_32S), white, ys, first_row, xs - half, xs + half)
+        rows = (2 * whites >= 2 * half + 1) & unlike & same  # white: at least half the middle's pixels
+        return np.asarray(np.add.reduceat(rows.astype(np.int64), np.cumsum(lengths) - lengths) / lengths)
 
     @staticmethod
     def distinct(posts: list[GoalPost]) -> list[GoalPost]:
