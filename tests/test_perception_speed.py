@@ -19,7 +19,16 @@ from hypothesis import strategies as st
 from tafel.core.framework.manager import make_module
 from tafel.modules.perception.field_boundary_detector import cell_shares
 from tafel.modules.perception.field_color_provider import below, byte_median, white_pixels
-from tafel.modules.perception.goal_post_detector import GoalPostDetector, edge_peaks
+from tafel.modules.perception.goal_post_detector import (
+    GoalPostDetector,
+    edge_peaks,
+    exact_norms,
+    exact_to_ground,
+    exact_to_image,
+    segment_medians,
+    strip_means,
+    strip_sums,
+)
 from tafel.modules.perception.image_geometry import ImageProjection, camera_views, own_body_mask
 from tafel.modules.perception.line_detector import CIRCLE_RADIUS, LineDetector, green_on_both_sides, longest_arc, white_runs
 from tafel.modules.perception.spl_ball_detector import SPLBallDetector, Spot, carpet, carpet_sample
@@ -651,3 +660,54 @@ def test_goal_posts_in_painted_scenes_are_the_loops(seed: int, size: tuple[int, 
     self = make_module(GoalPostDetector, parameters=GoalPostDetector.Parameters(),
                        segmented_image=SegmentedImage(top_hsv=hsv, top_green=green, top_white=white))
     same_posts_as_the_loops(self, "top", image, boundary, projection)  # type: ignore[arg-type]
+
+
+@settings(max_examples=200)
+@given(st.integers(0, 2**32 - 1), st.floats(-1.5, 1.5), st.floats(-0.6, 1.2), st.floats(300.0, 600.0), st.integers(1, 40))
+def test_the_geometry_of_many_posts_at_once_is_each_ones(seed: int, yaw: float, pitch: float, height: float, count: int) -> None:
+    """Pixels to the ground, points to the image and lengths for many posts at once: to the last bit
+    what the projection gives for each one alone (the detector's posts must not move by a rounding)."""
+    rng = np.random.default_rng(seed)
+    c, s, cp, sp = math.cos(yaw), math.sin(yaw), math.cos(pitch), math.sin(pitch)
+    rotation = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]) @ np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    projection = ImageProjection(CameraMatrix(rotation, np.array([*rng.normal(0, 50, 2), height]), True), 640, 480,
+                                 math.radians(56.3), math.radians(43.7))
+    xs, ys = rng.uniform(-20, 660, count), rng.uniform(-20, 500, count)
+    ground, hits = exact_to_ground(projection, xs, ys)
+    points = np.column_stack([rng.normal(0, 3000, (count, 2)), rng.uniform(0, 800, count)])
+    pixels, fronts = exact_to_image(projection, points)
+    for k in range(count):
+        one, hit = projection.to_ground(xs[k : k + 1], ys[k : k + 1])
+        assert hit[0] == hits[k] and np.array_equal(one[0], ground[k])
+        pixel, front = projection.to_image(points[k : k + 1])
+        assert front[0] == fronts[k] and np.array_equal(pixel[0], pixels[k])
+    for size in (2, 3):
+        vectors = points[:, :size] * rng.uniform(0.01, 10)
+        assert np.array_equal(exact_norms(vectors), [float(np.linalg.norm(vector)) for vector in vectors])
+
+
+@settings(max_examples=300)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 30), st.integers(1, 40), st.integers(1, 6))
+def test_strips_and_medians_of_many_posts_at_once_are_numpys(seed: int, rows: int, columns: int, posts: int) -> None:
+    """The strips' means (clipped at the image's sides) and each post's median along its rows: numpy's
+    float32 means of the pixels and np.median, to the last bit."""
+    rng = np.random.default_rng(seed)
+    image = rng.integers(0, 256, (rows, columns, 3)).astype(np.uint8)
+    mask = rng.random((rows, columns)) < 0.5
+    lengths = rng.integers(1, 12, posts)
+    ys = rng.integers(0, rows, int(lengths.sum()))
+    xs = rng.integers(-10, columns + 10, len(ys))
+    first = xs + rng.integers(-15, 3, len(ys))
+    last = first + rng.integers(0, 12, len(ys))
+    first_row = int(ys.min())
+    colour = cv2.integral(image[first_row:], sdepth=cv2.CV_32S)
+    means = strip_means(colour, image, ys, first_row, first, last)
+    whites = strip_sums(cv2.integral(mask[first_row:].view(np.uint8), sdepth=cv2.CV_32S), mask, ys, first_row, first, last)
+    for k in range(len(ys)):
+        strip = np.clip(np.arange(first[k], last[k] + 1), 0, columns - 1)
+        assert np.array_equal(means[k], image.astype(np.float32)[ys[k], strip].mean(axis=0))
+        assert whites[k] == mask[ys[k], strip].sum()
+    medians = segment_medians(means, lengths)
+    assert medians.dtype == np.float32
+    for k, (start, length) in enumerate(zip(np.cumsum(lengths) - lengths, lengths, strict=True)):
+        assert np.array_equal(medians[k], np.median(means[start : start + length], axis=0))

@@ -115,6 +115,43 @@ def segment_medians(values: np.ndarray, lengths: np.ndarray) -> np.ndarray:
     return np.asarray(np.where((lengths % 2 == 1)[:, None], upper, ((lower + upper) / 2).astype(np.float32)))
 
 
+def exact_rays(projection: ImageProjection, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """``projection.rays`` of each pixel as one call for that pixel alone gives it, to the last bit: a
+    stack of 1 x 3 products (numpy's product of many rows at once rounds differently)."""
+    camera = np.stack([np.ones_like(xs, dtype=float), -(np.asarray(xs, float) - projection.width / 2) / projection.fx,
+                       -(np.asarray(ys, float) - projection.height / 2) / projection.fy], axis=-1)
+    return np.asarray((camera[:, None, :] @ projection.rotation.T)[:, 0])
+
+
+def exact_to_ground(projection: ImageProjection, xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``projection.to_ground`` (on the ground) of each pixel as one call for it alone gives it."""
+    rays = exact_rays(projection, xs, ys)
+    hits = rays[:, 2] < -1e-6
+    scale = np.where(hits, (0.0 - projection.translation[2]) / np.where(hits, rays[:, 2], -1.0), 0.0)
+    return projection.translation[:2] + scale[:, None] * rays[:, :2], hits
+
+
+def exact_to_image(projection: ImageProjection, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``projection.to_image`` of each point as one call for it alone gives it."""
+    local = ((np.asarray(points, float) - projection.translation)[:, None, :] @ projection.rotation)[:, 0]
+    front = local[:, 0] > 1.0
+    depth = np.where(front, local[:, 0], 1.0)
+    return np.stack([projection.width / 2 - projection.fx * local[:, 1] / depth,
+                     projection.height / 2 - projection.fy * local[:, 2] / depth], axis=1), front
+
+
+def exact_norms(vectors: np.ndarray) -> np.ndarray:
+    """``np.linalg.norm`` of each row as numpy gives it for that row alone (the square root of its dot
+    product with itself)."""
+    return np.asarray(np.sqrt((vectors[:, None, :] @ vectors[:, :, None])[:, 0, 0]))
+
+
+def post_axis(ys: np.ndarray, centre: float, summit: np.ndarray, foot: int, post_width: int) -> Rows:
+    """The rows ``ys`` with a post's centre column in each: on the line from its foot (row ``foot``, column
+    ``centre``) to its ``summit`` (x, y px)."""
+    return ys, np.round(centre + (summit[0] - centre) * (foot - ys) / max(foot - summit[1], 1.0)).astype(int), post_width
+
+
 @requires(CameraImageTop, CameraImageBottom, SegmentedImage, FieldColor, FieldBoundary, CameraMatrixBuffer)
 @provides(GoalPostPercept)
 class GoalPostDetector(Module):
@@ -175,7 +212,7 @@ class GoalPostDetector(Module):
     parameters: Parameters
 
     def __init__(self) -> None:
-        self.colour = np.zeros((0, 0, 3), np.uint8)
+        self.colour: np.ndarray = np.zeros((0, 0, 3), np.uint8)
         """the image being searched, in YCrCb"""
         self.band_colour = np.zeros((0, 3), np.float32)
         """each column's mean colour (YCrCb) in the band above the boundary"""
@@ -225,18 +262,16 @@ class GoalPostDetector(Module):
                          zip(*((np.arange(len(edges) - k), np.arange(k, len(edges))) for k in range(1, 5))))
         wide = ~(edges[rights] - edges[lefts] < least[lefts])
         lefts, rights = lefts[wide], rights[wide]
-        possible, feet = self.possible(edges[lefts], edges[rights], top, green, projection)
+        possible, feet, unsure = self.possible(edges[lefts], edges[rights], top, green, projection)
         # the pairs that may hold a post, each edge with the edges after it in their order: their shapes
-        shapes: list[tuple[int, GoalPost, Rows, Rows]] = []
-        for k in np.lexsort((rights, lefts)):
-            if possible[k]:
-                shape = self.shape(camera, int(edges[lefts[k]]), int(edges[rights[k]]), int(feet[k]), top, projection)
-                if shape is not None:
-                    shapes.append((int(lefts[k]), *shape))
+        order = np.lexsort((rights, lefts))
+        order = order[possible[order]]
+        order = order[[not unsure[k] or self.band_checks(int(edges[lefts[k]]), int(edges[rights[k]])) for k in order]]
+        shapes = [(int(lefts[k]), *shape) for k, shape in zip(order, self.shapes(camera, edges[lefts[order]], edges[rights[order]], feet[order],
+                                                                                  top, projection), strict=True) if shape is not None]
         # and whether the white rises along each one's axis (all the rows of all of them judged at once)
         shares = iter(self.upright([rows for _, _, rising, down in shapes for rows in (rising, down) if len(rows[0])], white))
-        found: list[GoalPost] = []
-        best: dict[int, tuple[float, GoalPost]] = {}
+        best: dict[int, tuple[float, GoalPost]] = {}  # of each left edge's posts the one whose width fits best (the first of equals)
         for i, post, _, foot_rows in shapes:
             upright = next(shares) >= p.white_rows
             if len(foot_rows[0]) and next(shares) < 0.5:  # below: the white reaches down to the foot
@@ -246,8 +281,7 @@ class GoalPostDetector(Module):
                 misfit = abs(math.log(post.image_width * distance / (projection.fx * GOAL_POST_DIAMETER)))
                 if i not in best or misfit < best[i][0]:
                     best[i] = (misfit, post)
-        found = [best[i][1] for i in sorted(best)]
-        found = self.nearest(self.distinct(found))
+        found = self.nearest(self.distinct([best[i][1] for i in sorted(best)]))
         if self.draw:
             for post in found:
                 self.draw.canvas(Canvas.image(camera)).line(post.image_x, 0, post.image_x, post.image_foot, color="yellow", width=2)
@@ -255,21 +289,22 @@ class GoalPostDetector(Module):
         return found
 
     def possible(self, left: np.ndarray, right: np.ndarray, top: np.ndarray, green: np.ndarray,
-                 projection: ImageProjection) -> tuple[np.ndarray, np.ndarray]:
-        """Which of the pairs of edges at columns ``left`` and ``right`` may hold a post, and the row of
-        each one's foot: the first checks (white between the edges, unlike both sides, a foot, a post's
-        width at its distance), all pairs at once. The means and distances here may differ from
-        ``shape``'s in the last bits, so a pair is dropped only when it misses a threshold by more than
-        that; ``shape`` decides the rest. The feet are exact (counts)."""
+                 projection: ImageProjection) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Which of the pairs of edges at columns ``left`` and ``right`` may hold a post, the row of each
+        one's foot, and which lie so near the thresholds of the band's checks that only ``band_checks``
+        can tell: the first checks (white between the edges, unlike both sides, a foot, a post's width at
+        its distance), all pairs at once. The band's means here (running sums) may differ from the
+        slices' means in the last bits, and the distances from ``shapes``', so a pair is dropped only when
+        it misses a threshold by more than that; ``shapes`` decides the rest. The feet are exact (counts)."""
         p = self.parameters
         height, width = green.shape
         slack = 1e-6  # far more than the rounding, far less than any real difference
         post_width = right - left
         keep = (post_width >= 2) & (left >= 1) & (right <= width - 2)
         left, right, post_width = left[keep], right[keep], post_width[keep]
-        possible, feet = np.zeros(len(keep), bool), np.full(len(keep), -1)
+        possible, feet, unsure = np.zeros(len(keep), bool), np.full(len(keep), -1), np.zeros(len(keep), bool)
         if not len(left):
-            return possible, feet
+            return possible, feet, unsure
         margin = post_width // 4
         first = left + 1 + margin // 2
         stop = np.maximum(left + 2 + margin // 2, right - margin // 2)
@@ -277,10 +312,12 @@ class GoalPostDetector(Module):
         colour_prefix = np.concatenate([np.zeros((1, 3)), np.cumsum(self.band_colour, axis=0)])
         inside = window_means(colour_prefix, first, stop)
         side = np.maximum(2, post_width // 2)
-        unlike = np.ones(len(left), bool)
+        white = window_means(white_prefix, first, stop)
+        chosen, near = white >= 0.6 - slack, white < 0.6 + slack
         for outside_first, outside_stop in ((np.maximum(0, left - side), left), (right + 1, np.minimum(width, right + 1 + side))):
-            unlike &= np.linalg.norm(inside - window_means(colour_prefix, outside_first, outside_stop), axis=1) >= p.contrast_min - slack
-        chosen = (window_means(white_prefix, first, stop) >= 0.6 - slack) & unlike
+            contrast = np.linalg.norm(inside - window_means(colour_prefix, outside_first, outside_stop), axis=1)
+            chosen &= contrast >= p.contrast_min - slack
+            near |= contrast < p.contrast_min + slack
         # the foot: the first of ``run`` rows of carpet between the edges, down from the boundary
         # (a row is carpet where at least half the columns between the edges are green)
         start = np.maximum(0, top[(left + right) // 2] - 1)
@@ -303,64 +340,64 @@ class GoalPostDetector(Module):
         chosen &= ~(hit & misfit)
         possible[np.nonzero(keep)[0][chosen]] = True
         feet[np.nonzero(keep)[0]] = foot
-        return possible, feet
+        unsure[np.nonzero(keep)[0][near]] = True
+        return possible, feet, unsure
 
-    def shape(self, camera: str, left: int, right: int, foot: int, top: np.ndarray,
-              projection: ImageProjection) -> tuple[GoalPost, Rows, Rows] | None:
-        """The post between the edges at columns ``left`` and ``right`` with its foot at row ``foot`` (the
-        first rows of carpet below the boundary between them), if its colour, width and height fit one: with
-        the rows in which the white must rise along its axis and those in which it must reach down to the
-        foot (for ``upright``); None if there is none."""
-        p = self.parameters
-        height, width = self.colour.shape[:2]
+    def band_checks(self, left: int, right: int) -> bool:
+        """Whether the band above the boundary is white between the edges at columns ``left`` and ``right``
+        and unlike both sides (the slices' means: for the pairs whose running sums lie near a threshold)."""
         post_width = right - left
         side = max(2, post_width // 2)
-        if post_width < 2 or left < 1 or right > width - 2:
-            return None  # too thin to tell, or cut by the image's edge: its width is not known
-        centre = (left + right) / 2
-        column = int(centre)
         margin = post_width // 4
         inner = slice(left + 1 + margin // 2, max(left + 2 + margin // 2, right - margin // 2))
-        # between the edges, in the band above the boundary: white, and unlike both sides
         if self.band_white[inner].mean() < 0.6:
-            return None
+            return False
         inside = self.band_colour[inner].mean(axis=0)
-        for outside in (self.band_colour[max(0, left - side) : left], self.band_colour[right + 1 : right + 1 + side]):
-            if np.linalg.norm(inside - outside.mean(axis=0)) < p.contrast_min:
-                return None
-        ground, hit = projection.to_ground(np.array([centre]), np.array([foot + 0.5]))
-        if not hit[0]:
-            return None
-        distance = float(np.linalg.norm(np.append(ground[0], 0.0) - projection.translation))
-        expected = projection.fx * GOAL_POST_DIAMETER / distance
-        if post_width - expected > p.width_tolerance * expected + 1.5 or post_width < p.width_low * expected - 1.0:
-            return None
+        return all(np.linalg.norm(inside - outside.mean(axis=0)) >= self.parameters.contrast_min
+                   for outside in (self.band_colour[max(0, left - side) : left], self.band_colour[right + 1 : right + 1 + side]))
+
+    def shapes(self, camera: str, left: np.ndarray, right: np.ndarray, foot: np.ndarray, top: np.ndarray,
+               projection: ImageProjection) -> list[tuple[GoalPost, Rows, Rows] | None]:
+        """For the edges at columns ``left`` and ``right`` with a foot at row ``foot`` (the first rows of
+        carpet below the boundary between them) whose band passed its checks: the post, if its width and
+        height fit one, with the rows in which the white must rise along its axis and those in which it
+        must reach down to the foot (for ``upright``); else None. All at once, by the very operations the
+        pixel-by-pixel code did for each (``exact_rays``, ``exact_norms``), so the posts are the same to
+        the last bit."""
+        p = self.parameters
+        height = self.colour.shape[0]
+        if not len(left):
+            return []
+        post_width = right - left
+        centre = (left + right) / 2
+        column = (left + right) // 2  # int(centre)
+        ground, hit = exact_to_ground(projection, centre, foot + 0.5)
+        distance = exact_norms(np.column_stack([ground, np.zeros(len(left))]) - projection.translation)
+        expected = projection.fx * GOAL_POST_DIAMETER / np.where(hit, distance, 1.0)
+        fits = hit & ~((post_width - expected > p.width_tolerance * expected + 1.5) | (post_width < p.width_low * expected - 1.0))
         # the foot near the boundary: the boundary no farther behind it than max_behind
         eye = projection.translation[:2]
-        direction = (ground[0] - eye) / max(float(np.linalg.norm(ground[0] - eye)), 1.0)
-        behind, front = projection.to_image(np.array([[*(ground[0] + direction * p.max_behind), 0.0]]))
-        if front[0] and top[column] < behind[0, 1] - 2.0 - 0.01 * height:
-            return None
+        direction = (ground - eye) / np.maximum(exact_norms(ground - eye), 1.0)[:, None]
+        behind, front = exact_to_image(projection, np.column_stack([ground + direction * p.max_behind, np.zeros(len(left))]))
+        fits &= ~(front & (top[column] < behind[:, 1] - 2.0 - 0.01 * height))
         # the post rises from the foot along its projected axis: white, of one colour, unlike what is beside it
-        post_centre = ground[0] + direction * GOAL_POST_DIAMETER / 2
-        summit, front = projection.to_image(np.array([[*post_centre, p.rise * GOAL_HEIGHT]]))
-        if not front[0] or summit[0, 1] >= foot:
-            return None
-        upper = max(0, int(summit[0, 1]))
-        if foot - upper < p.min_height * post_width:
-            return None
-
-        def axis(ys: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
-            """The rows ``ys`` with the post's centre column in each."""
-            return ys, np.round(centre + (summit[0, 0] - centre) * (foot - ys) / max(foot - summit[0, 1], 1.0)).astype(int), post_width
-
-        rising = axis(np.unique(np.linspace(upper, foot, min(foot - upper + 1, 48)).round().astype(int)))  # at most 48 rows: enough to judge
-        # down to the foot (above the line it stands on): a thing behind the field's edge stands on the hall's
-        # floor (or its reflection on a glossy floor continues it), with something else between it and the carpet
-        line = max(2, post_width // 3)
-        down = axis(np.arange(max(upper, foot - 3 * line), foot - line + 1))
-        x, y = post_centre
-        return GoalPost(float(x), float(y), camera, float(centre), float(post_width), float(foot)), rising, down
+        post_centre = ground + direction * GOAL_POST_DIAMETER / 2
+        summit, front = exact_to_image(projection, np.column_stack([post_centre, np.full(len(left), p.rise * GOAL_HEIGHT)]))
+        fits &= front & (summit[:, 1] < foot)
+        upper = np.maximum(0, np.trunc(np.where(fits, summit[:, 1], 0.0))).astype(int)  # int(): towards zero
+        fits &= ~(foot - upper < p.min_height * post_width)
+        shapes: list[tuple[GoalPost, Rows, Rows] | None] = [None] * len(left)
+        for k in np.nonzero(fits)[0]:
+            k_foot, k_upper, k_width = int(foot[k]), int(upper[k]), int(post_width[k])
+            ys = np.unique(np.linspace(k_upper, k_foot, min(k_foot - k_upper + 1, 48)).round().astype(int))  # 48 rows: enough to judge
+            rising = post_axis(ys, float(centre[k]), summit[k], k_foot, k_width)
+            # down to the foot (above the line it stands on): a thing behind the field's edge stands on the hall's floor
+            # (or its reflection on a glossy floor continues it), with something else between it and the carpet
+            line = max(2, k_width // 3)
+            down = post_axis(np.arange(max(k_upper, k_foot - 3 * line), k_foot - line + 1), float(centre[k]), summit[k], k_foot, k_width)
+            x, y = post_centre[k]
+            shapes[k] = GoalPost(float(x), float(y), camera, float(centre[k]), float(k_width), float(k_foot)), rising, down
+        return shapes
 
     def upright(self, posts: list[Rows], white: np.ndarray) -> np.ndarray:
         """For each post's rows (``ys``, the post's centre column ``xs`` in each, its width): the share of the
