@@ -35,6 +35,14 @@ class Foot(enum.Enum):
     right = 1
 
 
+class WalkKick(enum.Enum):
+    """A kick out of the walk (``MotionRequest.walk_kick``): ``short`` passes or dribbles, ``long`` shoots."""
+
+    none = 0
+    short = 1
+    long = 2
+
+
 @representation
 class MotionRequest:
     """The motion cognition wants (behaviour writes it every frame).
@@ -43,7 +51,10 @@ class MotionRequest:
     - ``walk`` at ``walk_x``, ``walk_y`` (mm/s) and ``walk_rotation`` (rad/s), clipped to the walk's limits;
     - ``walk_to`` the pose ``target_x``, ``target_y`` (mm) and ``target_rotation`` (rad) relative to the
       robot, decelerating on arrival;
-    - ``kick`` with ``kick_foot`` towards ``kick_direction`` (rad, robot frame; 0 is straight ahead).
+    - ``kick`` with ``kick_foot`` towards ``kick_direction`` (rad, robot frame; 0 is straight ahead): the
+      keyframe kick, from standing;
+    - ``walk``/``walk_to`` with ``walk_kick`` (short or long): the next step of ``kick_foot`` kicks towards
+      ``kick_direction`` without stopping (the walk's kick, up to its ``max_direction`` either side).
     """
 
     motion: MotionType = MotionType.stand
@@ -55,12 +66,14 @@ class MotionRequest:
     target_rotation: float = bounded(-math.pi, math.pi)
     kick_foot: Foot = Foot.left
     kick_direction: float = bounded(-math.pi, math.pi)
+    walk_kick: WalkKick = WalkKick.none
 
     def status_text(self) -> str:
         if self.motion is MotionType.walk:
             return f"request walk {self.walk_x:.0f},{self.walk_y:.0f} mm/s {self.walk_rotation:.2f} rad/s"
         if self.motion is MotionType.walk_to:
-            return f"request walk_to {self.target_x:.0f},{self.target_y:.0f} mm {self.target_rotation:.2f} rad"
+            kick = f", {self.walk_kick.name} kick {self.kick_foot.name}" if self.walk_kick is not WalkKick.none else ""
+            return f"request walk_to {self.target_x:.0f},{self.target_y:.0f} mm {self.target_rotation:.2f} rad{kick}"
         if self.motion is MotionType.kick:
             return f"request kick {self.kick_foot.name}"
         return f"request {self.motion.name}"
@@ -167,6 +180,10 @@ class WalkingEngineOutput:
     step_phase: float = bounded(0.0, 1.0)
     #: the walk_to target is reached (within its tolerances)
     target_reached: bool = False
+    #: the current step is a kick (``MotionRequest.walk_kick``)
+    kicking: bool = False
+    #: walk kicks made since the start
+    kicks: int = 0
 
 
 @representation

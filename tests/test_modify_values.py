@@ -60,7 +60,7 @@ def test_a_pinned_step_duration_slows_the_walk_and_stays_within_its_range() -> N
 
 def test_a_pinned_kick_distance_changes_where_the_striker_walks_and_when_it_kicks() -> None:
     ball = BallModel(valid=True, x=2000.0, y=0.0)
-    harness = ModuleHarness(Striker, ball, Odometry())
+    harness = ModuleHarness(Striker, ball, Odometry(), parameters={"walk_kick": False})  # the keyframe kick's distance
     debug = client(harness, "cognition")
     assert harness.execute()[MotionRequest].target_x == 2000.0 - 190.0
     ask(debug, "modify:set -name Kick:behind -value 300")

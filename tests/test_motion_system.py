@@ -434,8 +434,8 @@ def test_the_fall_state_is_upright_only_within_the_stagger_angle_and_always_well
 
 
 # ------------------------------------------------------------------------------------------- striker
-def striker(ball: BallModel, rotation: float = 0.0) -> MotionRequest:
-    harness = ModuleHarness(Striker, ball, Odometry(rotation=rotation))
+def striker(ball: BallModel, rotation: float = 0.0, walk_kick: bool = False) -> MotionRequest:
+    harness = ModuleHarness(Striker, ball, Odometry(rotation=rotation), parameters={"walk_kick": walk_kick})
     return harness.execute()[MotionRequest]
 
 

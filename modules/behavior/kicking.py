@@ -1,5 +1,11 @@
 """How a field player gets the ball to where it wants it: walk behind it on the kick's line, then kick.
 
+With ``walk_kick`` (``Striker``'s default) the kick comes out of the walk: the robot walks to where the ball lies
+``walk_kick_distance`` ahead of the kicking foot along the kick direction, turned only as far as the
+walk kick cannot turn the ball itself (``walk_kick_max_angle`` either side), and asks for the kick while
+it walks; the kicking foot is the one on the side the ball goes (the foot swings outwards, never across
+the other), or for a straight kick the one on the ball's side. Without it: the keyframe kick, standing.
+
 Shared by the behaviours that kick (``Striker``, ``SoccerBehavior``); not a module.
 """
 
@@ -13,7 +19,7 @@ from tafel.debug import ModifyParameters
 from tafel.representations import field
 from tafel.representations.geometry import Pose2D
 from tafel.representations.modeling import BallModel, RobotPose
-from tafel.representations.motion_control import Foot, MotionRequest, MotionType, Odometry
+from tafel.representations.motion_control import Foot, MotionRequest, MotionType, Odometry, WalkKick
 
 
 @dataclass
@@ -28,10 +34,26 @@ class KickParameters:
     """mm the ball may lie beside the kicking foot for a kick"""
     kick_tolerance_angle: float = bounded(0.02, 1.0, 0.2)
     """rad the robot may face away from the kick direction for a kick"""
+    walk_kick: bool = False
+    """kick out of the walk (``MotionRequest.walk_kick``; the ``Striker``'s default); false: the keyframe kick from standing"""
+    walk_kick_distance: float = bounded(120.0, 300.0, 165.0)
+    """mm from the kicking foot's place beside the robot to the ball's centre, along the kick direction"""
+    walk_kick_turned_farther: float = bounded(0.0, 150.0, 40.0)
+    """mm farther the ball lies for a kick turned 90 degrees (times the sine): clear of the walking foot's corner"""
+    walk_kick_ask_within: float = bounded(20.0, 600.0, 250.0)
+    """mm from the kicking pose within which the walk kick is asked for: the walk kicks once it is there"""
+    walk_kick_max_angle: float = bounded(0.0, 0.8, 0.6)
+    """rad either side the walk kick sends the ball without the robot turning to it"""
+    walk_kick_long_max_angle: float = bounded(0.0, 0.8, 0.1)
+    """rad either side the long walk kick sends the ball without the robot turning (it is a straight kick)"""
+    walk_kick_keep_foot: float = bounded(0.0, 100.0, 40.0)
+    """mm either side of the middle within which a straight walk kick keeps the foot it chose"""
+    walk_kick_straight: float = bounded(0.0, 0.5, 0.15)
+    """rad within which a kick is straight: the foot on the ball's side kicks"""
 
 
 #: the kick's parameters tried live: modify values Kick:NAME, declared by the modules that kick
-KICK_TUNED = tuple(item.name for item in fields(KickParameters))
+KICK_TUNED = tuple(item.name for item in fields(KickParameters) if item.type in ("float", float))
 
 
 def kick_tuning() -> ModifyParameters:
@@ -48,13 +70,18 @@ def goal_direction(ball: BallModel, pose: RobotPose, odometry: Odometry) -> floa
     return math.atan2(goal_y - ball.y, goal_x - ball.x)
 
 
-def approach_and_kick(ball: BallModel, kick_direction: float, p: KickParameters, out: MotionRequest) -> tuple[float, float, float]:
+def approach_and_kick(ball: BallModel, kick_direction: float, p: KickParameters, out: MotionRequest,
+                      strength: WalkKick = WalkKick.long) -> tuple[float, float, float]:
     """Fill ``out``: kick towards ``kick_direction`` (rad, robot frame) when the ball lies right in front
     of the kicking foot, else walk to the point ``behind`` mm behind the ball on the kick's line, the
     kicking foot in line with the ball. Returns that point and direction (mm, mm, rad; robot frame).
+    With ``p.walk_kick``: the walk kick of ``strength`` (``walk_kick_approach``).
 
     The caller passes ``p`` with its modify values ``Kick:NAME`` applied (``kick_tuning``), so a value pinned
     by a debug client is tried live."""
+    out.walk_kick = WalkKick.none
+    if p.walk_kick:
+        return walk_kick_approach(ball, kick_direction, p, out, strength)
     foot = Foot.left if ball.y >= 0 else Foot.right
     side = p.foot_offset if foot is Foot.left else -p.foot_offset
     # behind the ball on the kick's line, shifted so that the kicking foot (not the centre) meets it
@@ -68,3 +95,32 @@ def approach_and_kick(ball: BallModel, kick_direction: float, p: KickParameters,
         out.motion = MotionType.walk_to
         out.target_x, out.target_y, out.target_rotation = target_x, target_y, kick_direction
     return target_x, target_y, kick_direction
+
+
+def walk_kick_approach(ball: BallModel, kick_direction: float, p: KickParameters, out: MotionRequest,
+                       strength: WalkKick) -> tuple[float, float, float]:
+    """Walk to where the ball lies ``walk_kick_distance`` ahead of the kicking foot along the kick line,
+    facing ``kick_direction`` turned back by what the walk kick turns itself; ask for the walk kick once
+    near it (``walk_kick_ask_within``): the walk kicks when it gets there. Returns the pose walked to (mm,
+    mm, rad; robot frame)."""
+    limit = min(p.walk_kick_max_angle, p.walk_kick_long_max_angle) if strength is WalkKick.long else p.walk_kick_max_angle
+    angle = min(limit, max(-limit, kick_direction))  # what the kick turns
+    heading = kick_direction - angle  # what the robot turns
+    if abs(angle) > p.walk_kick_straight:
+        foot = Foot.left if angle > 0 else Foot.right
+    elif abs(ball.y) > p.walk_kick_keep_foot:
+        foot = Foot.left if ball.y >= 0 else Foot.right
+    else:
+        foot = out.kick_foot  # near the middle: the foot of the last frame, as the torso sways the ball across
+    side = p.foot_offset if foot is Foot.left else -p.foot_offset
+    # the ball in the frame the robot has at the kick: ahead of the kicking foot along the kick's line
+    distance = p.walk_kick_distance + p.walk_kick_turned_farther * abs(math.sin(angle))  # clear of the walking foot
+    spot_x, spot_y = distance * math.cos(angle), side + distance * math.sin(angle)
+    target_x, target_y = Pose2D(ball.x, ball.y, heading).to_global(-spot_x, -spot_y)
+    along, across = Pose2D(0.0, side, angle).to_local(ball.x, ball.y)
+    out.motion = MotionType.walk_to
+    out.target_x, out.target_y, out.target_rotation = target_x, target_y, heading
+    out.kick_foot = foot  # kept for the next frame's choice near the middle
+    if math.hypot(along - distance, across) < p.walk_kick_ask_within and abs(heading) < p.kick_tolerance_angle:
+        out.walk_kick, out.kick_direction = strength, angle
+    return target_x, target_y, heading

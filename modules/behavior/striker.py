@@ -9,7 +9,7 @@ from tafel.debug import Canvas, DebugRequest
 from tafel.modules.behavior.kicking import KickParameters, approach_and_kick, goal_direction, kick_tuning
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
-from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType, Odometry
+from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType, Odometry, WalkKick
 
 
 @requires(BallModel, Odometry, MotionInfo, FrameInfo)
@@ -25,6 +25,10 @@ class Striker(Module):
     - Ball: walk to the point ``behind`` mm behind it on the line of the kick, the kicking foot in line
       with the ball, facing the kick direction.
     - There, with the ball in front of the foot: kick, and wait for the kick to end.
+
+    With ``walk_kick`` (the default here) the kick is the walk's long kick: the robot walks to the ball
+    ``walk_kick_distance`` ahead of the kicking foot and kicks without stopping (``kicking.walk_kick_approach``);
+    ``walk_kick = false`` keeps the keyframe kick.
     """
 
     ball_model: BallModel
@@ -41,6 +45,8 @@ class Striker(Module):
     class Parameters(KickParameters):
         search_turn: float = bounded(0.0, 2.0, 0.6)
         """rad/s while the ball is lost"""
+        walk_kick: bool = True
+        """kick out of the walk; false: the keyframe kick from standing"""
 
     parameters: Parameters
 
@@ -50,7 +56,7 @@ class Striker(Module):
             return
         if not ball.valid:
             out.motion, out.walk_x, out.walk_y = MotionType.walk, 0.0, 0.0
-            out.walk_rotation = p.search_turn
+            out.walk_rotation, out.walk_kick = p.search_turn, WalkKick.none
             return
         target_x, target_y, direction = approach_and_kick(ball, goal_direction(ball, self.robot_pose, self.odometry),
                                                         self.kick_tuning.apply(p), out)

@@ -5,7 +5,7 @@ curve, lifted in the middle, while the support foot slides back linearly; the le
 analytic inverse kinematics. The torso sways over the support foot, the gyroscope damps the ankles, and
 the support foot changes when the foot pressure says the swing foot has landed (or a step has taken
 too long). Odometry is the support foot's motion and the gyroscope's yaw rate, so it needs no ground
-truth.
+truth. A request with a ``walk_kick`` makes the next step of the kicking foot a kick (``walk_kicks``).
 """
 
 from __future__ import annotations
@@ -19,10 +19,19 @@ from tafel.core import Module, bounded, provides, requires
 from tafel.debug import Canvas, DebugRequest, ModifyParameters, Plot
 from tafel.modules.motion.inverse_kinematics import apply_leg_angles, leg_angles, pose
 from tafel.modules.motion.stand_motion import stand_pose
+from tafel.modules.motion.walk_kicks import KickStep, kick_swing, load_walk_kicks
 from tafel.representations.geometry import Pose2D
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.motion import JOINT_COUNT, JOINT_INDEX, FsrData, InertialSensorData
-from tafel.representations.motion_control import Foot, MotionRequest, MotionSelection, MotionType, Odometry, WalkingEngineOutput
+from tafel.representations.motion_control import (
+    Foot,
+    MotionRequest,
+    MotionSelection,
+    MotionType,
+    Odometry,
+    WalkingEngineOutput,
+    WalkKick,
+)
 from tafel.representations.nao import HIP_OFFSET_Z
 
 WALKING = (MotionType.walk, MotionType.walk_to)
@@ -110,6 +119,18 @@ class WalkingEngine(Module):
         """per mm of capture-point error beyond the deadband, how much faster the step goes (it lands sooner)"""
         max_hurry: float = bounded(1.0, 3.0, 1.6)
         """the fastest a step may go, as a multiple of its duration's speed"""
+        kick_rearm: float = bounded(0.2, 5.0, 1.0)
+        """s after a walk kick before the same request kicks again (a new request kicks at once)"""
+        kick_window_near: float = bounded(0.0, 200.0, 60.0)
+        """mm beyond a walk_to target (the ball nearer) up to which a walk kick is made, its line shifted back"""
+        kick_window_far: float = bounded(0.0, 200.0, 20.0)
+        """mm short of a walk_to target (the ball farther) from which a walk kick is made: the leg reaches little farther"""
+        kick_tolerance: float = bounded(5.0, 100.0, 15.0)
+        """mm within which walk_to has arrived while a walk kick is asked for"""
+        kick_max_sideways: float = bounded(0.0, 300.0, 50.0)
+        """mm/s of sideways walking towards the kicking foot's side beyond which no walk kick starts"""
+        kick_window_y: float = bounded(0.0, 100.0, 40.0)
+        """mm beside a walk_to target within which a walk kick is made"""
 
     parameters: Parameters
 
@@ -130,6 +151,12 @@ class WalkingEngine(Module):
         self.adjust = np.zeros(2)  # mm forward, left the swing foot steps beyond the plan, to catch the body
         self.reference = np.zeros(2)  # the torso's roll and pitch (rad) while walking undisturbed, a slow mean
         self.rates = np.zeros(2)  # roll and pitch rate (rad/s), lightly filtered
+        self.kicks: dict[WalkKick, KickStep] = load_walk_kicks()
+        self.kick: KickStep | None = None  # the current step's kick
+        self.kick_direction = 0.0  # rad, robot frame, of the current step's kick
+        self.kicked_ns: int | None = None  # when the last walk kick began, until the request drops it
+        self.steps = 0  # steps since the walk last stood still
+        self.kick_offset = (0.0, 0.0)  # mm the kick's line is shifted: the walk_to target not quite reached
 
     def execute(self) -> None:
         self.tuned = self.tuning.apply(self.parameters)
@@ -141,39 +168,47 @@ class WalkingEngine(Module):
         yaw_rate = float(self.inertial_sensor_data.gyroscope[2])
         self.odometry.rotation = math.remainder(self.odometry.rotation + yaw_rate * dt, math.tau)
         selected = self.motion_selection.active in WALKING
-        velocity, reached = self.requested_velocity() if selected else (np.zeros(3), False)
+        pending = selected and self.kick_pending(now_ns)
+        velocity, reached = self.requested_velocity(pending) if selected else (np.zeros(3), False)
         out.target_reached = reached
-        if not self.walking and not np.any(velocity):  # not selected, or nowhere to go: stand in the walk's pose
+        if not self.walking and not np.any(velocity) and not pending:  # not selected, or nowhere to go: stand in the walk's pose
             self.rest()
             return
         self.walking = True
-        phase = min(1.0, self.phase_s / p.step_duration)  # where the last frame left the step
+        phase = min(1.0, self.phase_s / self.duration())  # where the last frame left the step
         swing = Foot.right if self.support is Foot.left else Foot.left
         pressure = self.fsr_data.pressure
         left, right = float(np.sum(pressure[:4])), float(np.sum(pressure[4:]))
         swing_load = left if swing is Foot.left else right
         landed = swing_load > p.landing_share * (left + right)  # the swing foot carries its share: it has landed
-        if self.phase_s == 0.0 or self.phase_s >= p.longest_step * p.step_duration - 1e-9 or (phase >= p.switch_after and landed):
-            at_rest = not np.any(velocity) and not np.any(self.velocity) and not np.any(self.step)
+        switch_after = max(p.switch_after, self.kick.put_down_from) if self.kick else p.switch_after
+        if self.phase_s == 0.0 or self.phase_s >= p.longest_step * self.duration() - 1e-9 or (phase >= switch_after and landed):
+            at_rest = not np.any(velocity) and not np.any(self.velocity) and not np.any(self.step) and not pending
             if at_rest and self.phase_s > 0.0 and all(np.allclose(v, 0.0, atol=1e-9) for v in self.now.values()):
                 self.rest()  # a standstill with the feet together: stop stepping
                 self.walking = False
                 return
-            self.begin_step(velocity)
+            self.begin_step(velocity, pending, now_ns)
             swing = Foot.right if self.support is Foot.left else Foot.left
         beyond = self.balance(dt, phase)
         self.phase_s += dt * min(p.max_hurry, 1.0 + p.hurry * float(np.hypot(*beyond)))  # pushed: land sooner
-        phase = min(1.0, self.phase_s / p.step_duration)  # this frame's: the last frame of a step reaches 1
+        phase = min(1.0, self.phase_s / self.duration())  # this frame's: the last frame of a step reaches 1
         support_before = self.now[self.support].copy()
-        smooth = 0.5 - 0.5 * math.cos(math.pi * phase)
-        self.now[swing] = self.start[swing] + (self.goal(swing) - self.start[swing]) * smooth
+        toe = 0.0
+        if self.kick is not None:
+            self.now[swing], lift, toe = kick_swing(self.kick, phase, self.start[swing], self.goal(swing), self.kick_direction, swing,
+                                                    self.kick_offset)
+            lean = self.kick.sway * min(1.0, 2.0 * math.sin(math.pi * phase))  # over the support foot all the kick long
+        else:
+            smooth = 0.5 - 0.5 * math.cos(math.pi * phase)
+            self.now[swing] = self.start[swing] + (self.goal(swing) - self.start[swing]) * smooth
+            lift, lean = p.foot_lift * math.sin(math.pi * phase), p.sway * math.sin(math.pi * phase)
         self.now[self.support] = self.start[self.support] + (self.goal(self.support) - self.start[self.support]) * phase
         self.accumulate_odometry(support_before, self.now[self.support])
-        lift = p.foot_lift * math.sin(math.pi * phase)
-        sway = p.sway * math.sin(math.pi * phase) * (1.0 if self.support is Foot.left else -1.0)
-        self.set_joints(swing, lift, sway, phase)
+        sway = lean * (1.0 if self.support is Foot.left else -1.0)
+        self.set_joints(swing, lift, sway, phase, toe)
         out.support_foot, out.step_phase = self.support, phase
-        out.standing = False
+        out.standing, out.kicking = False, self.kick is not None
 
     def capture_error(self, dt: float) -> np.ndarray:
         """Where the body is going (mm forward, left) beyond where the walk's own rocking takes it: the
@@ -210,7 +245,7 @@ class WalkingEngine(Module):
             self.capture_y.add(float(error[1]))
         return beyond
 
-    def requested_velocity(self) -> tuple[np.ndarray, bool]:
+    def requested_velocity(self, kicking: bool = False) -> tuple[np.ndarray, bool]:
         """(forward mm/s, left mm/s, turn rad/s) within the limits, and whether a walk_to target is reached."""
         p, request = self.parameters, self.motion_request
         if request.motion is not MotionType.walk_to:
@@ -218,7 +253,7 @@ class WalkingEngine(Module):
         if request.motion is MotionType.walk:
             velocity = np.array([request.walk_x, request.walk_y, request.walk_rotation])
         elif request.motion is MotionType.walk_to:
-            velocity, reached = self.towards_target()
+            velocity, reached = self.towards_target(kicking)
             if reached:
                 return np.zeros(3), True
         else:
@@ -227,8 +262,9 @@ class WalkingEngine(Module):
         share = float(np.sqrt(np.sum((velocity / np.maximum(limits, 1e-6)) ** 2)))  # within an ellipsoid
         return (velocity / share if share > 1.0 else velocity), False
 
-    def towards_target(self) -> tuple[np.ndarray, bool]:
-        """Speed towards the walk_to target, kept in odometry coordinates while the request stays the same."""
+    def towards_target(self, kicking: bool = False) -> tuple[np.ndarray, bool]:
+        """Speed towards the walk_to target, kept in odometry coordinates while the request stays the same;
+        with a walk kick to make, arrived only within ``kick_tolerance`` (the kick needs the ball in place)."""
         request, odometry, p = self.motion_request, self.odometry, self.parameters
         wanted = np.array([request.target_x, request.target_y, request.target_rotation])
         here = odometry.as_pose2d()
@@ -239,15 +275,46 @@ class WalkingEngine(Module):
         turn = math.remainder(self.target[2] - odometry.rotation, math.tau)
         if self.draw_steps:
             self.draw_steps.canvas(Canvas.ROBOT).robot_pose(float(self.target[0]), float(self.target[1]), float(self.target[2]), color="yellow")
-        if math.hypot(x, y) < p.target_tolerance and abs(turn) < p.target_tolerance / 400:
+        tolerance = min(p.target_tolerance, p.kick_tolerance) if kicking else p.target_tolerance
+        if math.hypot(x, y) < tolerance and abs(turn) < p.target_tolerance / 400:
             return np.zeros(3), True
         far = math.hypot(x, y) > 400.0  # far away: face the target first, then turn to its rotation
         heading = math.atan2(y, x) if far and x > -200 else turn
         return np.array([x, y, heading]) * p.target_gain, False
 
-    def begin_step(self, velocity: np.ndarray) -> None:
-        """The swing foot has landed: it supports now, and the next step is planned."""
+    def duration(self) -> float:
+        """s of the current step: a kick's own, else ``step_duration``."""
+        return self.kick.duration if self.kick is not None else self.tuned.step_duration
+
+    def kick_pending(self, now_ns: int) -> bool:
+        """A walk kick is asked for and not yet made (the same request kicks again after ``kick_rearm``)."""
+        request = self.motion_request
+        if request.walk_kick is WalkKick.none or request.motion not in WALKING:
+            self.kicked_ns = None
+            return False
+        return self.kicked_ns is None or (now_ns - self.kicked_ns) * 1e-9 >= self.parameters.kick_rearm
+
+    def kick_reach(self, foot: Foot) -> tuple[float, float] | None:
+        """Where the walk_to target (the kicking pose) still is (mm ahead, left), when a kick from here
+        reaches the ball; None when not. A ``walk`` request kicks from where the robot is: (0, 0)."""
+        p = self.parameters
+        side = 1.0 if foot is Foot.left else -1.0
+        if self.velocity[1] * side > p.kick_max_sideways or abs(self.velocity[2]) > 0.3:
+            return None  # still stepping out to the kicking foot's side, or turning: it would swing off its line
+        if self.motion_request.motion is not MotionType.walk_to or self.target is None:
+            return (0.0, 0.0)
+        x, y = self.odometry.as_pose2d().to_local(float(self.target[0]), float(self.target[1]))
+        turn = math.remainder(float(self.target[2]) - self.odometry.rotation, math.tau)
+        if -p.kick_window_near <= x <= p.kick_window_far and abs(y) <= p.kick_window_y and abs(turn) < 0.2:
+            return (0.0, 0.0)  # near enough: a shifted line measured worse (the swing is shorter, odometry drifts)
+        return None
+
+    def begin_step(self, velocity: np.ndarray, pending: bool = False, now_ns: int = 0) -> None:
+        """The swing foot has landed: it supports now, and the next step is planned (a kick when one is
+        pending and the kicking foot swings)."""
         p = self.tuned
+        self.steps = self.steps + 1 if self.phase_s > 0.0 else 0
+        rocking = self.steps >= 2 and self.kick is None  # two walk steps ended: the torso sways in rhythm
         if self.phase_s > 0.0 or self.started:
             self.support = Foot.right if self.support is Foot.left else Foot.left
         self.started = True
@@ -266,6 +333,16 @@ class WalkingEngine(Module):
         if wanted[2] * side < 0:
             wanted[2] = 0.0
         self.step = wanted
+        self.kick = None
+        request = self.motion_request
+        offset = self.kick_reach(swing)
+        if pending and rocking and swing is request.kick_foot and offset is not None:  # never out of a standstill
+            self.kick, self.kick_offset = self.kicks[request.walk_kick], offset
+            widest = self.kick.max_direction
+            self.kick_direction = min(widest, max(-widest, float(request.kick_direction)))
+            self.kicked_ns = now_ns
+            self.walking_engine_output.kicks += 1
+            self.step = np.array([min(max(float(wanted[0]), 0.0), self.kick.landing), 0.0, 0.0])  # a straight step
         if self.draw_steps:
             goal = self.goal(swing)
             self.draw_steps.canvas(Canvas.ROBOT).rectangle(float(goal[0]) - 50, float(goal[1]) - 25 + side * 50,
@@ -280,14 +357,14 @@ class WalkingEngine(Module):
             goal[:2] += self.adjust
         return goal
 
-    def set_joints(self, swing: Foot, lift: float, sway: float, phase: float) -> None:
+    def set_joints(self, swing: Foot, lift: float, sway: float, phase: float, toe: float = 0.0) -> None:
         p, out = self.tuned, self.walking_engine_output
         height = p.hip_height + HIP_OFFSET_Z
         soles = {}
         for foot, side in ((Foot.left, 1.0), (Foot.right, -1.0)):
             x, y, yaw = self.now[foot]
             z = -height + (lift if foot is swing else 0.0)
-            soles[foot] = pose(x - p.torso_offset_x, side * 50.0 + y - sway, z, yaw=yaw)
+            soles[foot] = pose(x - p.torso_offset_x, side * 50.0 + y - sway, z, pitch=toe if foot is swing else 0.0, yaw=yaw)
         angles = leg_angles(soles[Foot.left], soles[Foot.right])
         # gyroscope feedback on the support ankle: lean against the torso's rotation
         self.gyro = 0.7 * self.gyro + 0.3 * np.asarray(self.inertial_sensor_data.gyroscope[:2], dtype=float)
@@ -319,5 +396,6 @@ class WalkingEngine(Module):
         self.phase_s = 0.0
         self.started = False
         self.adjust = np.zeros(2)
+        self.kick = None
         self.set_joints(Foot.right, 0.0, 0.0, 0.0)
-        out.standing, out.step_phase = True, 0.0
+        out.standing, out.step_phase, out.kicking = True, 0.0, False
