@@ -93,7 +93,11 @@ def strip_sums(integral: np.ndarray, image: np.ndarray, ys: np.ndarray, first_ro
     y = ys - first_row
     sums = integral[y + 1, high] - integral[y, high] - integral[y + 1, low] + integral[y, low]
     shape = (-1,) + (1,) * (image.ndim - 2)
-    return np.asarray(sums + out_left.reshape(shape) * image[ys, 0] + out_right.reshape(shape) * image[ys, width - 1])
+    if out_left.any():
+        sums = sums + out_left.reshape(shape) * image[ys, 0]
+    if out_right.any():
+        sums = sums + out_right.reshape(shape) * image[ys, width - 1]
+    return np.asarray(sums)
 
 
 def strip_means(integral: np.ndarray, image: np.ndarray, ys: np.ndarray, first_row: int, first: np.ndarray, last: np.ndarray) -> np.ndarray:
@@ -318,6 +322,11 @@ class GoalPostDetector(Module):
             contrast = np.linalg.norm(inside - window_means(colour_prefix, outside_first, outside_stop), axis=1)
             chosen &= contrast >= p.contrast_min - slack
             near |= contrast < p.contrast_min + slack
+        unsure[np.nonzero(keep)[0][near]] = True
+        index = np.nonzero(keep)[0][chosen]  # the pairs whose band may pass: on to their feet
+        left, right, post_width, first, stop = (values[chosen] for values in (left, right, post_width, first, stop))
+        if not len(left):
+            return possible, feet, unsure
         # the foot: the first of ``run`` rows of carpet between the edges, down from the boundary
         # (a row is carpet where at least half the columns between the edges are green)
         start = np.maximum(0, top[(left + right) // 2] - 1)
@@ -330,17 +339,13 @@ class GoalPostDetector(Module):
         carpets = np.concatenate([np.zeros((len(left), 1), np.int32), np.cumsum(carpet, axis=1, dtype=np.int32)], axis=1)
         ends = row - below + run[:, None]  # each run's end (not in it), among those rows
         lasting = (np.take_along_axis(carpets, np.minimum(ends, height - below), axis=1) - carpets[:, :-1] == run[:, None]) & (ends <= height - below)
-        chosen &= lasting.any(axis=1)
-        foot = np.maximum(start, below + np.argmax(lasting, axis=1) - 1)
+        feet[index] = foot = np.maximum(start, below + np.argmax(lasting, axis=1) - 1)
         # the width a post has at that foot's distance
         ground, hit = projection.to_ground((left + right) / 2, foot + 0.5)
         distance = np.linalg.norm(np.column_stack([ground, np.zeros(len(left))]) - projection.translation, axis=1)
         expected = projection.fx * GOAL_POST_DIAMETER / np.where(hit, distance, 1.0)
         misfit = (post_width - expected > p.width_tolerance * expected + 1.5 + slack) | (post_width < p.width_low * expected - 1.0 - slack)
-        chosen &= ~(hit & misfit)
-        possible[np.nonzero(keep)[0][chosen]] = True
-        feet[np.nonzero(keep)[0]] = foot
-        unsure[np.nonzero(keep)[0][near]] = True
+        possible[index[lasting.any(axis=1) & ~(hit & misfit)]] = True
         return possible, feet, unsure
 
     def band_checks(self, left: int, right: int) -> bool:
