@@ -699,10 +699,10 @@ def test_strips_and_medians_of_many_posts_at_once_are_numpys(seed: int, rows: in
     xs = rng.integers(-10, columns + 10, len(ys))
     first = xs + rng.integers(-15, 3, len(ys))
     last = first + rng.integers(0, 12, len(ys))
-    first_row = int(ys.min())
+    first_row = int(ys.min())  # the strips of the rows from there on
     colour = cv2.integral(image[first_row:], sdepth=cv2.CV_32S)
-    means = strip_means(colour, image, ys, first_row, first, last)
-    whites = strip_sums(cv2.integral(mask[first_row:].view(np.uint8), sdepth=cv2.CV_32S), mask, ys, first_row, first, last)
+    means = strip_means(colour, image[first_row:], ys - first_row, first, last)
+    whites = strip_sums(cv2.integral(mask[first_row:].view(np.uint8), sdepth=cv2.CV_32S), mask[first_row:], ys - first_row, first, last)
     for k in range(len(ys)):
         strip = np.clip(np.arange(first[k], last[k] + 1), 0, columns - 1)
         assert np.array_equal(means[k], image.astype(np.float32)[ys[k], strip].mean(axis=0))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import cv2
@@ -81,17 +82,16 @@ Rows = tuple[np.ndarray, np.ndarray, int]
 """rows of the image (``ys``), a post's centre column in each (``xs``) and the post's width (px)"""
 
 
-def strip_sums(integral: np.ndarray, image: np.ndarray, ys: np.ndarray, first_row: int, first: np.ndarray, last: np.ndarray) -> np.ndarray:
+def strip_sums(integral: np.ndarray, image: np.ndarray, ys: np.ndarray, first: np.ndarray, last: np.ndarray) -> np.ndarray:
     """For each row ``ys`` the sum of ``image``'s pixels in the columns ``first`` to ``last`` (both kept), a
     column left of the image counting as its first one and right of it as its last (as clipped indices
-    do); ``integral`` is ``cv2.integral`` of ``image``'s rows from ``first_row`` on. Exact integers."""
+    do); ``integral`` is ``cv2.integral`` of ``image``. Exact integers."""
     width = image.shape[1]
     count = last - first + 1
     out_left, out_right = np.clip(-first, 0, count), np.clip(last - width + 1, 0, count)
     low = np.clip(first, 0, width)
     high = low + count - out_left - out_right
-    y = ys - first_row
-    sums = integral[y + 1, high] - integral[y, high] - integral[y + 1, low] + integral[y, low]
+    sums = integral[ys + 1, high] - integral[ys, high] - integral[ys + 1, low] + integral[ys, low]
     shape = (-1,) + (1,) * (image.ndim - 2)
     if out_left.any():
         sums = sums + out_left.reshape(shape) * image[ys, 0]
@@ -100,11 +100,11 @@ def strip_sums(integral: np.ndarray, image: np.ndarray, ys: np.ndarray, first_ro
     return np.asarray(sums)
 
 
-def strip_means(integral: np.ndarray, image: np.ndarray, ys: np.ndarray, first_row: int, first: np.ndarray, last: np.ndarray) -> np.ndarray:
+def strip_means(integral: np.ndarray, image: np.ndarray, ys: np.ndarray, first: np.ndarray, last: np.ndarray) -> np.ndarray:
     """The means of ``strip_sums`` (float32): what numpy's mean of those pixels as float32 gives, as their
     sum is an exact integer in float32 and numpy divides it by the count in float64."""
     count = (last - first + 1)[:, None]
-    return np.asarray((strip_sums(integral, image, ys, first_row, first, last) / count).astype(np.float32))
+    return np.asarray((strip_sums(integral, image, ys, first, last) / count).astype(np.float32))
 
 
 def segment_medians(values: np.ndarray, lengths: np.ndarray) -> np.ndarray:
@@ -241,7 +241,12 @@ class GoalPostDetector(Module):
         height, width = green.shape
         if image.shape[:2] != green.shape:
             return []
-        white = white_pixels(hsv, p.saturation_max, p.white_share * self.segmented_image.white(camera)) & ~green
+        white_min = p.white_share * self.segmented_image.white(camera)
+
+        def white(rows: slice) -> np.ndarray:
+            """The white pixels (unsaturated, bright, not green) of those rows: only where they are looked at."""
+            return np.asarray(white_pixels(hsv[rows], p.saturation_max, white_min) & ~green[rows])
+
         band = max(3, int(round(p.band * height)))
         top = np.round(boundary).astype(int)
         room = top > band
@@ -260,7 +265,7 @@ class GoalPostDetector(Module):
         distance = np.linalg.norm(np.column_stack([ground, np.zeros(len(edges))]) - projection.translation, axis=1)
         least = np.where(hit, p.width_low * projection.fx * GOAL_POST_DIAMETER / np.maximum(distance, 1.0) - 1.0, 0.0)
         self.band_colour = band_means(colour, low, high)
-        self.band_white = band_means(cv2.integral(white[first_row:last_row].view(np.uint8), sdepth=cv2.CV_32S), low, high)
+        self.band_white = band_means(cv2.integral(white(slice(first_row, last_row)).view(np.uint8), sdepth=cv2.CV_32S), low, high)
         # each edge with one of the next edges (stickers, dents and shadows on a post make more)
         lefts, rights = (np.concatenate(ends).astype(int) for ends in
                          zip(*((np.arange(len(edges) - k), np.arange(k, len(edges))) for k in range(1, 5))))
@@ -404,7 +409,7 @@ class GoalPostDetector(Module):
             shapes[k] = GoalPost(float(x), float(y), camera, float(centre[k]), float(k_width), float(k_foot)), rising, down
         return shapes
 
-    def upright(self, posts: list[Rows], white: np.ndarray) -> np.ndarray:
+    def upright(self, posts: list[Rows], white: Callable[[slice], np.ndarray]) -> np.ndarray:
         """For each post's rows (``ys``, the post's centre column ``xs`` in each, its width): the share of the
         rows in which its middle is white, of the post's colour (the median along those rows) and unlike at
         least one side. All posts' rows at once: the strips' means from the image's integral (their sums are
@@ -418,12 +423,14 @@ class GoalPostDetector(Module):
         half, side, edge = np.maximum(1, post_width // 4), np.maximum(2, post_width // 2), (post_width + 1) // 2
         first_row = int(ys.min())
         block = slice(first_row, int(ys.max()) + 1)
-        colour = cv2.integral(self.colour[block], sdepth=cv2.CV_32S)
-        inside = strip_means(colour, self.colour, ys, first_row, xs - half, xs + half)
-        left, right = (strip_means(colour, self.colour, ys, first_row, xs + a, xs + b) for a, b in ((-edge - side, -edge - 1), (edge + 1, edge + side)))
+        pixels = self.colour[block]
+        colour = cv2.integral(pixels, sdepth=cv2.CV_32S)
+        inside = strip_means(colour, pixels, ys - first_row, xs - half, xs + half)
+        left, right = (strip_means(colour, pixels, ys - first_row, xs + a, xs + b) for a, b in ((-edge - side, -edge - 1), (edge + 1, edge + side)))
         unlike = np.maximum(np.linalg.norm(inside - left, axis=1), np.linalg.norm(inside - right, axis=1)) >= p.contrast_min
         same = np.linalg.norm(inside - np.repeat(segment_medians(inside, lengths), lengths, axis=0), axis=1) <= p.uniform_max
-        whites = strip_sums(cv2.integral(white[block].view(np.uint8), sdepth=cv2.CV_32S), white, ys, first_row, xs - half, xs + half)
+        bright = white(block)
+        whites = strip_sums(cv2.integral(bright.view(np.uint8), sdepth=cv2.CV_32S), bright, ys - first_row, xs - half, xs + half)
         rows = (2 * whites >= 2 * half + 1) & unlike & same  # white: at least half the middle's pixels
         return np.asarray(np.add.reduceat(rows.astype(np.int64), np.cumsum(lengths) - lengths) / lengths)
 
