@@ -52,13 +52,13 @@ discs = st.lists(st.tuples(st.floats(-3000, 3000), st.floats(-3000, 3000), st.fl
 @given(discs, st.floats(-4000, 4000), st.floats(-4000, 4000))
 def test_the_first_waypoint_never_leads_through_the_first_disc_in_the_way(obstacles: list, x: float, y: float) -> None:
     way = waypoint(x, y, obstacles, margin=100.0)
-    first = blocking(x, y, obstacles)
+    first = blocking(x, y, obstacles, margin=100.0)
     if first is None:
         assert way == (x, y)
     else:
         _, disc = first
-        hit = blocking(*way, [disc])
-        assert hit is None  # past the disc that was in the way
+        hit = blocking(*way, [disc], margin=100.0)
+        assert hit is None  # past the disc that was in the way, with the margin
 
 
 @given(discs, st.floats(-4000, 4000), st.floats(-4000, 4000))

@@ -2,6 +2,11 @@
 team out of) on the way to a target. Shared by the behaviours; not a module.
 
 Everything in the robot frame (mm): the robot at the origin. A disc is (x, y, radius).
+
+The way round a disc follows the tangent from the robot to the disc grown by a margin, on the side the
+straight line passes it (a disc dead ahead: the side asked for, else the right, so that two robots
+walking at each other both step aside the same way round). A robot already within the grown disc and
+heading further in steps out sideways instead of walking on.
 """
 
 from __future__ import annotations
@@ -11,6 +16,10 @@ from collections.abc import Sequence
 
 Disc = tuple[float, float, float]
 MAX_DETOURS = 4  # waypoints tried round one disc after another before the robot goes straight on
+MIN_STEP = 300.0  # mm: a detour's waypoint is at least this far, so that the walk does not slow down at it
+TANGENT_SLACK = 0.05  # rad beyond the exact tangent: the way to the waypoint clears the grown disc
+DEAD_AHEAD = 0.3  # share of the grown radius: a disc whose centre lies this near the way is "ahead" (the side asked for)
+RIGHT, LEFT = -1, 1
 
 
 def outside(x: float, y: float, discs: Sequence[Disc], margin: float = 0.0) -> tuple[float, float]:
@@ -27,35 +36,110 @@ def outside(x: float, y: float, discs: Sequence[Disc], margin: float = 0.0) -> t
     return x, y
 
 
-def blocking(x: float, y: float, discs: Sequence[Disc]) -> tuple[float, Disc] | None:
-    """The first disc the straight walk from the origin to (x, y) runs into, and how far along (0..1);
-    discs that hold the origin or the target are left out (the robot is in one, or has to go in)."""
+def blocking(x: float, y: float, discs: Sequence[Disc], margin: float = 0.0) -> tuple[float, Disc] | None:
+    """The first disc (grown by ``margin``) the straight walk from the origin to (x, y) runs into, and how
+    far along (0..1). A disc that holds the target is left out (the robot has to go in); one that holds
+    the robot blocks at 0 when the way leads further in, and is left out when it leads out."""
     length_sq = x * x + y * y
     first: tuple[float, Disc] | None = None
+    if length_sq < 1e-9:
+        return None
     for disc in discs:
         cx, cy, radius = disc
-        if math.hypot(cx, cy) < radius or math.hypot(x - cx, y - cy) < radius or length_sq < 1e-9:
+        reach = radius + margin
+        if math.hypot(x - cx, y - cy) < reach:
             continue
-        t = max(0.0, min(1.0, (cx * x + cy * y) / length_sq))
-        if math.hypot(t * x - cx, t * y - cy) < radius and (first is None or t < first[0]):
+        if math.hypot(cx, cy) < reach:
+            t = 0.0 if cx * x + cy * y > 0.0 else None
+        else:
+            t = max(0.0, min(1.0, (cx * x + cy * y) / length_sq))
+            t = t if math.hypot(t * x - cx, t * y - cy) < reach else None
+        if t is not None and (first is None or t < first[0]):
             first = (t, disc)
     return first
 
 
-def waypoint(x: float, y: float, discs: Sequence[Disc], margin: float = 100.0) -> tuple[float, float]:
-    """Where to walk first on the way to (x, y): the target itself when the straight way is free, else a
-    point beside the first disc in the way, on the side the straight line passes it (``margin`` mm
-    clear of it), checked in turn against the other discs."""
-    target = (x, y)
+def side_of(x: float, y: float, disc: Disc, reach: float, prefer: int = 0) -> int:
+    """The side (``LEFT`` or ``RIGHT``) to pass ``disc`` on the way to (x, y): away from its centre; when
+    the centre lies nearly on the way (``DEAD_AHEAD``), ``prefer`` (or the right, if none)."""
+    cx, cy, _ = disc
+    length = max(math.hypot(x, y), 1e-9)
+    cross = (x * cy - y * cx) / length  # mm the centre lies left of the way
+    if abs(cross) < DEAD_AHEAD * reach:
+        return prefer if prefer in (LEFT, RIGHT) else RIGHT
+    return RIGHT if cross > 0 else LEFT
+
+
+def around(disc: Disc, reach: float, side: int) -> tuple[float, float]:
+    """A waypoint past ``disc`` (grown to ``reach``) on ``side``: on the tangent from the robot, or, from
+    within it, sideways and outwards (the deeper in, the more outwards)."""
+    cx, cy, _ = disc
+    distance, bearing = math.hypot(cx, cy), math.atan2(cy, cx)
+    if distance > reach:
+        direction = bearing + side * (math.asin(reach / distance) + TANGENT_SLACK)
+        length = max(math.sqrt(distance * distance - reach * reach), MIN_STEP)
+    else:
+        depth = (reach - distance) / reach
+        direction = bearing + side * (math.pi / 2 + TANGENT_SLACK + depth * math.pi / 4)
+        length = MIN_STEP
+    return length * math.cos(direction), length * math.sin(direction)
+
+
+def free_direction(x: float, y: float, discs: Sequence[Disc], margin: float, prefer: int = 0) -> tuple[float, float, int]:
+    """A waypoint ``MIN_STEP`` mm away in the direction nearest that of (x, y) whose way runs into no disc
+    (grown by ``margin``; one that holds the robot: not further in), the side asked for first at equal
+    angles; the origin (stand) when every direction is closed. Also the side it turned to (0: none)."""
+    bearing, first = math.atan2(y, x), prefer if prefer in (LEFT, RIGHT) else RIGHT
+    for step in range(61):  # 3-degree steps round to the back
+        for side in ((first, -first) if step else (0,)):
+            direction = bearing + side * math.radians(3.0 * step)
+            way = (MIN_STEP * math.cos(direction), MIN_STEP * math.sin(direction))
+            if clear(*way, discs, margin):
+                return way[0], way[1], side
+    return 0.0, 0.0, 0
+
+
+def clear(x: float, y: float, discs: Sequence[Disc], margin: float) -> bool:
+    """Whether the straight way from the origin to (x, y) keeps out of every disc (grown by ``margin``),
+    the end included; a disc that holds the robot: the way does not lead further in."""
+    for cx, cy, radius in discs:
+        reach = radius + margin
+        if math.hypot(cx, cy) < reach:
+            if cx * x + cy * y > 0.0:
+                return False
+            continue
+        t = max(0.0, min(1.0, (cx * x + cy * y) / max(x * x + y * y, 1e-9)))
+        if math.hypot(t * x - cx, t * y - cy) < reach:
+            return False
+    return True
+
+
+def detour(x: float, y: float, discs: Sequence[Disc], margin: float = 100.0, prefer: int = 0) -> tuple[float, float, int]:
+    """Where to walk first on the way to (x, y), and the side of the first disc passed (0: none): the
+    target itself when the straight way is free of every disc grown by ``margin``, else a waypoint round
+    the first disc in the way (``around``), checked in turn against the others. Within a disc and heading
+    further in, or still blocked after ``MAX_DETOURS``: the free direction nearest the target's
+    (``free_direction``)."""
+    target, first_side = (x, y), 0
     for _ in range(MAX_DETOURS):
-        hit = blocking(*target, discs)
+        hit = blocking(*target, discs, margin)
         if hit is None:
-            return target
-        t, (cx, cy, radius) = hit
-        px, py = t * target[0] - cx, t * target[1] - cy  # from the centre to the line's nearest point
-        side = math.hypot(px, py)
-        if side < 1e-6:  # straight through the centre: pass on the left of the way
-            length = math.hypot(*target)
-            px, py, side = -target[1] / length, target[0] / length, 1.0
-        target = (cx + px / side * (radius + margin), cy + py / side * (radius + margin))
-    return target
+            return target[0], target[1], first_side
+        _, disc = hit
+        reach = disc[2] + margin
+        side = side_of(*target, disc, reach, prefer if first_side == 0 else first_side)
+        if math.hypot(disc[0], disc[1]) < reach:  # within it: out of every disc that holds the robot at once
+            break
+        first_side = first_side or side
+        target = around(disc, reach, side)
+    else:
+        if blocking(*target, discs, margin) is None:
+            return target[0], target[1], first_side
+    way_x, way_y, turned = free_direction(x, y, discs, margin, first_side or prefer or side)
+    return way_x, way_y, first_side or turned
+
+
+def waypoint(x: float, y: float, discs: Sequence[Disc], margin: float = 100.0) -> tuple[float, float]:
+    """Where to walk first on the way to (x, y) (``detour`` without a side asked for)."""
+    way_x, way_y, _ = detour(x, y, discs, margin)
+    return way_x, way_y

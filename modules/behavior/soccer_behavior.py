@@ -13,14 +13,14 @@ from tafel.debug import Canvas, DebugRequest
 from tafel.modules.behavior.kicking import KickParameters, goal_direction, kick_tuning
 from tafel.modules.behavior.options import OptionRunner
 from tafel.modules.behavior.options.soccer import FREE_KICKS, OWN_GOAL_X, PlaySoccer
-from tafel.modules.behavior.paths import Disc
+from tafel.modules.behavior.paths import Disc, detour, outside
 from tafel.representations import field as pitch
 from tafel.representations.behavior import ActivationGraph, OptionGraph
 from tafel.representations.game import GameState, SetPlay
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType, Odometry
-from tafel.representations.obstacles import ROBOT_RADIUS, Obstacles
+from tafel.representations.obstacles import ROBOT_RADIUS, ObstacleKind, Obstacles
 from tafel.representations.team import PlayerRole, TeamMates
 
 OPPONENT_PENALTY_MARK_X = pitch.LENGTH / 2 - pitch.PENALTY_MARK_DISTANCE
@@ -54,7 +54,11 @@ class SoccerBehavior(Module):
     - FINISHED: sit.
 
     It walks around the robots in ``Obstacles`` (and around the areas the rules keep it out of) by
-    ``paths.waypoint``: pushing is a foul.
+    ``paths.detour``, keeping ``obstacle_margin`` between footprints and stopping short of a robot that
+    stands where it wants to go: pushing is a foul. When an opponent is nearer the ball (``contested``),
+    the striker holds back ``hold_distance`` from the ball, between it and the own goal, as B-Human's
+    do; after ``hold_max_s`` it goes for the ball anyway for ``challenge_s`` (a robot that stands by
+    the ball must not stall the game).
 
     Each decision is an option's state (``options/soccer.py``); ``ActivationGraph`` says every frame
     which options are active, in which state and for how long, ``OptionGraph`` what they all are.
@@ -109,6 +113,23 @@ class SoccerBehavior(Module):
         """mm: within this of the ball the striker goes straight for it (a duel for the ball is no push)"""
         shootout_aim: float = bounded(0.0, 700.0, 450.0)
         """mm beside the goal's centre the shoot-out kick aims (the side away from the keeper)"""
+        face_the_way: float = bounded(0.0, 5000.0, 700.0)
+        """mm: the striker walks to a spot behind the ball farther than this facing the way, not the kick"""
+        contest_distance: float = bounded(0.0, 3000.0, 1000.0)
+        """mm: an opponent this near the ball and nearer to it than this robot contests it"""
+        contest_margin: float = bounded(0.0, 1000.0, 50.0)
+        """mm an opponent must be nearer the ball to make the striker hold back (it goes again once the
+        opponent is no nearer: two robots at about the same distance do not both wait)"""
+        hold_distance: float = bounded(300.0, 2000.0, 700.0)
+        """mm from the ball the striker waits while an opponent plays it"""
+        hold_max_s: float = bounded(0.0, 60.0, 8.0)
+        """s the striker holds back at most; then it challenges for the ball"""
+        challenge_s: float = bounded(0.0, 60.0, 5.0)
+        """s the striker goes for the ball after holding back, contested or not"""
+        field_margin: float = bounded(0.0, 300.0, 150.0)
+        """mm beyond the field's lines a walk may lead at most (the torso 0.3 m beyond one has left the field)"""
+        detour_memory_s: float = bounded(0.0, 10.0, 1.5)
+        """s a side chosen round an obstacle is kept for one dead ahead (no zigzag)"""
 
     parameters: Parameters
 
@@ -118,6 +139,8 @@ class SoccerBehavior(Module):
         """field discs (mm) the rules keep the team out of this frame: the set plays' options add them"""
         self.indirect = False
         """this frame's kick is an own free kick's: indirect, never straight at the goal"""
+        self.detour_side, self.detour_s = 0, -math.inf
+        """the side last chosen round an obstacle, and when (s)"""
 
     def execute(self) -> None:
         out = self.motion_request
@@ -128,9 +151,22 @@ class SoccerBehavior(Module):
         self.keep_out, self.indirect = [], False
         out.motion = MotionType.stand
         self.options.run(self, self.frame_info.time_s, self.activation_graph)
+        self.stay_on_field()
         if busy is not None:  # a kick or get-up plays to its end: the options went on, the request stays
             for name, value in busy.items():
                 setattr(out, name, value)
+
+    def stay_on_field(self) -> None:
+        """A walk's target beyond the lines by more than ``field_margin`` comes back to it: leaving the field
+        is a foul (the referee calls it 0.3 m beyond a line)."""
+        out, pose, margin = self.motion_request, self.robot_pose, self.parameters.field_margin
+        if out.motion is not MotionType.walk_to or not pose.valid:
+            return
+        x, y = pose.to_field(out.target_x, out.target_y)
+        limit_x, limit_y = pitch.LENGTH / 2 + margin, pitch.WIDTH / 2 + margin
+        inside = max(-limit_x, min(limit_x, x)), max(-limit_y, min(limit_y, y))
+        if inside != (x, y):
+            out.target_x, out.target_y = pose.to_robot(*inside)
 
     # ------------------------------------------------------------------------ what the options do
     def stand(self) -> None:
@@ -204,6 +240,49 @@ class SoccerBehavior(Module):
         best = min(heard, key=lambda m: m.age + m.message.ball_age).message
         return best.ball_x, best.ball_y
 
-    def robot_discs(self) -> list[Disc]:
-        """The robots known to be near (robot frame), as discs this robot's centre keeps out of."""
-        return [(o.x, o.y, o.radius + ROBOT_RADIUS) for o in self.obstacles.obstacles]
+    def robot_discs(self, margin: float = 0.0) -> list[Disc]:
+        """The robots known to be near (robot frame), as discs this robot's centre keeps out of (grown by
+        ``margin`` mm)."""
+        return [(o.x, o.y, o.radius + ROBOT_RADIUS + margin) for o in self.obstacles.obstacles]
+
+    def avoid(self, x: float, y: float, zones: list[Disc] | None = None) -> tuple[float, float, bool]:
+        """Where to walk first on the way to (x, y) (robot frame mm) without walking into a robot (kept
+        ``obstacle_margin`` away) or into ``zones`` (robot frame discs the rules close), and whether that is
+        a detour. A target on a robot moves out to the edge of its disc: the robot stops short of it."""
+        robots, closed = self.robot_discs(self.parameters.obstacle_margin), []
+        for cx, cy, radius in zones or []:
+            if math.hypot(cx, cy) >= radius:
+                closed.append((cx, cy, radius))
+            elif cx * x + cy * y > 0.0:  # within a closed area and the way leads further in: straight out first
+                out_x, out_y = outside(0.0, 0.0, [(cx, cy, radius)], 1.0)
+                return out_x, out_y, True
+        x, y = outside(x, y, robots, 1.0)
+        now = self.frame_info.time_s
+        prefer = self.detour_side if now - self.detour_s <= self.parameters.detour_memory_s else 0
+        way_x, way_y, side = detour(x, y, [*closed, *robots], 0.0, prefer)
+        if side:
+            self.detour_side, self.detour_s = side, now
+        return way_x, way_y, (way_x, way_y) != (x, y)
+
+    def contested(self, holding: bool) -> bool:
+        """Whether an opponent contests the ball: a robot not of the team within ``contest_distance`` of
+        the ball and nearer to it than this robot (by ``contest_margin``, unless ``holding`` back already)."""
+        ball, p = self.ball_model, self.parameters
+        if not ball.valid:
+            return False
+        rivals = [math.hypot(o.x - ball.x, o.y - ball.y) for o in self.obstacles.obstacles if o.kind is ObstacleKind.robot]
+        nearest = min(rivals, default=math.inf)
+        return nearest < p.contest_distance and nearest < math.hypot(ball.x, ball.y) - (0.0 if holding else p.contest_margin)
+
+    def hold_point(self) -> tuple[float, float, float]:
+        """Where the striker waits while an opponent plays the ball: ``hold_distance`` from the ball towards
+        the own goal's centre (towards this robot without a pose), facing the ball; robot frame mm, mm, rad."""
+        ball, pose = self.ball_model, self.robot_pose
+        gx, gy = pose.to_robot(OWN_GOAL_X, 0.0) if pose.valid else (0.0, 0.0)
+        dx, dy = gx - ball.x, gy - ball.y
+        distance = math.hypot(dx, dy)
+        if distance < 1.0:
+            dx, dy, distance = -ball.x, -ball.y, max(math.hypot(ball.x, ball.y), 1.0)
+        reach = min(self.parameters.hold_distance, distance)
+        x, y = ball.x + dx / distance * reach, ball.y + dy / distance * reach
+        return x, y, math.atan2(ball.y - y, ball.x - x)

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 from tafel.modules.behavior.kicking import approach_and_kick, goal_direction
 from tafel.modules.behavior.options.framework import Next, Option, common, state
-from tafel.modules.behavior.paths import outside, waypoint
+from tafel.modules.behavior.paths import outside
 from tafel.representations import field as pitch
 from tafel.representations.game import GamePhase, SetPlay, State
 from tafel.representations.motion_control import MotionType
@@ -65,8 +65,8 @@ class GoTo(Option["SoccerBehavior"]):
         target_x, target_y = pose.to_robot(x, y)
         turn = math.remainder(rotation - pose.rotation, math.tau)
         zones = [(*pose.to_robot(cx, cy), radius) for cx, cy, radius in b.keep_out]
-        way_x, way_y = waypoint(target_x, target_y, [*zones, *b.robot_discs()], b.parameters.obstacle_margin)
-        if (way_x, way_y) != (target_x, target_y):  # a detour: face the way while walking round
+        way_x, way_y, detoured = b.avoid(target_x, target_y, zones)
+        if detoured:  # face the way while walking round
             turn = math.atan2(way_y, way_x)
         b.walk_to(way_x, way_y, turn)
 
@@ -90,17 +90,22 @@ class GoTo(Option["SoccerBehavior"]):
 
 class Striker(Option["SoccerBehavior"]):
     """Get the ball to the opponent goal: kick it there (an own free kick: ahead and towards the middle),
-    go by a teammate's ball without an own sighting, search by turning without any."""
+    go by a teammate's ball without an own sighting, search by turning without any. While an opponent
+    nearer the ball plays it, hold back (pushing is a foul); after ``hold_max_s`` challenge for it."""
 
     calls = (GoTo,)
 
-    @common(to=("wait_outside", "kick", "to_teammates_ball", "search"))
+    @common(to=("wait_outside", "kick", "hold_back", "challenge", "to_teammates_ball", "search"))
     def what_is_known(self, b: SoccerBehavior) -> Next:
-        ball = b.ball_on_field()
+        ball, p = b.ball_on_field(), b.parameters
         if b.keep_out and ball is not None:
             return "wait_outside"
         if b.ball_model.valid:
-            return "kick"
+            if self.state == "challenge" and self.time_in_state < p.challenge_s:
+                return "challenge"
+            if self.state == "hold_back" and self.time_in_state >= p.hold_max_s:
+                return "challenge"
+            return "hold_back" if b.contested(holding=self.state == "hold_back") else "kick"
         if ball is not None and b.robot_pose.valid:
             return "to_teammates_ball"
         return "search"
@@ -112,12 +117,33 @@ class Striker(Option["SoccerBehavior"]):
 
     @state
     def kick(self, b: SoccerBehavior) -> None:
-        """Walk behind the ball on the kick's line and kick (``kicking.approach_and_kick``)."""
+        """Walk behind the ball on the kick's line and kick (``kicking.approach_and_kick``); far from the
+        spot, facing the way (so that the robot sees what it walks into), round the robots in it."""
         ball, p, out = b.ball_model, b.parameters, b.motion_request
         direction = b.indirect_direction() if b.indirect else goal_direction(ball, b.robot_pose, b.odometry)
         approach_and_kick(ball, direction, b.kick_tuning.apply(p), out)
         if out.motion is MotionType.walk_to and math.hypot(ball.x, ball.y) > p.near_ball:  # near it a duel is no push
-            out.target_x, out.target_y = waypoint(out.target_x, out.target_y, b.robot_discs(), p.obstacle_margin)
+            x, y, detoured = b.avoid(out.target_x, out.target_y)
+            if detoured or math.hypot(x, y) > p.face_the_way:
+                out.target_rotation = math.atan2(y, x)
+            out.target_x, out.target_y = x, y
+
+    @state
+    def hold_back(self, b: SoccerBehavior) -> None:
+        """An opponent nearer the ball plays it: wait ``hold_distance`` from the ball, between it and the own
+        goal, facing it (round the robots on the way)."""
+        x, y, rotation = b.hold_point()
+        if b.robot_pose.valid:
+            fx, fy = b.robot_pose.to_field(x, y)
+            self.call(GoTo, x=fx, y=fy, rotation=math.remainder(b.robot_pose.rotation + rotation, math.tau))
+        else:
+            way_x, way_y, _ = b.avoid(x, y)
+            b.walk_to(way_x, way_y, rotation)
+
+    @state
+    def challenge(self, b: SoccerBehavior) -> None:
+        """Held back for ``hold_max_s``: go for the ball as ``kick`` does, for ``challenge_s``."""
+        self.kick(b)
 
     @state
     def to_teammates_ball(self, b: SoccerBehavior) -> None:

@@ -1,0 +1,140 @@
+"""Playing without fouls (issue 32), through the mocked blackboard: the way round robots (``paths``), the
+striker that holds back while an opponent nearer the ball plays it, and stopping short of a robot on
+the target. The referee's side of the same rules is in ``test_referee.py``; whole games in ``test_match.py``."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from tafel.core.testing import ModuleHarness
+from tafel.modules.behavior.paths import LEFT, RIGHT, detour, waypoint
+from tafel.modules.behavior.soccer_behavior import SoccerBehavior
+from tafel.representations.behavior import ActivationGraph
+from tafel.representations.game import GameState, RobotInfo, State, TeamInfo
+from tafel.representations.modeling import BallModel, RobotPose
+from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType
+from tafel.representations.obstacles import ROBOT_RADIUS, Obstacle, ObstacleKind, Obstacles
+from tafel.representations.team import PlayerRole, Role, TeamMates
+
+CONTACT = 330.0  # mm between two torsos: the simulated referee's contact (tools/simulation/fouls.py)
+
+
+def playing() -> GameState:
+    team = TeamInfo(team_number=1, players=[RobotInfo() for _ in range(20)])
+    return GameState(state=State.playing, teams=[team, TeamInfo(team_number=2)], team_number=1, player_number=2, kicking_team=1)
+
+
+def striker(pose: RobotPose, ball_field: tuple[float, float], obstacles: list[Obstacle]) -> ModuleHarness:
+    """The striker in PLAYING (after the kick-off's wait), the ball at ``ball_field`` (field mm), the given
+    obstacles (robot frame)."""
+    ball = BallModel(valid=True, seen=True, x=pose.to_robot(*ball_field)[0], y=pose.to_robot(*ball_field)[1])
+    return ModuleHarness(SoccerBehavior, playing(), PlayerRole(role=Role.striker), pose, ball, TeamMates(), MotionInfo(),
+                         Obstacles(obstacles=obstacles))
+
+
+def states(harness: ModuleHarness) -> list[tuple[str, str]]:
+    return [(o.name, o.state) for o in harness[ActivationGraph].options]
+
+
+def segment_distance(x: float, y: float, cx: float, cy: float) -> float:
+    """mm from (cx, cy) to the straight way from the origin to (x, y)."""
+    t = max(0.0, min(1.0, (cx * x + cy * y) / max(x * x + y * y, 1e-9)))
+    return math.hypot(t * x - cx, t * y - cy)
+
+
+# ------------------------------------------------------------------------------------ paths
+@given(st.floats(0.0, 2 * math.pi), st.floats(0.0, 440.0), st.floats(-3000.0, 3000.0), st.floats(-3000.0, 3000.0))
+def test_a_robot_too_near_another_never_walks_further_in(bearing: float, distance: float, x: float, y: float) -> None:
+    """Within the grown disc of another robot (say after it walked up), the way never leads nearer its
+    centre: sideways and out (before: the disc was left out and the robot walked on into it)."""
+    cx, cy = distance * math.cos(bearing), distance * math.sin(bearing)
+    disc = (cx, cy, 2 * ROBOT_RADIUS + 150.0)
+    if math.hypot(x - cx, y - cy) < disc[2]:
+        return  # the target is in the disc: the caller moves it out first
+    way_x, way_y = waypoint(x, y, [disc], margin=0.0)
+    assert cx * way_x + cy * way_y <= 1e-6 * max(1.0, math.hypot(cx, cy))  # not towards its centre
+
+
+def test_two_robots_walking_at_each_other_both_step_to_their_right_and_keep_a_side_asked_for() -> None:
+    ahead = [(800.0, 0.0, 450.0)]
+    x, y, side = detour(2000.0, 0.0, ahead, 0.0)
+    assert side == RIGHT and y < 0.0 and segment_distance(x, y, 800.0, 0.0) >= 450.0
+    assert detour(2000.0, 10.0, ahead, 0.0, prefer=LEFT)[2] == LEFT  # dead ahead: the side kept from before
+    assert detour(2000.0, -600.0, ahead, 0.0, prefer=LEFT)[2] == RIGHT  # clearly on one side: that side
+
+
+def test_a_robot_between_two_others_finds_the_free_way_out_or_stands() -> None:
+    x, y, _ = detour(1500.0, 0.0, [(200.0, 250.0, 450.0), (200.0, -250.0, 450.0)], 0.0)
+    assert x <= 1e-6  # both ahead: back out, never between them
+    assert detour(1500.0, 0.0, [(300.0 * math.cos(a), 300.0 * math.sin(a), 450.0) for a in (0.0, 2.1, 4.2)], 0.0)[:2] == (0.0, 0.0)
+
+
+# ------------------------------------------------------------------------------ the striker
+def test_the_striker_walks_round_an_opponent_between_it_and_the_ball_keeping_clear_of_contact() -> None:
+    pose = RobotPose(valid=True, x=-2000.0, y=0.0)
+    opponent = Obstacle(x=700.0, y=60.0, radius=ROBOT_RADIUS, kind=ObstacleKind.robot)
+    harness = striker(pose, (0.0, 0.0), [opponent])
+    out = harness.execute()[MotionRequest]
+    assert out.motion is MotionType.walk_to and states(harness)[-1] == ("Striker", "kick")
+    assert segment_distance(out.target_x, out.target_y, opponent.x, opponent.y) > CONTACT + 100.0
+    assert out.target_rotation == pytest.approx(math.atan2(out.target_y, out.target_x))  # facing the way round
+
+
+def test_the_striker_holds_back_while_an_opponent_nearer_the_ball_plays_it_then_challenges() -> None:
+    pose = RobotPose(valid=True, x=-1500.0, y=300.0)
+    ball_field = (-500.0, 0.0)
+    bx, by = pose.to_robot(*ball_field)
+    opponent = Obstacle(x=bx + 300.0, y=by, kind=ObstacleKind.robot)  # behind the ball, 300 mm from it: nearer than this robot
+    harness = striker(pose, ball_field, [opponent])
+    out = harness.execute()[MotionRequest]
+    assert states(harness)[-2:] == [("Striker", "hold_back"), ("GoTo", "walk")]
+    p = SoccerBehavior.Parameters()
+    goal_side = pose.to_field(out.target_x, out.target_y)
+    # the waiting place: hold_distance from the ball, between it and the own goal (on the line to it)
+    assert math.hypot(goal_side[0] - ball_field[0], goal_side[1] - ball_field[1]) == pytest.approx(p.hold_distance, abs=1.0)
+    assert goal_side[0] < ball_field[0]
+    harness.advance(p.hold_max_s - 1.0)
+    assert states(harness)[1:] != [] and ("Striker", "hold_back") in states(harness)
+    harness.advance(2.0)  # held back too long: go for the ball, contested or not
+    assert ("Striker", "challenge") in states(harness)
+    harness.advance(p.challenge_s + 0.5)
+    assert ("Striker", "hold_back") in states(harness)  # and wait again while it is still contested
+
+
+@pytest.mark.parametrize("opponent_distance, holds", [(300.0, True), (980.0, False), (1200.0, False)])
+def test_only_an_opponent_nearer_the_ball_makes_the_striker_hold_back_and_never_a_teammate(opponent_distance: float, holds: bool) -> None:
+    pose = RobotPose(valid=True, x=-1000.0, y=0.0)  # 1000 mm from the ball: 980 is within contest_margin
+    bx, by = pose.to_robot(0.0, 0.0)
+    for kind in (ObstacleKind.robot, ObstacleKind.teammate):
+        harness = striker(pose, (0.0, 0.0), [Obstacle(x=bx + opponent_distance, y=by, kind=kind)])
+        harness.execute()
+        assert (("Striker", "hold_back") in states(harness)) is (holds and kind is ObstacleKind.robot), (opponent_distance, kind)
+
+
+def test_a_robot_on_the_place_to_go_stops_the_walk_short_of_it() -> None:
+    pose = RobotPose(valid=True, x=-3000.0, y=0.0)  # READY: the striker's place is (-1000, 0), where another robot stands
+    other = Obstacle(x=2000.0, y=0.0, kind=ObstacleKind.robot)
+    harness = ModuleHarness(SoccerBehavior, GameState(state=State.ready, teams=[TeamInfo(team_number=1, players=[RobotInfo()] * 20),
+                                                                                TeamInfo(team_number=2)],
+                                                      team_number=1, player_number=2, kicking_team=2),
+                            PlayerRole(role=Role.striker), pose, BallModel(), TeamMates(), MotionInfo(), Obstacles(obstacles=[other]))
+    for _ in range(5):
+        out = harness.execute()[MotionRequest]
+        assert out.motion is MotionType.walk_to
+        assert math.hypot(out.target_x - other.x, out.target_y - other.y) > CONTACT + 100.0
+        assert segment_distance(out.target_x, out.target_y, other.x, other.y) > CONTACT + 100.0
+
+
+def test_a_walk_never_leads_more_than_field_margin_beyond_a_line() -> None:
+    """The ball on the touchline, the kick's spot behind it beyond the line: the walk stops at the margin
+    (the referee calls leaving the field 0.3 m beyond a line)."""
+    pose = RobotPose(valid=True, x=2000.0, y=2600.0, rotation=2.5)
+    harness = striker(pose, (1000.0, 3120.0), [])
+    out = harness.execute()[MotionRequest]
+    assert out.motion is MotionType.walk_to
+    x, y = pose.to_field(out.target_x, out.target_y)
+    assert abs(y) <= 3000.0 + SoccerBehavior.Parameters().field_margin + 1e-6 and abs(x) <= 4500.0
