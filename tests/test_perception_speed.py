@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 
 from tafel.core.framework.manager import make_module
 from tafel.modules.perception.field_boundary_detector import cell_shares
-from tafel.modules.perception.field_color_provider import below, byte_median, white_pixels
+from tafel.modules.perception.field_color_provider import below, byte_median, byte_percentile, white_pixels
 from tafel.modules.perception.goal_post_detector import (
     GoalPostDetector,
     edge_peaks,
@@ -369,6 +369,25 @@ def test_byte_median_is_numpys(values: list[int]) -> None:
     array = np.array(values, np.uint8)
     if values:
         assert byte_median(array) == np.median(array)
+
+
+@settings(max_examples=500)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 3000), st.integers(0, 255), st.integers(0, 255),
+       st.one_of(st.sampled_from([99, 0, 100, 50, 99.0]), st.floats(0.0, 100.0)))
+def test_byte_percentile_is_numpys(seed: int, count: int, low: int, high: int, q: float) -> None:
+    """The white's percentile from a histogram: numpy's percentile of the same bytes, to the last bit."""
+    values = np.random.default_rng(seed).integers(min(low, high), max(low, high) + 1, count).astype(np.uint8)
+    assert byte_percentile(values, q) == float(np.percentile(values, q))
+
+
+def test_byte_percentile_interpolates_as_numpy_does() -> None:
+    """Between two bytes numpy interpolates from the upper one past the middle (4 and 17 at 99 %: the
+    lower one's way rounds differently); so does the histogram's percentile."""
+    for low in range(0, 256, 3):
+        for high in range(low, 256, 7):
+            values = np.array([high, low], np.uint8)
+            for q in (99, 75.5, 50, 12.5):
+                assert byte_percentile(values, q) == float(np.percentile(values, q))
 
 
 def reference_fit_circle(self: LineDetector, points: np.ndarray) -> np.ndarray:

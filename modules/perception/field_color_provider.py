@@ -54,6 +54,22 @@ def byte_median(values: np.ndarray) -> float:
     return (int(low) + int(high)) / 2
 
 
+def byte_percentile(values: np.ndarray, q: float) -> float:
+    """``np.percentile(values, q)`` of uint8 values (the same number: its two neighbouring order statistics
+    from the values' histogram, then numpy's linear interpolation between them), without numpy's
+    partitioned copy of the values."""
+    if len(values) == 0 or not 0 <= q <= 100:
+        return float(np.percentile(values, q))  # nan with numpy's warning, or numpy's error
+    count = len(values)
+    virtual = (count - 1) * (q / 100)  # where the percentile lies among the sorted values
+    previous = count - 1 if virtual >= count - 1 else math.floor(virtual)
+    gamma = virtual - (-1 if virtual >= count - 1 else previous)  # numpy indexes the last value as -1
+    cumulative = np.cumsum(np.bincount(values, minlength=256))
+    low, high = (float(v) for v in np.searchsorted(cumulative, [previous, min(previous + 1, count - 1)], side="right"))
+    difference = high - low
+    return low + difference * gamma if gamma < 0.5 else high - difference * (1 - gamma)
+
+
 def green_mask(color: FieldColor, hsv: np.ndarray) -> np.ndarray:
     """Which pixels of an HSV image (h x w x 3 uint8) are field green by ``color`` (h x w bool); the hue
     range may wrap round red (OpenCV hue is 0..179)."""
@@ -122,7 +138,7 @@ class FieldColorProvider(Module):
             step = self.parameters.step
             sampled, off_field = hsv[::step, ::step], ~green[::step, ::step]
             values = sampled[off_field & (sampled[..., 1] <= WHITE_SATURATION_MAX)][:, 2]
-            setattr(segmented, f"{camera}_white", float(np.percentile(values, 99)) if values.size else 255.0)
+            setattr(segmented, f"{camera}_white", byte_percentile(values, 99) if values.size else 255.0)
 
     def estimate(self) -> None:
         """This frame's field colour from samples of both images, blended into the last estimate."""
