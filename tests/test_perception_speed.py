@@ -21,6 +21,7 @@ from tafel.modules.perception.field_boundary_detector import cell_shares
 from tafel.modules.perception.field_color_provider import below, byte_median, byte_percentile, white_pixels
 from tafel.modules.perception.goal_post_detector import (
     GoalPostDetector,
+    band_passes,
     edge_peaks,
     exact_norms,
     exact_to_ground,
@@ -730,3 +731,33 @@ def test_strips_and_medians_of_many_posts_at_once_are_numpys(seed: int, rows: in
     assert medians.dtype == np.float32
     for k, (start, length) in enumerate(zip(np.cumsum(lengths) - lengths, lengths, strict=True)):
         assert np.array_equal(medians[k], np.median(means[start : start + length], axis=0))
+
+
+@settings(max_examples=300)
+@given(st.integers(0, 2**32 - 1), st.integers(8, 120), st.sampled_from([1, 3, 5, 10]), st.floats(1.0, 40.0))
+def test_the_band_checks_of_all_pairs_at_once_let_through_what_may_pass(seed: int, width: int, levels: int, contrast_min: float) -> None:
+    """Every pair of edges whose band passes the slices' checks (the loops') passes the running sums'
+    ones; a pair they call sure (not near a threshold) passes exactly when the slices' checks pass, and
+    the detector decides the others by those checks. Shares and colours on a coarse grid, so that means
+    land on the thresholds exactly."""
+    rng = np.random.default_rng(seed)
+    self = make_module(GoalPostDetector, parameters=GoalPostDetector.Parameters(contrast_min=contrast_min))
+    self.band_white = rng.integers(0, levels + 1, width) / levels  # type: ignore[attr-defined]
+    self.band_colour = rng.integers(0, 4, (width, 3)) * float(rng.choice([contrast_min / 2, contrast_min / 3, 7.0]))  # type: ignore[attr-defined]
+    left = rng.integers(1, width - 3, 60)
+    right = np.minimum(left + rng.integers(2, 40, 60), width - 2)
+    keep = right - left >= 2
+    left, right = left[keep], right[keep]
+    passes, near = band_passes(self.band_white, self.band_colour, left, right, contrast_min, 1e-6)  # type: ignore[attr-defined]
+    for k in range(len(left)):
+        post_width = int(right[k] - left[k])
+        side, margin = max(2, post_width // 2), post_width // 4
+        inner = slice(int(left[k]) + 1 + margin // 2, max(int(left[k]) + 2 + margin // 2, int(right[k]) - margin // 2))
+        inside = self.band_colour[inner].mean(axis=0)  # type: ignore[attr-defined]
+        loops = self.band_white[inner].mean() >= 0.6 and all(  # type: ignore[attr-defined]
+            np.linalg.norm(inside - outside.mean(axis=0)) >= contrast_min
+            for outside in (self.band_colour[max(0, int(left[k]) - side) : int(left[k])], self.band_colour[int(right[k]) + 1 : int(right[k]) + 1 + side]))  # type: ignore[attr-defined]
+        assert self.band_checks(int(left[k]), int(right[k])) == loops  # type: ignore[attr-defined]
+        assert passes[k] or not loops
+        if not near[k]:
+            assert passes[k] == loops

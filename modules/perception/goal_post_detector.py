@@ -71,6 +71,29 @@ def window_means(prefix: np.ndarray, first: np.ndarray, stop: np.ndarray) -> np.
     return np.asarray((prefix[stop] - prefix[first]) / count)
 
 
+def band_passes(band_white: np.ndarray, band_colour: np.ndarray, left: np.ndarray, right: np.ndarray, contrast_min: float,
+                slack: float) -> tuple[np.ndarray, np.ndarray]:
+    """For pairs of edges at columns ``left`` and ``right`` (at least 2 apart, inside the image): which may
+    pass the band's checks (white between the edges, unlike both sides: ``GoalPostDetector.band_checks``)
+    and which lie within ``slack`` of a threshold there. From running sums, all pairs at once: their
+    means may differ from the slices' in the last bits, so only a pair off by more than ``slack`` is sure."""
+    width = len(band_white)
+    post_width = right - left
+    margin, side = post_width // 4, np.maximum(2, post_width // 2)
+    first = left + 1 + margin // 2
+    stop = np.maximum(left + 2 + margin // 2, right - margin // 2)
+    white_prefix = np.concatenate([[0.0], np.cumsum(band_white)])
+    colour_prefix = np.concatenate([np.zeros((1, 3)), np.cumsum(band_colour, axis=0)])
+    inside = window_means(colour_prefix, first, stop)
+    white = window_means(white_prefix, first, stop)
+    passes, near = white >= 0.6 - slack, white < 0.6 + slack
+    for outside_first, outside_stop in ((np.maximum(0, left - side), left), (right + 1, np.minimum(width, right + 1 + side))):
+        contrast = np.linalg.norm(inside - window_means(colour_prefix, outside_first, outside_stop), axis=1)
+        passes &= contrast >= contrast_min - slack
+        near |= contrast < contrast_min + slack
+    return passes, near
+
+
 def edge_peaks(profile: np.ndarray, minimum: float) -> np.ndarray:
     """Columns where ``profile`` is at least ``minimum`` and no lower than its neighbours (one per plateau)."""
     padded = np.concatenate([[-np.inf], profile, [-np.inf]])
@@ -307,7 +330,7 @@ class GoalPostDetector(Module):
         it misses a threshold by more than that; ``shapes`` decides the rest. The feet are exact (counts)."""
         p = self.parameters
         height, width = green.shape
-        slack = 1e-6  # far more than the rounding, far less than any real difference
+        slack = 1e-6  # far more than the rounding of the means and distances, far less than any real difference
         post_width = right - left
         keep = (post_width >= 2) & (left >= 1) & (right <= width - 2)
         left, right, post_width = left[keep], right[keep], post_width[keep]
@@ -317,16 +340,7 @@ class GoalPostDetector(Module):
         margin = post_width // 4
         first = left + 1 + margin // 2
         stop = np.maximum(left + 2 + margin // 2, right - margin // 2)
-        white_prefix = np.concatenate([[0.0], np.cumsum(self.band_white)])
-        colour_prefix = np.concatenate([np.zeros((1, 3)), np.cumsum(self.band_colour, axis=0)])
-        inside = window_means(colour_prefix, first, stop)
-        side = np.maximum(2, post_width // 2)
-        white = window_means(white_prefix, first, stop)
-        chosen, near = white >= 0.6 - slack, white < 0.6 + slack
-        for outside_first, outside_stop in ((np.maximum(0, left - side), left), (right + 1, np.minimum(width, right + 1 + side))):
-            contrast = np.linalg.norm(inside - window_means(colour_prefix, outside_first, outside_stop), axis=1)
-            chosen &= contrast >= p.contrast_min - slack
-            near |= contrast < p.contrast_min + slack
+        chosen, near = band_passes(self.band_white, self.band_colour, left, right, p.contrast_min, slack)
         unsure[np.nonzero(keep)[0][near]] = True
         index = np.nonzero(keep)[0][chosen]  # the pairs whose band may pass: on to their feet
         left, right, post_width, first, stop = (values[chosen] for values in (left, right, post_width, first, stop))
