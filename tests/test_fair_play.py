@@ -12,13 +12,14 @@ from hypothesis import strategies as st
 
 from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.paths import LEFT, RIGHT, detour, waypoint
+from tafel.modules.behavior.role_provider import RoleProvider
 from tafel.modules.behavior.soccer_behavior import SoccerBehavior
 from tafel.representations.behavior import ActivationGraph
-from tafel.representations.game import GameState, RobotInfo, State, TeamInfo
+from tafel.representations.game import GameState, Penalty, RobotInfo, State, TeamInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType
 from tafel.representations.obstacles import ROBOT_RADIUS, Obstacle, ObstacleKind, Obstacles
-from tafel.representations.team import PlayerRole, Role, TeamMates
+from tafel.representations.team import PlayerRole, Role, TeamMate, TeamMates, TeamMessage
 
 CONTACT = 330.0  # mm between two torsos: the simulated referee's contact (tools/simulation/fouls.py)
 
@@ -138,3 +139,51 @@ def test_a_walk_never_leads_more_than_field_margin_beyond_a_line() -> None:
     assert out.motion is MotionType.walk_to
     x, y = pose.to_field(out.target_x, out.target_y)
     assert abs(y) <= 3000.0 + SoccerBehavior.Parameters().field_margin + 1e-6 and abs(x) <= 4500.0
+
+
+# ------------------------------------------------------------------------------ the roles
+def team_game(state: State, player: int, players: int, penalized: tuple[int, ...] = ()) -> GameState:
+    """The GameController's view: ``players`` a team, those in ``penalized`` off the field."""
+    own = TeamInfo(team_number=1, goalkeeper=1, players=[RobotInfo() for _ in range(20)])
+    for number in penalized:
+        own.players[number - 1].penalty = Penalty.player_pushing
+    return GameState(state=state, players_per_team=players, teams=[own, TeamInfo(team_number=2)], team_number=1, player_number=player,
+                     kicking_team=2)
+
+
+def role(game: GameState, mates: list[TeamMessage] | None = None) -> Role:
+    said = TeamMates(mates=[TeamMate(m, age=0.5) for m in mates or []])
+    return ModuleHarness(RoleProvider, game, said, BallModel(valid=True, x=1500.0), PlayerRole()).execute()[PlayerRole].role
+
+
+def test_in_ready_nobody_talks_so_the_roles_go_by_the_numbers_and_the_keeper_stays_in_goal() -> None:
+    """Messages are spent in PLAYING only: in READY every robot heard nobody for a while. Before, each then
+    thought it was alone and all walked to the striker's place, the keeper too."""
+    assert [role(team_game(State.ready, n, 5)) for n in range(1, 6)] == [Role.goalkeeper, Role.striker, Role.supporter, Role.defender,
+                                                                        Role.defender]
+    assert [role(team_game(State.ready, n, 2)) for n in (1, 2)] == [Role.goalkeeper, Role.striker]
+    assert [role(team_game(State.ready, n, 3, penalized=(2,))) for n in (1, 3)] == [Role.goalkeeper, Role.striker]
+
+
+def test_the_keeper_plays_striker_only_when_the_game_controller_has_it_alone_on_the_field() -> None:
+    fallen = TeamMessage(team=1, player=2, pose_valid=True, fallen=True)
+    assert role(team_game(State.playing, 1, 2), [fallen]) is Role.goalkeeper  # a teammate down is still on the field
+    assert role(team_game(State.playing, 1, 2)) is Role.goalkeeper  # and one not heard for a while
+    assert role(team_game(State.playing, 1, 2, penalized=(2,))) is Role.striker  # alone: it plays the ball
+    assert role(team_game(State.ready, 1, 2, penalized=(2,))) is Role.striker
+
+
+def test_two_defenders_walk_to_places_on_either_side_in_ready_and_in_play() -> None:
+    places = []
+    for player in (4, 5):
+        for state in (State.ready, State.playing):
+            game = team_game(state, player, 5)
+            pose = RobotPose(valid=True, x=-3000.0, y=0.0)
+            harness = ModuleHarness(SoccerBehavior, game, PlayerRole(role=Role.defender), pose, BallModel(valid=True, seen=True, x=2000.0),
+                                    TeamMates(), MotionInfo(), Obstacles())
+            out = harness.execute()[MotionRequest]
+            assert out.motion is MotionType.walk_to
+            places.append((state, pose.to_field(out.target_x, out.target_y)))
+    (_, ready_4), (_, play_4), (_, ready_5), (_, play_5) = places
+    assert math.hypot(ready_4[0] - ready_5[0], ready_4[1] - ready_5[1]) > 1000.0
+    assert math.hypot(play_4[0] - play_5[0], play_4[1] - play_5[1]) > 500.0

@@ -6,7 +6,7 @@ import math
 from dataclasses import dataclass
 
 from tafel.core import Module, bounded, provides, requires, uses
-from tafel.representations.game import GameState, State
+from tafel.representations.game import GameState, Penalty, State
 from tafel.representations.modeling import BallModel
 from tafel.representations.motion_control import FallState
 from tafel.representations.team import Intention, PlayerRole, Role, TeamMates
@@ -20,7 +20,12 @@ class RoleProvider(Module):
     to the ball:
 
     - The goalkeeper is the team's goalkeeper by the GameController (player 1 by default). A robot
-      that is its team's only player on the field plays striker instead.
+      that is its team's only player on the field plays striker instead: alone by the GameController
+      (every other player penalized), or, without the GameController's team, alone by the messages (a
+      teammate that is fallen or quiet for a while does not take the goalkeeper out of its goal).
+    - In READY and SET nobody sends (messages are spent in PLAYING only), so the field players the
+      GameController has on the field take the roles by their numbers: the lowest strikes, the next
+      supports, the others defend.
     - The striker is the field player with the shortest time to the ball (each robot's own estimate,
       shared in its messages). The current striker counts ``stay_bonus`` s quicker, so that the role
       does not flicker between two robots at about the same distance. A robot that does not know where
@@ -58,15 +63,29 @@ class RoleProvider(Module):
         team = game.own_team()
         keeper = team.goalkeeper if team is not None and team.goalkeeper else 1
         mates = [m.message for m in self.team_mates.fresh(self.parameters.mate_timeout) if not (m.message.penalized or m.message.fallen)]
-        if game.player_number == keeper and mates:
+        on_field = self.on_field()
+        alone = not mates if on_field is None else on_field == [game.player_number]
+        if game.player_number == keeper and not alone:
             out.role, out.intention = Role.goalkeeper, Intention.keep_goal
             return
-        me = (game.player_number, out.time_to_ball, out.role is Role.striker)
-        field_players = [me, *((m.player, m.time_to_ball, m.role is Role.striker) for m in mates if m.player != keeper)]
-        order = sorted(field_players, key=lambda player: self.rank(*player))
-        place = [player for player, _, _ in order].index(game.player_number)
+        if on_field is not None and game.state in (State.ready, State.set):  # nobody talks: by the numbers
+            place = [n for n in on_field if n != keeper or alone].index(game.player_number)
+        else:
+            me = (game.player_number, out.time_to_ball, out.role is Role.striker)
+            field_players = [me, *((m.player, m.time_to_ball, m.role is Role.striker) for m in mates if m.player != keeper)]
+            order = sorted(field_players, key=lambda player: self.rank(*player))
+            place = [player for player, _, _ in order].index(game.player_number)
         out.role = Role.striker if place == 0 else Role.supporter if place == 1 else Role.defender
         out.intention = (Intention.play_ball if self.ball_model.valid else Intention.search_ball) if place == 0 else Intention.take_position
+
+    def on_field(self) -> list[int] | None:
+        """The numbers of the team's players on the field by the GameController (this robot among them, in
+        order), or None when it does not say (no team size, or this robot not in it)."""
+        game, team = self.game_state, self.game_state.own_team()
+        if team is None or game.players_per_team <= 0:
+            return None
+        numbers = [n for n, robot in enumerate(team.players[: game.players_per_team], start=1) if robot.penalty is Penalty.none]
+        return numbers if game.player_number in numbers else None
 
     def rank(self, player: int, time_to_ball: float, striker: bool) -> tuple[float, int, int]:
         """Sort key: time to the ball (unknown last), the striker's bonus, then the last striker, then the number."""

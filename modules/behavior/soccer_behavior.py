@@ -126,6 +126,8 @@ class SoccerBehavior(Module):
         """s the striker holds back at most; then it challenges for the ball"""
         challenge_s: float = bounded(0.0, 60.0, 5.0)
         """s the striker goes for the ball after holding back, contested or not"""
+        defender_spread: float = bounded(0.0, 2000.0, 400.0)
+        """mm a defender stands beside the line from the ball to the own goal (even numbers left, odd right)"""
         field_margin: float = bounded(0.0, 300.0, 150.0)
         """mm beyond the field's lines a walk may lead at most (the torso 0.3 m beyond one has left the field)"""
         detour_memory_s: float = bounded(0.0, 10.0, 1.5)
@@ -239,6 +241,11 @@ class SoccerBehavior(Module):
             return None
         best = min(heard, key=lambda m: m.age + m.message.ball_age).message
         return best.ball_x, best.ball_y
+
+    def defender_side(self) -> float:
+        """+1 for even player numbers, -1 for odd ones: the side a defender stands on (+1: as configured,
+        left of the line to the own goal in PLAYING)."""
+        return -1.0 if self.game_state.player_number % 2 else 1.0
 
     def robot_discs(self, margin: float = 0.0) -> list[Disc]:
         """The robots known to be near (robot frame), as discs this robot's centre keeps out of (grown by

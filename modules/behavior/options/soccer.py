@@ -208,9 +208,10 @@ class Defender(Option["SoccerBehavior"]):
 
     @state(initial=True)
     def defend(self, b: SoccerBehavior) -> None:
-        """A third of the way from the own goal to the ball."""
+        """A third of the way from the own goal to the ball, ``defender_spread`` to one side (even player
+        numbers left, odd right: two defenders do not walk to the same place)."""
         bx, by = b.ball_on_field() or (0.0, 0.0)
-        x, y = OWN_GOAL_X + 0.35 * (bx - OWN_GOAL_X), 0.35 * by
+        x, y = OWN_GOAL_X + 0.35 * (bx - OWN_GOAL_X), 0.35 * by + b.defender_side() * b.parameters.defender_spread
         self.call(GoTo, x=x, y=y, rotation=b.facing_ball(x, y))
 
 
@@ -284,7 +285,10 @@ class ReadyPosition(Option["SoccerBehavior"]):
         game, role, p = b.game_state, b.player_role.role, b.parameters
         kicking_off = role is Role.striker and game.kicking_team == game.team_number
         name = "striker_kicking_off" if kicking_off else role.name if role is not Role.none else "defender"
-        self.go(getattr(p, f"ready_{name}"))
+        x, y, rotation = getattr(p, f"ready_{name}")
+        if name == "defender":  # two defenders: one on each side (even numbers where configured)
+            y *= b.defender_side()
+        self.go([x, y, rotation])
 
     @state
     def penalty_kick(self, b: SoccerBehavior) -> None:
