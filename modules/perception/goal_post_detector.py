@@ -37,7 +37,17 @@ def band_sums(integral: np.ndarray, low: np.ndarray, high: np.ndarray, columns: 
     """For each of ``columns``, the sum of its pixels in the rows ``high`` up to (not with) ``low`` (of the
     image whose ``cv2.integral`` is ``integral``): exact integers, where a cumulative sum down the rows
     costs a pass over every pixel of the band's rows (and numpy's is slow along them)."""
-    return np.asarray(integral[low, columns + 1] - integral[high, columns + 1] - integral[low, columns] + integral[high, columns])
+    return corner_sums(integral, high, low, columns, columns + 1)
+
+
+def corner_sums(integral: np.ndarray, top: np.ndarray, bottom: np.ndarray, left: np.ndarray, right: np.ndarray) -> np.ndarray:
+    """The sums of the boxes from rows ``top`` and columns ``left`` up to (not with) ``bottom`` and ``right``
+    from the image's ``cv2.integral``: its four corners taken from the flat array (numpy's take is several
+    times faster than indexing by rows and columns)."""
+    stride = integral.shape[1]
+    flat = integral.reshape((-1, *integral.shape[2:]))
+    return np.asarray(np.take(flat, bottom * stride + right, axis=0) - np.take(flat, top * stride + right, axis=0)
+                      - np.take(flat, bottom * stride + left, axis=0) + np.take(flat, top * stride + left, axis=0))
 
 
 def edge_profile(integral: np.ndarray, low: np.ndarray, high: np.ndarray, step: int = 1) -> np.ndarray:
@@ -114,7 +124,7 @@ def strip_sums(integral: np.ndarray, image: np.ndarray, ys: np.ndarray, first: n
     out_left, out_right = np.clip(-first, 0, count), np.clip(last - width + 1, 0, count)
     low = np.clip(first, 0, width)
     high = low + count - out_left - out_right
-    sums = integral[ys + 1, high] - integral[ys, high] - integral[ys + 1, low] + integral[ys, low]
+    sums = corner_sums(integral, ys, ys + 1, low, high)
     shape = (-1,) + (1,) * (image.ndim - 2)
     if out_left.any():
         sums = sums + out_left.reshape(shape) * image[ys, 0]
@@ -351,7 +361,8 @@ class GoalPostDetector(Module):
         start = np.maximum(0, top[(left + right) // 2] - 1)
         below = int(start.min())  # the rows from here down
         rows = cv2.integral(green[below:].view(np.uint8), sdepth=cv2.CV_32S)
-        counts = (rows[1:, stop] - rows[:-1, stop] - rows[1:, first] + rows[:-1, first]).T  # pairs x rows
+        between = np.take(rows, stop, axis=1) - np.take(rows, first, axis=1)  # green from the top to each row, between the edges
+        counts = (between[1:] - between[:-1]).T  # pairs x rows
         row = np.arange(below, height)[None, :]
         carpet = (2 * counts >= (stop - first)[:, None]) & (row >= start[:, None])
         run = np.maximum(2, post_width // 6)
