@@ -18,7 +18,7 @@ from tafel.modules.behavior.options.framework import Next, Option, common, state
 from tafel.modules.behavior.paths import outside
 from tafel.representations import field as pitch
 from tafel.representations.game import GamePhase, SetPlay, State
-from tafel.representations.motion_control import MotionType
+from tafel.representations.motion_control import MotionType, WalkKick
 from tafel.representations.team import Role
 
 if TYPE_CHECKING:
@@ -126,6 +126,8 @@ class Striker(Option["SoccerBehavior"]):
             x, y, detoured = b.avoid(out.target_x, out.target_y)
             if detoured or math.hypot(x, y) > p.face_the_way:
                 out.target_rotation = math.atan2(y, x)
+            if detoured:  # on the way round, no walk kick (it would go where the detour faces)
+                out.walk_kick = WalkKick.none
             out.target_x, out.target_y = x, y
 
     @state
