@@ -26,6 +26,8 @@ from tafel.modules.perception.goal_post_detector import (
     exact_norms,
     exact_to_ground,
     exact_to_image,
+    rising_rows,
+    runs_of_rows,
     segment_medians,
     strip_means,
     strip_sums,
@@ -761,3 +763,21 @@ def test_the_band_checks_of_all_pairs_at_once_let_through_what_may_pass(seed: in
         assert passes[k] or not loops
         if not near[k]:
             assert passes[k] == loops
+
+
+@settings(max_examples=300)
+@given(st.lists(st.tuples(st.integers(0, 479), st.integers(1, 479)), max_size=12), st.integers(2, 60))
+def test_the_rows_of_many_posts_at_once_are_numpys(spans: list[tuple[int, int]], most: int) -> None:
+    """The rows along each post (rounded linspace, each once) and the runs down to their feet: those numpy
+    gives for each post alone."""
+    upper = np.array([a for a, _ in spans], int)
+    foot = upper + np.array([b for _, b in spans], int)
+    ys, lengths = rising_rows(upper, foot, most)
+    expected = [np.unique(np.linspace(a, b, min(b - a + 1, most)).round().astype(int)) for a, b in zip(upper, foot, strict=True)]
+    assert lengths.tolist() == [len(rows) for rows in expected]
+    np.testing.assert_array_equal(ys, np.concatenate([np.zeros(0, int), *expected]))
+    first, stop = upper - foot // 3, foot - foot // 4  # some runs empty
+    ys, lengths = runs_of_rows(first, stop)
+    expected = [np.arange(a, b) for a, b in zip(first, stop, strict=True)]
+    assert lengths.tolist() == [len(rows) for rows in expected]
+    np.testing.assert_array_equal(ys, np.concatenate([np.zeros(0, int), *expected]))

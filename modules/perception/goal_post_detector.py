@@ -111,8 +111,9 @@ def edge_peaks(profile: np.ndarray, minimum: float) -> np.ndarray:
     return np.nonzero(peak)[0]
 
 
-Rows = tuple[np.ndarray, np.ndarray, int]
-"""rows of the image (``ys``), a post's centre column in each (``xs``) and the post's width (px)"""
+Rows = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+"""rows of the image (``ys``), a post's centre column in each (``xs``) and the post's width (px) in each, the
+posts' rows one post after the other; and how many rows each post has"""
 
 
 def strip_sums(integral: np.ndarray, image: np.ndarray, ys: np.ndarray, first: np.ndarray, last: np.ndarray) -> np.ndarray:
@@ -183,10 +184,34 @@ def exact_norms(vectors: np.ndarray) -> np.ndarray:
     return np.asarray(np.sqrt((vectors[:, None, :] @ vectors[:, :, None])[:, 0, 0]))
 
 
-def post_axis(ys: np.ndarray, centre: float, summit: np.ndarray, foot: int, post_width: int) -> Rows:
-    """The rows ``ys`` with a post's centre column in each: on the line from its foot (row ``foot``, column
-    ``centre``) to its ``summit`` (x, y px)."""
-    return ys, np.round(centre + (summit[0] - centre) * (foot - ys) / max(foot - summit[1], 1.0)).astype(int), post_width
+def rising_rows(upper: np.ndarray, foot: np.ndarray, most: int) -> tuple[np.ndarray, np.ndarray]:
+    """For each post (from row ``upper`` down to row ``foot`` below it) the rows ``np.unique(np.linspace(upper,
+    foot, min(foot - upper + 1, most)).round().astype(int))``, one post's after the other, and how many each
+    has: numpy's linspace step by step for all at once (the step multiplied, the start added, the end set)."""
+    count = np.minimum(foot - upper + 1, most)
+    steps = np.arange(most, dtype=float)[None, :]
+    spaced = steps * ((foot - upper).astype(float) / (count - 1))[:, None]
+    spaced += upper[:, None]
+    spaced[np.arange(len(foot)), count - 1] = foot
+    rows = spaced.round().astype(int)  # ascending along each post: np.unique drops the repeats
+    chosen = (steps < count[:, None]) & np.concatenate([np.ones((len(foot), 1), bool), rows[:, 1:] != rows[:, :-1]], axis=1)
+    return rows[chosen], chosen.sum(axis=1)
+
+
+def runs_of_rows(first: np.ndarray, stop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each post the rows ``np.arange(first, stop)``, one post's after the other, and how many each has."""
+    lengths = np.maximum(stop - first, 0)
+    return np.arange(int(lengths.sum())) - np.repeat(np.cumsum(lengths) - lengths - first, lengths), lengths
+
+
+def post_rows(ys: np.ndarray, lengths: np.ndarray, centre: np.ndarray, summit: np.ndarray, foot: np.ndarray,
+              post_width: np.ndarray) -> Rows:
+    """The rows ``ys`` of each post (``lengths`` of them each) with its centre column in each: on the line
+    from its foot (row ``foot``, column ``centre``) to its ``summit`` (x, y px)."""
+    each = [np.repeat(values, lengths) for values in (centre, summit[:, 0], summit[:, 1], foot, post_width)]
+    centres, summit_x, summit_y, feet, widths = each
+    xs = np.round(centres + (summit_x - centres) * (feet - ys) / np.maximum(feet - summit_y, 1.0)).astype(int)
+    return ys, xs, widths, lengths
 
 
 @requires(CameraImageTop, CameraImageBottom, SegmentedImage, FieldColor, FieldBoundary, CameraMatrixBuffer)
@@ -309,16 +334,15 @@ class GoalPostDetector(Module):
         order = np.lexsort((rights, lefts))
         order = order[possible[order]]
         order = order[[not unsure[k] or self.band_checks(int(edges[lefts[k]]), int(edges[rights[k]])) for k in order]]
-        shapes = [(int(lefts[k]), *shape) for k, shape in zip(order, self.shapes(camera, edges[lefts[order]], edges[rights[order]], feet[order],
-                                                                                  top, projection), strict=True) if shape is not None]
-        # and whether the white rises along each one's axis (all the rows of all of them judged at once)
-        shares = iter(self.upright([rows for _, _, rising, down in shapes for rows in (rising, down) if len(rows[0])], white))
+        posts, rising, down = self.shapes(camera, edges[lefts[order]], edges[rights[order]], feet[order], top, projection)
+        # and whether the white rises along each one's axis and reaches down to its foot (all their rows at once)
+        ys, xs, widths, lengths = (np.concatenate(pair) for pair in zip(rising, down, strict=True))
+        shares = self.upright((ys, xs, widths, lengths), white)
+        rises, reaches = shares[: len(rising[3])], shares[len(rising[3]) :]
+        shaped = [(int(lefts[k]), post) for k, post in zip(order, posts, strict=True) if post is not None]
         best: dict[int, tuple[float, GoalPost]] = {}  # of each left edge's posts the one whose width fits best (the first of equals)
-        for i, post, _, foot_rows in shapes:
-            upright = next(shares) >= p.white_rows
-            if len(foot_rows[0]) and next(shares) < 0.5:  # below: the white reaches down to the foot
-                upright = False
-            if upright:
+        for (i, post), rise, reach, below in zip(shaped, rises, reaches, down[3], strict=True):
+            if rise >= p.white_rows and not (below and reach < 0.5):  # below: the white reaches down to the foot
                 distance = float(np.linalg.norm(np.array([post.x, post.y, 0.0]) - projection.translation))
                 misfit = abs(math.log(post.image_width * distance / (projection.fx * GOAL_POST_DIAMETER)))
                 if i not in best or misfit < best[i][0]:
@@ -392,17 +416,18 @@ class GoalPostDetector(Module):
                    for outside in (self.band_colour[max(0, left - side) : left], self.band_colour[right + 1 : right + 1 + side]))
 
     def shapes(self, camera: str, left: np.ndarray, right: np.ndarray, foot: np.ndarray, top: np.ndarray,
-               projection: ImageProjection) -> list[tuple[GoalPost, Rows, Rows] | None]:
+               projection: ImageProjection) -> tuple[list[GoalPost | None], Rows, Rows]:
         """For the edges at columns ``left`` and ``right`` with a foot at row ``foot`` (the first rows of
         carpet below the boundary between them) whose band passed its checks: the post, if its width and
-        height fit one, with the rows in which the white must rise along its axis and those in which it
-        must reach down to the foot (for ``upright``); else None. All at once, by the very operations the
-        pixel-by-pixel code did for each (``exact_rays``, ``exact_norms``), so the posts are the same to
-        the last bit."""
+        height fit one, else None; and for those posts in turn the rows in which the white must rise along
+        its axis and those in which it must reach down to the foot (for ``upright``). All at once, by the
+        very operations the pixel-by-pixel code did for each (``exact_rays``, ``exact_norms``, numpy's
+        linspace), so the posts are the same to the last bit."""
         p = self.parameters
         height = self.colour.shape[0]
         if not len(left):
-            return []
+            nothing = np.zeros(0, int)
+            return [], (nothing, nothing, nothing, nothing), (nothing, nothing, nothing, nothing)
         post_width = right - left
         centre = (left + right) / 2
         column = (left + right) // 2  # int(centre)
@@ -421,30 +446,29 @@ class GoalPostDetector(Module):
         fits &= front & (summit[:, 1] < foot)
         upper = np.maximum(0, np.trunc(np.where(fits, summit[:, 1], 0.0))).astype(int)  # int(): towards zero
         fits &= ~(foot - upper < p.min_height * post_width)
-        shapes: list[tuple[GoalPost, Rows, Rows] | None] = [None] * len(left)
-        for k in np.nonzero(fits)[0]:
-            k_foot, k_upper, k_width = int(foot[k]), int(upper[k]), int(post_width[k])
-            ys = np.unique(np.linspace(k_upper, k_foot, min(k_foot - k_upper + 1, 48)).round().astype(int))  # 48 rows: enough to judge
-            rising = post_axis(ys, float(centre[k]), summit[k], k_foot, k_width)
-            # down to the foot (above the line it stands on): a thing behind the field's edge stands on the hall's floor
-            # (or its reflection on a glossy floor continues it), with something else between it and the carpet
-            line = max(2, k_width // 3)
-            down = post_axis(np.arange(max(k_upper, k_foot - 3 * line), k_foot - line + 1), float(centre[k]), summit[k], k_foot, k_width)
+        fitting = np.nonzero(fits)[0]
+        posts: list[GoalPost | None] = [None] * len(left)
+        for k in fitting:
             x, y = post_centre[k]
-            shapes[k] = GoalPost(float(x), float(y), camera, float(centre[k]), float(k_width), float(k_foot)), rising, down
-        return shapes
+            posts[k] = GoalPost(float(x), float(y), camera, float(centre[k]), float(post_width[k]), float(foot[k]))
+        centre, summit, foot, upper, post_width = centre[fitting], summit[fitting], foot[fitting], upper[fitting], post_width[fitting]
+        rising = post_rows(*rising_rows(upper, foot, 48), centre, summit, foot, post_width)  # 48 rows: enough to judge
+        # down to the foot (above the line it stands on): a thing behind the field's edge stands on the hall's floor
+        # (or its reflection on a glossy floor continues it), with something else between it and the carpet
+        line = np.maximum(2, post_width // 3)
+        down = post_rows(*runs_of_rows(np.maximum(upper, foot - 3 * line), foot - line + 1), centre, summit, foot, post_width)
+        return posts, rising, down
 
-    def upright(self, posts: list[Rows], white: Callable[[slice], np.ndarray]) -> np.ndarray:
-        """For each post's rows (``ys``, the post's centre column ``xs`` in each, its width): the share of the
-        rows in which its middle is white, of the post's colour (the median along those rows) and unlike at
-        least one side. All posts' rows at once: the strips' means from the image's integral (their sums are
-        exact integers, so the means are the ones the strips' pixels give)."""
+    def upright(self, rows: Rows, white: Callable[[slice], np.ndarray]) -> np.ndarray:
+        """For each post's ``rows``: the share of them in which its middle is white, of the post's colour (the
+        median along those rows) and unlike at least one side (nan for a post without rows). All posts'
+        rows at once: the strips' means from the image's integral (their sums are exact integers, so the
+        means are the ones the strips' pixels give)."""
         p = self.parameters
-        if not posts:
-            return np.zeros(0)
-        lengths = np.array([len(ys) for ys, _, _ in posts])
-        ys, xs = np.concatenate([ys for ys, _, _ in posts]), np.concatenate([xs for _, xs, _ in posts])
-        post_width = np.repeat([width for _, _, width in posts], lengths)
+        ys, xs, post_width, lengths = rows
+        shares = np.full(len(lengths), np.nan)
+        if not len(ys):
+            return shares
         half, side, edge = np.maximum(1, post_width // 4), np.maximum(2, post_width // 2), (post_width + 1) // 2
         first_row = int(ys.min())
         block = slice(first_row, int(ys.max()) + 1)
@@ -453,11 +477,13 @@ class GoalPostDetector(Module):
         inside = strip_means(colour, pixels, ys - first_row, xs - half, xs + half)
         left, right = (strip_means(colour, pixels, ys - first_row, xs + a, xs + b) for a, b in ((-edge - side, -edge - 1), (edge + 1, edge + side)))
         unlike = np.maximum(np.linalg.norm(inside - left, axis=1), np.linalg.norm(inside - right, axis=1)) >= p.contrast_min
-        same = np.linalg.norm(inside - np.repeat(segment_medians(inside, lengths), lengths, axis=0), axis=1) <= p.uniform_max
+        some = lengths[lengths > 0]
+        same = np.linalg.norm(inside - np.repeat(segment_medians(inside, some), some, axis=0), axis=1) <= p.uniform_max
         bright = white(block)
         whites = strip_sums(cv2.integral(bright.view(np.uint8), sdepth=cv2.CV_32S), bright, ys - first_row, xs - half, xs + half)
-        rows = (2 * whites >= 2 * half + 1) & unlike & same  # white: at least half the middle's pixels
-        return np.asarray(np.add.reduceat(rows.astype(np.int64), np.cumsum(lengths) - lengths) / lengths)
+        judged = (2 * whites >= 2 * half + 1) & unlike & same  # white: at least half the middle's pixels
+        shares[lengths > 0] = np.add.reduceat(judged.astype(np.int64), np.cumsum(some) - some) / some
+        return shares
 
     @staticmethod
     def distinct(posts: list[GoalPost]) -> list[GoalPost]:
