@@ -1,6 +1,7 @@
 """The perception modules' vectorized steps (issue 34) against the loops they replaced, kept here as the
 reference: the same output on painted scenes drawn by hypothesis (balls with black patches, lines,
-posts over the field's edge, dark corners). The real-image figures are benchmarks/real_images.py's."""
+posts over the field's edge, dark corners), and for the goal posts on every real image of
+../shared/real-images (MuJoCo renders where it is absent). The real-image figures are benchmarks/real_images.py's."""
 
 from __future__ import annotations
 
