@@ -14,11 +14,12 @@ from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.paths import LEFT, RIGHT, detour, waypoint
 from tafel.modules.behavior.role_provider import RoleProvider
 from tafel.modules.behavior.soccer_behavior import SoccerBehavior
+from tafel.modules.modeling.obstacle_modeler import ObstacleModeler
 from tafel.representations.behavior import ActivationGraph
 from tafel.representations.game import GameState, Penalty, RobotInfo, State, TeamInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType
-from tafel.representations.obstacles import ROBOT_RADIUS, Obstacle, ObstacleKind, Obstacles
+from tafel.representations.obstacles import ROBOT_RADIUS, Obstacle, ObstacleKind, Obstacles, RobotsPercept, SeenRobot
 from tafel.representations.team import PlayerRole, Role, TeamMate, TeamMates, TeamMessage
 
 CONTACT = 330.0  # mm between two torsos: the simulated referee's contact (tools/simulation/fouls.py)
@@ -81,7 +82,8 @@ def test_the_striker_walks_round_an_opponent_between_it_and_the_ball_keeping_cle
     harness = striker(pose, (0.0, 0.0), [opponent])
     out = harness.execute()[MotionRequest]
     assert out.motion is MotionType.walk_to and states(harness)[-1] == ("Striker", "kick")
-    assert segment_distance(out.target_x, out.target_y, opponent.x, opponent.y) > CONTACT + 100.0
+    # clear of contact by what two robots walking at each other close in before they have stopped (~0.2 m)
+    assert segment_distance(out.target_x, out.target_y, opponent.x, opponent.y) > CONTACT + 200.0
     assert out.target_rotation == pytest.approx(math.atan2(out.target_y, out.target_x))  # facing the way round
 
 
@@ -187,3 +189,13 @@ def test_two_defenders_walk_to_places_on_either_side_in_ready_and_in_play() -> N
     (_, ready_4), (_, play_4), (_, ready_5), (_, play_5) = places
     assert math.hypot(ready_4[0] - ready_5[0], ready_4[1] - ready_5[1]) > 1000.0
     assert math.hypot(play_4[0] - play_5[0], play_4[1] - play_5[1]) > 500.0
+
+
+def test_a_robot_out_of_view_is_still_walked_round_for_a_while() -> None:
+    """Walking sideways or backwards to the ball the robot no longer sees the one beside it (the view is
+    +-100 degrees): it is kept for ``memory_s`` (2 s; before, 1 s)."""
+    harness = ModuleHarness(ObstacleModeler, RobotPose(valid=True), RobotsPercept(robots=[SeenRobot(600.0, 0.0)]))
+    harness.execute()
+    harness.set(RobotsPercept(robots=[]))
+    harness.execute(45)  # 1.5 s at 30 Hz
+    assert len(harness[Obstacles].obstacles) == 1

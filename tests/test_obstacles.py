@@ -34,7 +34,7 @@ def test_seen_robots_stay_put_on_the_field_while_this_robot_turns_and_are_forgot
     harness.set(RobotsPercept(robots=[]), RobotPose(valid=True, rotation=math.pi / 2))  # turned left, no longer seen
     held = harness.execute()[Obstacles].obstacles
     assert len(held) == 1 and (held[0].x, held[0].y) == pytest.approx((0.0, -800.0), abs=1e-6)
-    harness.execute(40)  # > 1 s later
+    harness.execute(70)  # > 2 s later
     assert harness.blackboard[Obstacles].obstacles == []
 
 

@@ -107,7 +107,7 @@ class SoccerBehavior(Module):
         indirect_target: list[float] = field(default_factory=lambda: [1500.0, 0.5])
         """an own free kick goes this far ahead of the ball (mm, at most to the penalty area's front) and
         this share of the way to the field's long axis: never straight at the goal"""
-        obstacle_margin: float = bounded(0.0, 1000.0, 150.0)
+        obstacle_margin: float = bounded(0.0, 1000.0, 250.0)
         """mm kept between this robot's and another robot's footprints on the way"""
         near_ball: float = bounded(0.0, 2000.0, 400.0)
         """mm: within this of the ball the striker goes straight for it (a duel for the ball is no push)"""

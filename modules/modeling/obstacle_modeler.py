@@ -31,8 +31,9 @@ class ObstacleModeler(Module):
 
     @dataclass
     class Parameters:
-        memory_s: float = bounded(0.0, 10.0, 1.0)
-        """s a seen robot is remembered after it was last seen"""
+        memory_s: float = bounded(0.0, 10.0, 2.0)
+        """s a seen robot is remembered after it was last seen (robots out of view while this one walks
+        sideways or backwards are still walked round)"""
         mate_timeout: float = bounded(0.0, 30.0, 6.0)
         """s after a teammate's message that its position is still used"""
         mate_spread: float = bounded(0.0, 500.0, 60.0)
