@@ -26,6 +26,7 @@ from tafel.representations.motion_control import (
     WalkKick,
 )
 from tests.support.kick_trials import kick_trial
+from tests.support.simulation import Simulation
 
 KICKS = load_walk_kicks()
 
@@ -161,3 +162,27 @@ def test_a_walk_kick_sends_the_ball_where_asked_without_stopping_or_falling(engi
     assert math.isfinite(trial.request_to_moving_s)  # it kicked
     assert trial.distance_mm >= least_mm
     assert abs(trial.direction_error_deg) <= 12.0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_striker_with_its_cameras_walks_to_the_ball_and_kicks_it_towards_the_goal_out_of_the_walk(seed: int) -> None:
+    """The whole program (perception, ball model, ``Striker``) in the default scene, judged on ground truth:
+    from (-1500, 0) to the ball on the centre spot, walk kicks towards the opponent goal, no fall."""
+    sim = Simulation("mujoco", scene="default", cameras="on", seed=str(seed), overrides=['cognition.providers.MotionRequest="Striker"'])
+    lying = [False, 0]
+
+    def watch(s: Simulation) -> None:
+        down = s.platform.posture() != "upright"
+        lying[1] += int(down and not lying[0])
+        lying[0] = down
+
+    try:
+        sim.run(20.0, watch)
+        kicks = sim.blackboard("motion")[WalkingEngineOutput].kicks
+        x, y = sim.platform.ball_position()
+    finally:
+        sim.close()
+    assert lying[1] == 0
+    assert kicks >= 1
+    assert x > 2000.0 and abs(y) < x  # played well on towards the opponent goal (+x)
