@@ -45,8 +45,8 @@ def corner_sums(integral: np.ndarray, top: np.ndarray, bottom: np.ndarray, left:
     times faster than indexing by rows and columns)."""
     stride = integral.shape[1]
     flat = integral.reshape((-1, *integral.shape[2:]))
-    return np.asarray(np.take(flat, bottom * stride + right, axis=0) - np.take(flat, top * stride + right, axis=0)
-                      - np.take(flat, bottom * stride + left, axis=0) + np.take(flat, top * stride + left, axis=0))
+    return np.asarray(flat.take(bottom * stride + right, axis=0) - flat.take(top * stride + right, axis=0)
+                      - flat.take(bottom * stride + left, axis=0) + flat.take(top * stride + left, axis=0))
 
 
 def edge_profile(integral: np.ndarray, low: np.ndarray, high: np.ndarray, step: int = 1) -> np.ndarray:
@@ -61,7 +61,7 @@ def edge_profile(integral: np.ndarray, low: np.ndarray, high: np.ndarray, step: 
     # float32 as the running sums this replaced: the integers are exact in it, the length rounds the same
     change = (band_sums(integral, low, high, columns + step) - band_sums(integral, low, high, columns - step)).astype(np.float32)
     profile = np.zeros(width, np.float32)
-    profile[columns] = np.linalg.norm(change, axis=1) / np.maximum(low - high, 1)
+    profile[columns] = row_norms(change) / np.maximum(low - high, 1)
     return profile
 
 
@@ -91,13 +91,13 @@ def band_passes(band_white: np.ndarray, band_colour: np.ndarray, left: np.ndarra
     margin, side = post_width // 4, np.maximum(2, post_width // 2)
     first = left + 1 + margin // 2
     stop = np.maximum(left + 2 + margin // 2, right - margin // 2)
-    white_prefix = np.concatenate([[0.0], np.cumsum(band_white)])
-    colour_prefix = np.concatenate([np.zeros((1, 3)), np.cumsum(band_colour, axis=0)])
+    white_prefix = np.concatenate([[0.0], band_white.cumsum()])
+    colour_prefix = np.concatenate([np.zeros((1, 3)), band_colour.cumsum(axis=0)])
     inside = window_means(colour_prefix, first, stop)
     white = window_means(white_prefix, first, stop)
     passes, near = white >= 0.6 - slack, white < 0.6 + slack
     for outside_first, outside_stop in ((np.maximum(0, left - side), left), (right + 1, np.minimum(width, right + 1 + side))):
-        contrast = np.linalg.norm(inside - window_means(colour_prefix, outside_first, outside_stop), axis=1)
+        contrast = row_norms(inside - window_means(colour_prefix, outside_first, outside_stop))
         passes &= contrast >= contrast_min - slack
         near |= contrast < contrast_min + slack
     return passes, near
@@ -121,8 +121,8 @@ def strip_sums(integral: np.ndarray, image: np.ndarray, ys: np.ndarray, first: n
     do); ``integral`` is ``cv2.integral`` of ``image``. Exact integers."""
     width = image.shape[1]
     count = last - first + 1
-    out_left, out_right = np.clip(-first, 0, count), np.clip(last - width + 1, 0, count)
-    low = np.clip(first, 0, width)
+    out_left, out_right = np.minimum(np.maximum(-first, 0), count), np.minimum(np.maximum(last - width + 1, 0), count)
+    low = np.minimum(np.maximum(first, 0), width)
     high = low + count - out_left - out_right
     sums = corner_sums(integral, ys, ys + 1, low, high)
     shape = (-1,) + (1,) * (image.ndim - 2)
@@ -143,10 +143,10 @@ def strip_means(integral: np.ndarray, image: np.ndarray, ys: np.ndarray, first: 
 def segment_medians(values: np.ndarray, lengths: np.ndarray) -> np.ndarray:
     """The median of each channel of ``values`` (float32, rows x channels) in each run of ``lengths``
     rows, as ``np.median`` gives it (of two middle values their float32 sum halved)."""
-    segment = np.repeat(np.arange(len(lengths)), lengths)
-    order = np.argsort(segment[:, None] * 1024.0 + values, axis=0, kind="stable")  # the segments in turn, each sorted
-    ordered = np.take_along_axis(values, order, axis=0)
-    starts = np.cumsum(lengths) - lengths
+    segment = np.arange(len(lengths)).repeat(lengths)
+    order = (segment[:, None] * 1024.0 + values).argsort(axis=0, kind="stable")  # the segments in turn, each sorted
+    ordered = values[order, np.arange(values.shape[1])]
+    starts = lengths.cumsum() - lengths
     upper = ordered[starts + lengths // 2]
     lower = ordered[starts + (lengths - 1) // 2]
     return np.asarray(np.where((lengths % 2 == 1)[:, None], upper, ((lower + upper) / 2).astype(np.float32)))
@@ -177,6 +177,12 @@ def exact_to_image(projection: ImageProjection, points: np.ndarray) -> tuple[np.
                      projection.height / 2 - projection.fy * local[:, 2] / depth], axis=1), front
 
 
+def row_norms(vectors: np.ndarray) -> np.ndarray:
+    """``np.linalg.norm(vectors, axis=1)`` of real vectors, as numpy computes it (the square root of the
+    squares summed along the rows) without its Python around it: called a few dozen times a frame."""
+    return np.asarray(np.sqrt(np.add.reduce(vectors * vectors, axis=1)))
+
+
 def exact_norms(vectors: np.ndarray) -> np.ndarray:
     """``np.linalg.norm`` of each row as numpy gives it for that row alone (the square root of its dot
     product with itself)."""
@@ -200,16 +206,16 @@ def rising_rows(upper: np.ndarray, foot: np.ndarray, most: int) -> tuple[np.ndar
 def runs_of_rows(first: np.ndarray, stop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For each post the rows ``np.arange(first, stop)``, one post's after the other, and how many each has."""
     lengths = np.maximum(stop - first, 0)
-    return np.arange(int(lengths.sum())) - np.repeat(np.cumsum(lengths) - lengths - first, lengths), lengths
+    return np.arange(int(lengths.sum())) - (lengths.cumsum() - lengths - first).repeat(lengths), lengths
 
 
 def post_rows(ys: np.ndarray, lengths: np.ndarray, centre: np.ndarray, summit: np.ndarray, foot: np.ndarray,
               post_width: np.ndarray) -> Rows:
     """The rows ``ys`` of each post (``lengths`` of them each) with its centre column in each: on the line
     from its foot (row ``foot``, column ``centre``) to its ``summit`` (x, y px)."""
-    each = [np.repeat(values, lengths) for values in (centre, summit[:, 0], summit[:, 1], foot, post_width)]
+    each = [values.repeat(lengths) for values in (centre, summit[:, 0], summit[:, 1], foot, post_width)]
     centres, summit_x, summit_y, feet, widths = each
-    xs = np.round(centres + (summit_x - centres) * (feet - ys) / np.maximum(feet - summit_y, 1.0)).astype(int)
+    xs = (centres + (summit_x - centres) * (feet - ys) / np.maximum(feet - summit_y, 1.0)).round().astype(int)
     return ys, xs, widths, lengths
 
 
@@ -319,7 +325,7 @@ class GoalPostDetector(Module):
         edges = edge_peaks(profile, p.edge_min)
         # the least width a post can have at each edge: the one it has standing on the boundary (its foot is no farther)
         ground, hit = projection.to_ground(edges + 0.5, top[edges] + 0.5)
-        distance = np.linalg.norm(np.column_stack([ground, np.zeros(len(edges))]) - projection.translation, axis=1)
+        distance = row_norms(np.column_stack([ground, np.zeros(len(edges))]) - projection.translation)
         least = np.where(hit, p.width_low * projection.fx * GOAL_POST_DIAMETER / np.maximum(distance, 1.0) - 1.0, 0.0)
         self.band_colour = band_means(colour, low, high)
         self.band_white = band_means(cv2.integral(white(slice(first_row, last_row)).view(np.uint8), sdepth=cv2.CV_32S), low, high)
@@ -342,8 +348,8 @@ class GoalPostDetector(Module):
         best: dict[int, tuple[float, GoalPost]] = {}  # of each left edge's posts the one whose width fits best (the first of equals)
         for (i, post), rise, reach, below in zip(shaped, rises, reaches, down[3], strict=True):
             if rise >= p.white_rows and not (below and reach < 0.5):  # below: the white reaches down to the foot
-                distance = float(np.linalg.norm(np.array([post.x, post.y, 0.0]) - projection.translation))
-                misfit = abs(math.log(post.image_width * distance / (projection.fx * GOAL_POST_DIAMETER)))
+                away = float(np.linalg.norm(np.array([post.x, post.y, 0.0]) - projection.translation))
+                misfit = abs(math.log(post.image_width * away / (projection.fx * GOAL_POST_DIAMETER)))
                 if i not in best or misfit < best[i][0]:
                     best[i] = (misfit, post)
         found = self.nearest(self.distinct([best[i][1] for i in sorted(best)]))
@@ -384,7 +390,7 @@ class GoalPostDetector(Module):
         start = np.maximum(0, top[(left + right) // 2] - 1)
         below = int(start.min())  # the rows from here down
         rows = cv2.integral(green[below:].view(np.uint8), sdepth=cv2.CV_32S)
-        between = np.take(rows, stop, axis=1) - np.take(rows, first, axis=1)  # green from the top to each row, between the edges
+        between = rows.take(stop, axis=1) - rows.take(first, axis=1)  # green from the top to each row, between the edges
         counts = (between[1:] - between[:-1]).T  # pairs x rows
         row = np.arange(below, height)[None, :]
         carpet = (2 * counts >= (stop - first)[:, None]) & (row >= start[:, None])
@@ -395,7 +401,7 @@ class GoalPostDetector(Module):
         feet[index] = foot = np.maximum(start, below + np.argmax(lasting, axis=1) - 1)
         # the width a post has at that foot's distance
         ground, hit = projection.to_ground((left + right) / 2, foot + 0.5)
-        distance = np.linalg.norm(np.column_stack([ground, np.zeros(len(left))]) - projection.translation, axis=1)
+        distance = row_norms(np.column_stack([ground, np.zeros(len(left))]) - projection.translation)
         expected = projection.fx * GOAL_POST_DIAMETER / np.where(hit, distance, 1.0)
         misfit = (post_width - expected > p.width_tolerance * expected + 1.5 + slack) | (post_width < p.width_low * expected - 1.0 - slack)
         possible[index[lasting.any(axis=1) & ~(hit & misfit)]] = True
@@ -475,13 +481,13 @@ class GoalPostDetector(Module):
         colour = cv2.integral(pixels, sdepth=cv2.CV_32S)
         inside = strip_means(colour, pixels, ys - first_row, xs - half, xs + half)
         left, right = (strip_means(colour, pixels, ys - first_row, xs + a, xs + b) for a, b in ((-edge - side, -edge - 1), (edge + 1, edge + side)))
-        unlike = np.maximum(np.linalg.norm(inside - left, axis=1), np.linalg.norm(inside - right, axis=1)) >= p.contrast_min
+        unlike = np.maximum(row_norms(inside - left), row_norms(inside - right)) >= p.contrast_min
         some = lengths[lengths > 0]
-        same = np.linalg.norm(inside - np.repeat(segment_medians(inside, some), some, axis=0), axis=1) <= p.uniform_max
+        same = row_norms(inside - segment_medians(inside, some).repeat(some, axis=0)) <= p.uniform_max
         bright = white(block)
         whites = strip_sums(cv2.integral(bright.view(np.uint8), sdepth=cv2.CV_32S), bright, ys - first_row, xs - half, xs + half)
         judged = (2 * whites >= 2 * half + 1) & unlike & same  # white: at least half the middle's pixels
-        shares[lengths > 0] = np.add.reduceat(judged.astype(np.int64), np.cumsum(some) - some) / some
+        shares[lengths > 0] = np.add.reduceat(judged.astype(np.int64), some.cumsum() - some) / some
         return shares
 
     @staticmethod
