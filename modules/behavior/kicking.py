@@ -38,11 +38,11 @@ class KickParameters:
     """kick out of the walk (``MotionRequest.walk_kick``; the ``Striker``'s default); false: the keyframe kick from standing"""
     walk_kick_distance: float = bounded(120.0, 300.0, 150.0)
     """mm from the kicking foot's place beside the robot to the ball's centre, along the kick direction"""
-    walk_kick_turned_farther: float = bounded(0.0, 150.0, 60.0)
+    walk_kick_turned_farther: float = bounded(0.0, 150.0, 40.0)
     """mm farther the ball lies for a kick turned 90 degrees (times the sine): clear of the walking foot's corner"""
     walk_kick_ask_within: float = bounded(20.0, 600.0, 250.0)
     """mm from the kicking pose within which the walk kick is asked for: the walk kicks once it is there"""
-    walk_kick_max_angle: float = bounded(0.0, 0.8, 0.6)
+    walk_kick_max_angle: float = bounded(0.0, 0.8, 0.8)
     """rad either side the walk kick sends the ball without the robot turning to it"""
     walk_kick_long_max_angle: float = bounded(0.0, 0.8, 0.1)
     """rad either side the long walk kick sends the ball without the robot turning (it is a straight kick)"""

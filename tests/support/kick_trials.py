@@ -49,7 +49,8 @@ def kick_trial(engine: str, seed: int, direction_deg: float, strength: WalkKick 
                 asked_at = t
             if math.hypot(bx - ball0[0], by - ball0[1]) > 30.0:
                 moved_at = t
-                driven.request = MotionRequest(motion=MotionType.walk)
+                if request.motion is not MotionType.kick:  # the keyframe kick plays on as asked, then stands
+                    driven.request = MotionRequest(motion=MotionType.walk)
         driven.run(0.03)
         t += 0.03
     bx, by = driven.sim.platform.ball_position()
