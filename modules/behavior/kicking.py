@@ -45,7 +45,7 @@ class KickParameters:
     walk_kick_max_angle: float = bounded(0.0, 0.8, 0.8)
     """rad either side the walk kick sends the ball without the robot turning to it"""
     walk_kick_long_max_angle: float = bounded(0.0, 0.8, 0.1)
-    """rad either side the long walk kick sends the ball without the robot turning (it is a straight kick)"""
+    """rad either side the long walk kick turns the ball (it is a straight kick: the robot faces its direction)"""
     walk_kick_keep_foot: float = bounded(0.0, 100.0, 40.0)
     """mm either side of the middle within which a straight walk kick keeps the foot it chose"""
     walk_kick_straight: float = bounded(0.0, 0.5, 0.15)
@@ -103,7 +103,7 @@ def walk_kick_approach(ball: BallModel, kick_direction: float, p: KickParameters
     facing ``kick_direction`` turned back by what the walk kick turns itself; ask for the walk kick once
     near it (``walk_kick_ask_within``): the walk kicks when it gets there. Returns the pose walked to (mm,
     mm, rad; robot frame)."""
-    limit = min(p.walk_kick_max_angle, p.walk_kick_long_max_angle) if strength is WalkKick.long else p.walk_kick_max_angle
+    limit = 0.0 if strength is WalkKick.long else p.walk_kick_max_angle  # the long kick: the robot faces its direction
     angle = min(limit, max(-limit, kick_direction))  # what the kick turns
     heading = kick_direction - angle  # what the robot turns
     if abs(angle) > p.walk_kick_straight:
@@ -122,5 +122,7 @@ def walk_kick_approach(ball: BallModel, kick_direction: float, p: KickParameters
     out.target_x, out.target_y, out.target_rotation = target_x, target_y, heading
     out.kick_foot = foot  # kept for the next frame's choice near the middle
     if math.hypot(along - distance, across) < p.walk_kick_ask_within and abs(heading) < p.kick_tolerance_angle:
-        out.walk_kick, out.kick_direction = strength, angle
+        # the long kick corrects what the robot is still turned away, up to walk_kick_long_max_angle
+        residual = min(p.walk_kick_long_max_angle, max(-p.walk_kick_long_max_angle, heading))
+        out.walk_kick, out.kick_direction = strength, angle + (residual if strength is WalkKick.long else 0.0)
     return target_x, target_y, heading
