@@ -42,9 +42,14 @@ def play(*args: str) -> dict:
         return json.loads(result.read_text())
 
 
+#: the referee's events that begin a game state (the others, a penalty, a free kick or a goal, fall within one)
+STATES = ("INITIAL", "STANDBY", "READY", "SET", "PLAYING", "FINISHED")
+
+
 def playing_s(result: dict) -> float:
-    """s of PLAYING in a match: from each PLAYING to the next event."""
-    events = result["events"] + [{"time_s": result["simulated_s"], "event": "END"}]
+    """s of PLAYING in a match: from each PLAYING to the next state (a penalty or a free kick within it
+    does not end it)."""
+    events = [e for e in result["events"] if e["event"] in STATES] + [{"time_s": result["simulated_s"], "event": "END"}]
     return sum(b["time_s"] - a["time_s"] for a, b in zip(events, events[1:]) if a["event"] == "PLAYING")
 
 
