@@ -69,10 +69,10 @@ class MotionRequest:
     walk_kick: WalkKick = WalkKick.none
 
     def status_text(self) -> str:
+        kick = f", {self.walk_kick.name} kick {self.kick_foot.name}" if self.walk_kick is not WalkKick.none else ""
         if self.motion is MotionType.walk:
-            return f"request walk {self.walk_x:.0f},{self.walk_y:.0f} mm/s {self.walk_rotation:.2f} rad/s"
+            return f"request walk {self.walk_x:.0f},{self.walk_y:.0f} mm/s {self.walk_rotation:.2f} rad/s{kick}"
         if self.motion is MotionType.walk_to:
-            kick = f", {self.walk_kick.name} kick {self.kick_foot.name}" if self.walk_kick is not WalkKick.none else ""
             return f"request walk_to {self.target_x:.0f},{self.target_y:.0f} mm {self.target_rotation:.2f} rad{kick}"
         if self.motion is MotionType.kick:
             return f"request kick {self.kick_foot.name}"

@@ -111,6 +111,13 @@ def test_the_walk_kicks_file_is_checked_key_by_key(tmp_path: Path) -> None:
         load_walk_kicks(broken)
 
 
+def test_the_status_line_names_a_walk_kick_and_only_then() -> None:
+    assert walk_kick(Foot.right, WalkKick.short).status_text().endswith(", short kick right")
+    asked = MotionRequest(motion=MotionType.walk_to, target_x=300.0, walk_kick=WalkKick.long).status_text()
+    assert asked == "request walk_to 300,0 mm 0.00 rad, long kick left"
+    assert "kick" not in MotionRequest(motion=MotionType.walk_to, target_x=300.0).status_text()
+
+
 # ------------------------------------------------------------------------------------ the behaviour
 def striker(ball: BallModel) -> MotionRequest:
     return ModuleHarness(Striker, ball, Odometry()).execute()[MotionRequest]
