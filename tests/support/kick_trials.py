@@ -20,6 +20,7 @@ class KickTrial:
     direction_error_deg: float  # its direction against the wanted one (field frame)
     approach_to_moving_s: float  # from the start of the approach (1 m off) to the ball moving
     request_to_moving_s: float  # from the first frame the kick was asked for to the ball moving
+    arrival_to_moving_s: float  # from the robot at its kicking pose (within 40 mm; the keyframe kick: asked for) to the ball moving
     falls: int
 
 
@@ -35,7 +36,7 @@ def kick_trial(engine: str, seed: int, direction_deg: float, strength: WalkKick 
     wanted = math.radians(direction_deg)
     p = replace(KickParameters(), walk_kick=walk_kick)
     t = 0.0
-    asked_at = moved_at = None
+    asked_at = arrived_at = moved_at = None
     request = MotionRequest()  # kept from frame to frame, as the blackboard keeps the behaviour's
     while t < 15.0 and (moved_at is None or t < moved_at + 6.0):
         if moved_at is None:
@@ -47,6 +48,9 @@ def kick_trial(engine: str, seed: int, direction_deg: float, strength: WalkKick 
             driven.request = replace(request)
             if asked_at is None and (request.walk_kick is not WalkKick.none or request.motion is MotionType.kick):
                 asked_at = t
+            there = request.motion is MotionType.kick or (request.walk_kick is not WalkKick.none and math.hypot(request.target_x, request.target_y) < 40.0)
+            if arrived_at is None and there:
+                arrived_at = t
             if math.hypot(bx - ball0[0], by - ball0[1]) > 30.0:
                 moved_at = t
                 if request.motion is not MotionType.kick:  # the keyframe kick plays on as asked, then stands
@@ -57,5 +61,7 @@ def kick_trial(engine: str, seed: int, direction_deg: float, strength: WalkKick 
     driven.close()
     travel = math.hypot(bx - ball0[0], by - ball0[1])
     error = math.degrees(math.remainder(math.atan2(by - ball0[1], bx - ball0[0]) - wanted, math.tau))
-    return KickTrial(travel, error, moved_at if moved_at is not None else math.inf,
-                     (moved_at - asked_at) if moved_at is not None and asked_at is not None else math.inf, driven.falls)
+    def since(start: float | None) -> float:
+        return moved_at - start if moved_at is not None and start is not None else math.inf
+
+    return KickTrial(travel, error, moved_at if moved_at is not None else math.inf, since(asked_at), since(arrived_at), driven.falls)
