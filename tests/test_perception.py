@@ -378,7 +378,7 @@ def painted_candidates(rng: np.random.Generator, count: int) -> tuple[np.ndarray
     patches round its centre) on the carpet, half a thing of the same size that is none (a joint, a foot)."""
     from tafel.modules.perception.ball_classifier import features
     from tafel.modules.perception.spl_ball_detector import carpet
-    from tafel.tools.simulation.train_ball_classifier import distractors, realistic
+    from tafel.tools.simulation.train_ball_classifier import camera_like, distractors
 
     rows, labels = [], []
     for i in range(count):
@@ -398,7 +398,7 @@ def painted_candidates(rng: np.random.Generator, count: int) -> tuple[np.ndarray
             if len(xs):
                 pick = int(rng.integers(len(xs)))
                 x, y = float(xs[pick]), float(ys[pick])
-        image = realistic(image, rng)
+        image = camera_like(image, rng)
         hsv = cv2.cvtColor(image, cv2.COLOR_RGB2HSV)
         green = (hsv[..., 0] > 30) & (hsv[..., 0] < 90) & (hsv[..., 1] > 60)
         rows.append(features(hsv, green, x, y, r, *carpet(hsv, green)))
@@ -449,7 +449,8 @@ def test_the_training_script_trains_on_renders_and_real_images(tmp_path) -> None
     from tafel.tools.simulation.train_ball_classifier import main
 
     out = tmp_path / "model.npz"
-    main(["--scenes", "3", "--real-variants", "1", "--epochs", "50", "--out", str(out)])
+    main(["--scenes", "3", "--real", str(Path(__file__).parent / "data" / "real_images"), "--real-variants", "1", "--epochs", "50",
+          "--out", str(out)])
     assert BallClassifier(out).scores(np.zeros((2, BallClassifier(out).w1.shape[0]))).shape == (2,)
 
 

@@ -8,8 +8,9 @@ light and colour casts do not matter), the carpet's share in eight sectors round
 the carpet; things at the field's edge have none above them) and a few colour figures measured
 against the carpet. A small neural network decides: small (a few kB, shipped as ``ball_classifier.npz``
 beside this file), fast (microseconds per candidate) and trained by
-``python -m tafel.tools.simulation.train_ball_classifier`` on simulator renders with ground truth plus the real
-images whose licence allows it.
+``python -m tafel.tools.simulation.train_ball_classifier`` on simulator renders with ground truth, seen through the
+platforms' own camera pipeline and hall (``--realism``), plus real labelled images where given (none by default:
+the only ones the project may train on are the real-image benchmark's).
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ the camera matrix computed by the same kinematics the program uses.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -26,6 +26,7 @@ from tafel.modules.perception.field_color_provider import FieldColorProvider
 from tafel.modules.perception.goal_post_detector import GoalPostDetector
 from tafel.modules.perception.line_detector import LineDetector
 from tafel.modules.perception.spl_ball_detector import SPLBallDetector
+from tafel.platforms.realism import CameraRealism
 from tafel.platforms.simulated import SimulatedRobotPlatform
 from tafel.representations import field as spl
 from tafel.representations.geometry import Pose2D
@@ -79,9 +80,18 @@ class SceneRenderer:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def frames(self, robot_pose: tuple[float, float, float], head: tuple[float, float], ball: tuple[float, float]) -> dict[str, LabelledFrame]:
+    def new_cameras(self, seed: int) -> None:
+        """Cameras of their own for the next frames (exposure, white balance, cast, noise, JPEG drawn from
+        ``seed``; the hall stays): training sees many cameras without building a world for each."""
+        level = self.platform.realism_level
+        if level is not None:
+            self.platform.camera_realism = {name: CameraRealism(level, seed, name) for name in CAMERAS}
+
+    def frames(self, robot_pose: tuple[float, float, float], head: tuple[float, float], ball: tuple[float, float],
+               paint: Callable[[str, np.ndarray, tuple[float, float, float] | None], np.ndarray] | None = None) -> dict[str, LabelledFrame]:
         """Both cameras' frames with the robot at ``robot_pose`` (field mm, rad), head (yaw, pitch) in
-        rad and the ball at ``ball`` (field mm)."""
+        rad and the ball at ``ball`` (field mm). ``paint(camera, image, ball circle px)``: changes the render
+        before the camera's pipeline (``--realism``) sees it, as things really in the scene would be."""
         angles = self.angles.copy()
         angles[HEAD_YAW], angles[HEAD_PITCH] = head
         poses = link_poses(angles_by_name(angles), CAMERA_LINKS)
@@ -102,11 +112,13 @@ class SceneRenderer:
             camera = torso_in_robot @ camera_pose_in_torso(poses, mount)
             matrix = CameraMatrix(camera[:3, :3].copy(), camera[:3, 3].copy(), True)
             image = p.render(name)
+            projected = project_ball(matrix, ball_robot, p.width, p.height, horizontal_fov, vertical_fov)
+            if paint is not None:
+                image = paint(name, image, projected)
             pipeline = p.camera_realism.get(name)
             if pipeline is not None:
                 image = pipeline(image, pipeline.posed_shift(p.focal_px()[0]))
             mask = p.ball_mask(name)
-            projected = project_ball(matrix, ball_robot, p.width, p.height, horizontal_fov, vertical_fov)
             visible = 0.0
             if projected is not None:
                 area = math.pi * projected[2] ** 2

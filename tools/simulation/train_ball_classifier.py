@@ -1,21 +1,23 @@
 """Train the ball classifier (``modules/perception/ball_classifier.py``) reproducibly.
 
-    python -m tafel.tools.simulation.train_ball_classifier [--scenes 250] [--seed 0] [--real tests/data/real_images] [--out PATH]
+    python -m tafel.tools.simulation.train_ball_classifier [--scenes 250] [--seed 0] [--real FOLDER] [--out PATH]
 
 Data:
 - simulator renders with ground truth (``tools.simulation.scene_frames.SceneRenderer``, MuJoCo): the robot anywhere
-  on the field, the head anywhere, the ball 0.3 to 5 m away, at 640x480 and 320x240. Each image is first
-  made to look like a real camera's (``realistic``: exposure, white balance and colour casts, gamma,
-  vignetting, blur, sensor noise, YUV422 chroma subsampling, JPEG), and most get things painted in that
-  real fields hold and the simulator does not (``distractors``: robots' black joints in white plastic,
-  dark feet of goal frames and tables, legs and shoes); all seeded;
+  on the field, the head anywhere, the ball 0.3 to 5 m away, at 640x480 and 320x240, through the platform's own
+  ``--realism`` (``platforms/realism.py``, ``config/realism.toml``): blocks of ``HALL_SCENES`` scenes in one seeded hall
+  (clutter, nets, carpet green, shadows at full), the levels ``LEVELS`` in turn, each scene with a camera of its own
+  (exposure, white balance, cast, vignetting, noise, motion blur, YUV422, JPEG). Most renders first get things painted
+  in that real fields hold and the simulator does not (``distractors``: robots' black joints in white plastic, dark
+  feet of goal frames and tables, legs and shoes), before the camera sees them; all seeded;
 - every candidate ``SPLBallDetector`` examines in them (its checks' verdict aside) is a row: a ball when
   its centre lies within 0.75 of the true radius of the rendered ball's, none when farther than 1.5 radii
   (between: left out); the true ball itself, its centre (by a quarter radius) and radius (-20 to +35 %) jittered as the
   detector's estimates are, adds positives;
-- real labelled images (``--real``: a folder laid out as ``../shared/real-images``; by default the ones in
-  ``tests/data/real_images`` whose licence allows their use) the same way, each in a few realistic variants.
-  Give only images whose licence allows training on them.
+- real labelled images only where given (``--real``: a folder laid out as ``../shared/real-images``), each in a
+  few variants through a mild ``--realism`` camera. None by default: the only ones the project may train on
+  (``tests/data/real_images``) are images of ``benchmarks/real_images.py``, and a model trained on them is judged on
+  what it learned. Give only images whose licence allows training on them, and none the benchmark uses.
 
 Everything is seeded: the same arguments give the same model. Prints one JSON line (rows, balls,
 training and held-out accuracy, the model's size) and writes the model (default: the shipped one). Needs nothing beyond the project's dependencies and a simulator.
@@ -39,47 +41,32 @@ import numpy as np
 from tafel.modules.perception.ball_classifier import FEATURES, MODEL_PATH, features, train
 from tafel.modules.perception.spl_ball_detector import SPLBallDetector, carpet
 from tafel.platforms.images import posed_image
+from tafel.platforms.realism import CameraRealism, realism_level
 from tafel.representations.motion import CameraMatrix
 from tafel.tools.simulation.scene_frames import LabelledFrame, Perception, random_ball_scene
 
 REPO = Path(__file__).resolve().parents[2]  # tools/simulation/: the checkout, for its test images
+#: the real images in the checkout whose licence allows training: all are images of benchmarks/real_images.py, so
+#: ``--real`` leaves them out unless asked (the pipeline's test uses them as its tiny real data set)
 DEFAULT_REAL = REPO / "tests" / "data" / "real_images"
 RESOLUTIONS = ("640x480", "320x240")
+#: the ``--realism`` levels the renders cycle through, a block of scenes (one hall) each: mostly real cameras, some plain
+LEVELS = ("full", "mild", "full", "off")
+#: scenes rendered in one hall (a world built for each seed) before the next; every scene gets cameras of its own
+HALL_SCENES = 10
+#: focal length of the NAO's cameras in image widths (56.3 degrees across)
+NAO_FOCAL = 0.5 / math.tan(math.radians(56.3) / 2)
 
 
-def realistic(image: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """``image`` (RGB, uint8) as a real NAO camera might deliver it: exposure, white balance and colour
-    cast, gamma, vignetting, blur, noise, YUV422 chroma subsampling and JPEG artefacts, drawn from ``rng``."""
-    out = image.astype(np.float32) / 255.0
-    out *= rng.uniform(0.55, 1.3) * rng.normal(1.0, 0.12, 3).clip(0.7, 1.3)  # exposure and white balance
-    out = np.clip(out, 0.0, 1.0) ** rng.uniform(0.7, 1.4)
-    height, width = out.shape[:2]
-    if rng.random() < 0.5:  # vignetting: darker corners
-        yy, xx = np.mgrid[0:height, 0:width]
-        r2 = ((xx - width / 2) / (width / 2)) ** 2 + ((yy - height / 2) / (height / 2)) ** 2
-        out *= (1.0 - rng.uniform(0.1, 0.5) * r2 / 2.0)[..., None]
-    if rng.random() < 0.4:  # defocus or motion blur
-        if rng.random() < 0.5:
-            out = cv2.GaussianBlur(out, (0, 0), rng.uniform(0.4, 1.2) * width / 640)
-        else:
-            length = max(2, int(rng.uniform(2, 8) * width / 640))
-            kernel = np.zeros((length, length), np.float32)
-            kernel[length // 2, :] = 1.0 / length
-            rotation = cv2.getRotationMatrix2D((length / 2 - 0.5, length / 2 - 0.5), rng.uniform(0, 180), 1.0)
-            kernel = cv2.warpAffine(kernel, rotation, (length, length))
-            out = cv2.filter2D(out, -1, kernel / max(kernel.sum(), 1e-6))
-    out += rng.normal(0.0, rng.uniform(0.0, 0.03), out.shape).astype(np.float32)
-    rgb = (np.clip(out, 0.0, 1.0) * 255.0).astype(np.uint8)
-    if rng.random() < 0.6:  # YUV422: the colour at half the horizontal resolution
-        ycc = cv2.cvtColor(rgb, cv2.COLOR_RGB2YCrCb)
-        for channel in (1, 2):
-            half = cv2.resize(ycc[..., channel], (width // 2, height), interpolation=cv2.INTER_AREA)
-            ycc[..., channel] = cv2.resize(half, (width, height), interpolation=cv2.INTER_LINEAR)
-        rgb = cv2.cvtColor(ycc, cv2.COLOR_YCrCb2RGB)
-    if rng.random() < 0.5:
-        ok, data = cv2.imencode(".jpg", rgb, [cv2.IMWRITE_JPEG_QUALITY, int(rng.uniform(40, 95))])
-        rgb = cv2.imdecode(data, cv2.IMREAD_UNCHANGED) if ok else rgb
-    return rgb
+def camera_like(image: np.ndarray, rng: np.random.Generator, level: str = "full") -> np.ndarray:
+    """``image`` (RGB, uint8) as a camera of the platforms' ``--realism`` ``level`` delivers it (``platforms/realism.py``:
+    exposure, white balance, cast, vignetting, noise, motion blur, YUV422, JPEG), the camera drawn from ``rng``:
+    the one image-degradation code, for images that did not come through a simulated camera (real ones, painted tests)."""
+    settings = realism_level(level)
+    if settings is None:
+        return image
+    pipeline = CameraRealism(settings, int(rng.integers(2**31)), "top")
+    return pipeline(image, pipeline.posed_shift(NAO_FOCAL * image.shape[1]))
 
 
 def distractors(image: np.ndarray, rng: np.random.Generator, ball: tuple[float, float, float] | None,
@@ -178,33 +165,38 @@ def perception_without_classifier() -> Perception:
 
 
 def simulated(collector: Collector, engine: str, scenes: int, seed: int, painted_negatives: bool = False) -> None:
-    """Rows from ``scenes`` random rendered scenes at each resolution; ``painted_negatives``: every painted
-    distractor is a row too, not only those the detector proposes (tried: it made the model timid, recall
-    on real balls fell)."""
+    """Rows from ``scenes`` random rendered scenes at each resolution, through the platform's own camera
+    pipeline and hall (``--realism``, ``LEVELS`` in turn, a hall of its own every ``HALL_SCENES`` scenes and a camera
+    of its own every scene); ``painted_negatives``: every painted distractor is a row too, not only those the
+    detector proposes (tried: it made the model timid, recall on real balls fell)."""
     from tafel.tools.simulation.scene_frames import SceneRenderer
 
     rng = np.random.default_rng(seed)
     for resolution in RESOLUTIONS:
-        with SceneRenderer(engine, resolution) as renderer:
-            perception = perception_without_classifier()
-            made = 0
-            while made < scenes:
-                scene = random_ball_scene(rng)
-                if scene is None:
-                    continue
-                pose, head, ball = scene
-                made += 1
-                views = renderer.frames(pose, head, ball)
-                painted: dict[str, list[tuple[float, float, float]]] = {camera: [] for camera in views}
-                for camera, view in views.items():
-                    if rng.random() < 0.7:
-                        view.image = distractors(view.image, rng, view.ball_image, painted[camera])
-                    view.image = realistic(view.image, rng)
-                for _ in range(2):  # the field colour settles on this frame's light
-                    perception(views)
-                for camera, view in views.items():
-                    truth = view.ball_image if view.ball_image is not None and view.ball_visible >= 0.5 else None
-                    collector.add(perception, camera, truth, group=made, others=painted[camera] if painted_negatives else ())
+        made = 0
+        while made < scenes:
+            level = LEVELS[(made // HALL_SCENES) % len(LEVELS)]
+            with SceneRenderer(engine, resolution, realism=level, seed=int(rng.integers(2**31))) as renderer:
+                perception = perception_without_classifier()
+                for _ in range(min(HALL_SCENES, scenes - made)):
+                    scene = random_ball_scene(rng)
+                    while scene is None:
+                        scene = random_ball_scene(rng)
+                    pose, head, ball = scene
+                    made += 1
+                    renderer.new_cameras(int(rng.integers(2**31)))
+                    painted: dict[str, list[tuple[float, float, float]]] = {"top": [], "bottom": []}
+
+                    def paint(camera: str, image: np.ndarray, circle: tuple[float, float, float] | None,
+                              marks: dict[str, list[tuple[float, float, float]]] = painted) -> np.ndarray:
+                        return distractors(image, rng, circle, marks[camera]) if rng.random() < 0.7 else image
+
+                    views = renderer.frames(pose, head, ball, paint)
+                    for _ in range(2):  # the field colour settles on this frame's light
+                        perception(views)
+                    for camera, view in views.items():
+                        truth = view.ball_image if view.ball_image is not None and view.ball_visible >= 0.5 else None
+                        collector.add(perception, camera, truth, group=made, others=painted[camera] if painted_negatives else ())
 
 
 def real(collector: Collector, folder: Path, variants: int) -> None:
@@ -213,14 +205,16 @@ def real(collector: Collector, folder: Path, variants: int) -> None:
     if not labels.is_file():
         raise SystemExit(f"{folder} has no labels.csv: give a folder laid out as ../shared/real-images, or --real '' for none")
     empty = LabelledFrame("", np.zeros((0, 0, 3), np.uint8), CameraMatrix(), 0.0, 0.0, (0.0, 0.0, 0.0), (0.0, 0.0), 0.0, None, 0.0)
-    for index, row in enumerate(csv.DictReader(labels.open())):
+    with labels.open() as handle:
+        rows = list(csv.DictReader(handle))
+    for index, row in enumerate(rows):
         posed = posed_image(folder / row["image"], camera=row.get("camera") or None)
         for variant in range(variants):
             for resolution in RESOLUTIONS:
                 scale = int(resolution.split("x")[0]) / posed.image.shape[1]
                 image = posed.image if scale == 1.0 else cv2.resize(posed.image, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
-                if variant:
-                    image = realistic(image, collector.rng)
+                if variant:  # a real image through another camera still: the mild level, on top of its own
+                    image = camera_like(image, collector.rng, "mild")
                 view = LabelledFrame(posed.camera, image, posed.matrix, posed.horizontal_fov, posed.vertical_fov, (0.0, 0.0, 0.0),
                                      (0.0, 0.0), 0.0, None, 0.0)
                 perception = perception_without_classifier()
@@ -233,17 +227,30 @@ def real(collector: Collector, folder: Path, variants: int) -> None:
                 collector.add(perception, posed.camera, truth, group=-1 - index)
 
 
-def main(argv: list[str] | None = None) -> None:
+def labelled_images(folder: Path) -> list[str]:
+    """The images (paths below ``folder``) that ``folder``'s labels.csv lists: what ``real`` trains on."""
+    with (folder / "labels.csv").open() as labels:
+        return [row["image"] for row in csv.DictReader(labels)]
+
+
+def arguments() -> argparse.ArgumentParser:
+    """The command line: what the data and the network are."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--scenes", type=int, default=250, help="random rendered scenes per resolution (both cameras each)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--engine", default="mujoco", help="the simulator that renders (mujoco or pybullet)")
-    parser.add_argument("--real", default=str(DEFAULT_REAL), help="labelled real images (labels.csv); '' for none")
+    parser.add_argument("--real", default="", help="labelled real images (labels.csv), none by default: the only ones the "
+                        "project may train on (tests/data/real_images) are benchmark images, and training on them is training on the test")
     parser.add_argument("--real-variants", type=int, default=6, help="realistic versions of each real image")
     parser.add_argument("--painted-negatives", action="store_true", help="every painted distractor as a row, not only those proposed")
     parser.add_argument("--hidden", type=int, default=24, help="hidden units of the network")
     parser.add_argument("--epochs", type=int, default=600, help="full-batch training steps")
     parser.add_argument("--out", default=str(MODEL_PATH), help="where the model is written (.npz)")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = arguments()
     args = parser.parse_args(argv)
     if args.scenes < 0 or args.real_variants < 1:
         parser.error("--scenes must be 0 or more and --real-variants 1 or more")
