@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
@@ -70,6 +70,9 @@ class SPLBallDetector(Module):
       Real light needs the field as the measure: the ball's black patches are darker than the carpet
       around it (``black_contrast``); dark image corners, shadows and the hall's dark floor are
       uniformly dark and have no patches darker than the carpet beside them.
+    - Second look: a small ball smeared by the head's turn has grey patches, not black ones, and a cast gives
+      its white a little colour; a candidate that fails only so passes looser checks (``second_*``) and is a
+      ball if the classifier is sure of it (``second_look_min``).
     """
 
     camera_image_top: CameraImageTop
@@ -118,6 +121,17 @@ class SPLBallDetector(Module):
         """the classifier's score (a logit) a ball needs (higher: fewer false balls, more missed ones)"""
         classifier_at_edge: bool = False
         """the classifier also decides candidates whose square reaches out of the image"""
+        second_look: bool = True
+        """a candidate that fails the checks only by faint black patches or a little colour (a small ball blurred by the
+        head's turn, in a colour cast) is a ball if it passes looser ones and the classifier is sure (``second_look_min``)"""
+        second_dark_ratio: float = bounded(0.1, 1.0, 0.6)
+        """the looser checks: a pixel is dark below this share of the bright pixels' value ..."""
+        second_black_contrast: float = bounded(0.1, 1.5, 0.85)
+        """... the black patches darker than this share of the carpet's value ..."""
+        second_saturation_max: float = bounded(0.0, 255.0, 90.0)
+        """... and this mean saturation inside at most"""
+        second_look_min: float = bounded(-5.0, 10.0, 3.0)
+        """the classifier's score (a logit) a candidate that passed only the looser checks needs"""
 
     parameters: Parameters
 
@@ -156,6 +170,8 @@ class SPLBallDetector(Module):
                     if score and self.parameters.classifier:
                         light = light or carpet(hsv, green, sampled)
                         score = self.classify(hsv, green, spot, score, light)
+                    elif not score and not under_post and self.parameters.classifier and self.parameters.second_look:
+                        score = self.second_look(hsv, green, spot, white, sampled)
                     if self.draw_candidates:
                         self.draw_candidates.canvas(Canvas.image(camera)).circle(spot.x, spot.y, spot.radius, color="blue" if score else "gray")
                     if score:
@@ -174,6 +190,26 @@ class SPLBallDetector(Module):
             return score
         row = features(hsv, green, spot.x, spot.y, spot.radius, *(light or carpet(hsv, green)))
         return score if float(self.model.scores(row)[0]) >= self.parameters.classifier_min else 0.0
+
+    def second_look(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, sampled: np.ndarray | None = None) -> float:
+        """A score if ``spot``, which failed the checks, passes the looser ones (``second_*``) and the classifier takes
+        it for a ball with a score of ``second_look_min`` at least; else 0. A small ball blurred by the head's turn has
+        grey, not black, patches, and a colour cast gives its white some colour: the checks alone would take dark
+        corners and robots' joints then, the classifier tells them apart. Not at the image's edge, where the
+        classifier does not decide."""
+        p = self.parameters
+        height, width = green.shape
+        side = 1.1 * spot.radius
+        if not (side <= spot.x <= width - side and side <= spot.y <= height - side):
+            return 0.0
+        loose = replace(p, dark_ratio=p.second_dark_ratio, black_contrast=p.second_black_contrast, saturation_max=p.second_saturation_max)
+        score = self.check(hsv, green, spot, white, parameters=loose)[0]
+        if not score:
+            return 0.0
+        if self.model is None:
+            self.model = BallClassifier()
+        row = features(hsv, green, spot.x, spot.y, spot.radius, *carpet(hsv, green, sampled))
+        return score if float(self.model.scores(row)[0]) >= p.second_look_min else 0.0
 
     def dark_pixels(self, hsv: np.ndarray, green: np.ndarray, sampled: np.ndarray | None = None) -> np.ndarray | None:
         """Pixels darker than ``black_contrast`` times the carpet's median value (the ball's black patches
@@ -331,11 +367,13 @@ class SPLBallDetector(Module):
             free[start:] &= (xs[start:] - spot.x) ** 2 + (ys[start:] - spot.y) ** 2 > (spot.expected * 1.5) ** 2
         return chosen
 
-    def check(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, beside_post: bool = False) -> tuple[float, bool]:
+    def check(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, beside_post: bool = False,
+              parameters: Parameters | None = None) -> tuple[float, bool]:
         """(0 if the spot is no ball, else a score in (0, 1]: how well it fits; whether a post rises over
         it). ``white``: the value (V) of the image's brightest non-green pixels. ``beside_post``: the
-        spot was moved off a post already (its edge may still be in the way above)."""
-        p = self.parameters
+        spot was moved off a post already (its edge may still be in the way above). ``parameters``: other
+        thresholds than the module's (``second_look``)."""
+        p = parameters or self.parameters
         height, width = green.shape
         r = spot.radius
         reach = int(math.ceil(r * 1.7)) + 1
