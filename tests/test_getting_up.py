@@ -35,9 +35,6 @@ TURN_MOMENTS = [0.57 + 0.08 * i for i in range(10)]
 
 @pytest.mark.slow
 @pytest.mark.parametrize("engine", ENGINES)
-@pytest.mark.xfail(strict=True, reason="issue 36: WalkingEngine keeps its step adjustment's reference tilt and rates from "
-                   "before the fall (it stepped on while the robot lay), so its first steps after a get-up lunge; the fix "
-                   "belongs to modules/motion/walking_engine.py (reset them at rest), not to the get-up")
 def test_after_getting_up_from_the_back_the_walk_goes_on_without_falling(engine: str) -> None:
     """The striker searching for the ball turns in place; laid on its back at moments across its steps, it
     gets up and turns on: ground truth must see it stay upright for 2 s after standing, every time (this is

@@ -128,16 +128,7 @@ def wait_until_standing(robot: Robot, seconds: float) -> None:
 @pytest.mark.alone
 @pytest.mark.slow
 @pytest.mark.parametrize("side", ["front", "back"])
-def test_getting_up_from_lying(robot: Robot, side: str, request: pytest.FixtureRequest) -> None:
-    if side == "back" and "mujoco" in request.node.name:
-        # a known defect (issue 36): in MuJoCo the robot sometimes stands up from its back and falls back
-        # within 2 s (2 of 4 full runs on 2026-11-26); still run, reported as XPASS when it holds. The cause is
-        # the walk that follows (the striker turns to search the ball): WalkingEngine starts with its step
-        # adjustment's reference tilt and rates from before the fall, so its first steps lunge and throw the
-        # robot onto its back; made repeatable in test_getting_up.py (strict xfail until the walk resets them)
-        request.applymarker(pytest.mark.xfail(reason="MuJoCo: the walk after getting up from the back sometimes throws the "
-                                              "robot over (stale step adjustment state in WalkingEngine, issue 36)",
-                                              strict=False))
+def test_getting_up_from_lying(robot: Robot, side: str) -> None:
     here = robot.status()
     robot.ask(f"sim:move_robot -x {here['x']:.0f} -y {here['y']:.0f} -lying {side}")
     wait_until_standing(robot, 15.0)

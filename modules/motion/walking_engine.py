@@ -396,6 +396,10 @@ class WalkingEngine(Module):
         self.phase_s = 0.0
         self.started = False
         self.adjust = np.zeros(2)
+        # standing still is the undisturbed tilt: a fall and get-up while not walking must not leave the
+        # step adjustment a stale tilt or rate (it lunged the first step after a get-up)
+        self.reference = np.asarray(self.inertial_sensor_data.angles[:2], dtype=float).copy()
+        self.rates = np.zeros(2)
         self.kick = None
         self.set_joints(Foot.right, 0.0, 0.0, 0.0)
         out.standing, out.step_phase, out.kicking = True, 0.0, False
