@@ -200,3 +200,18 @@ def random_ball_scene(rng: np.random.Generator) -> tuple[tuple[float, float, flo
     if abs(ball[0]) > 4800 or abs(ball[1]) > 3300:
         return None
     return pose, head, ball
+
+
+def random_far_ball_scene(rng: np.random.Generator, near: float = 4500.0, far: float = 9000.0
+                          ) -> tuple[tuple[float, float, float], tuple[float, float], tuple[float, float]] | None:
+    """A seeded random scene with the ball far away: the ball anywhere on the field, the robot anywhere ``near`` to ``far``
+    mm from it, turned roughly towards it, its head looking about level (where the top camera sees far balls); pose
+    (mm, rad), head (yaw, pitch; rad), ball (field mm), or None when the distance does not fit (draw again)."""
+    ball = (rng.uniform(-spl.LENGTH / 2, spl.LENGTH / 2), rng.uniform(-spl.WIDTH / 2, spl.WIDTH / 2))
+    x, y = rng.uniform(-4300, 4300), rng.uniform(-2800, 2800)
+    distance = math.hypot(ball[0] - x, ball[1] - y)
+    if not near <= distance <= far:
+        return None
+    head = (rng.uniform(-0.8, 0.8), rng.uniform(-0.3, 0.3))
+    heading = math.atan2(ball[1] - y, ball[0] - x) - head[0] + rng.normal(0.0, 0.35)
+    return (x, y, math.remainder(heading, math.tau)), head, ball
