@@ -199,3 +199,22 @@ def test_a_robot_out_of_view_is_still_walked_round_for_a_while() -> None:
     harness.set(RobotsPercept(robots=[]))
     harness.execute(45)  # 1.5 s at 30 Hz
     assert len(harness[Obstacles].obstacles) == 1
+
+
+@pytest.mark.parametrize("start", [(2500.0, 200.0, math.pi), (600.0, -100.0, 0.0), (3000.0, 2000.0, 2.0)])
+def test_in_ready_from_the_opponent_half_it_crosses_the_halfway_line_first_beside_the_centre(start: tuple[float, float, float]) -> None:
+    """After a goal the striker walks back from near the opponent goal; the straight way runs through the
+    centre, where the other team's kick-off places are: before, it was still in the other half at SET
+    (penalized) when it had to walk round them."""
+    pose = RobotPose(valid=True, x=start[0], y=start[1], rotation=start[2])
+    game = team_game(State.ready, 2, 2)
+    harness = ModuleHarness(SoccerBehavior, game, PlayerRole(role=Role.striker), pose, BallModel(), TeamMates(), MotionInfo(), Obstacles())
+    out = harness.execute()[MotionRequest]
+    assert out.motion is MotionType.walk_to
+    x, y = pose.to_field(out.target_x, out.target_y)
+    assert x < 0.0 and abs(y) >= 1250.0 - 1e-6  # into the own half, beside the centre circle (and the kick-off places)
+    assert abs(y - start[1]) <= max(0.0, 1250.0 - abs(start[1])) + 1e-6  # on its own side: no walk across the field
+    back = RobotPose(valid=True, x=-400.0, y=math.copysign(1250.0, start[1]))  # once over the line: to its place
+    harness.set(back)
+    out = harness.execute()[MotionRequest]
+    assert back.to_field(out.target_x, out.target_y) == pytest.approx((-1000.0, 0.0), abs=1e-6)

@@ -32,6 +32,10 @@ FREE_KICK_S = 30.0  # s: then the set play is over, touched or not (the GameCont
 KICK_OFF_S = 10.0  # s of PLAYING the defending team stays out of the centre circle, unless the ball moved
 BALL_MOVED = 200.0  # mm from the centre spot: the kick-off ball has moved
 LOST_TURN = 0.3  # rad/s: turning (the head looks around) while the robot does not know where it is
+#: READY from the opponent half: the robot crosses the halfway line first (to CROSSED mm into the own half), at
+#: least CROSS_BESIDE mm beside the centre, where the other team's kick-off places stand: in SET a robot in the
+#: other half is penalized
+CROSSED, CROSS_BESIDE = 250.0, pitch.CENTER_CIRCLE_DIAMETER / 2 + 500.0
 
 
 class GoTo(Option["SoccerBehavior"]):
@@ -283,13 +287,18 @@ class ReadyPosition(Option["SoccerBehavior"]):
 
     @state(initial=True)
     def kick_off(self, b: SoccerBehavior) -> None:
-        """The role's place in the own half; the striker nearer the centre when its team kicks off."""
+        """The role's place in the own half; the striker nearer the centre when its team kicks off. From the
+        opponent half, over the halfway line first, beside the centre circle (``CROSS_BESIDE``)."""
         game, role, p = b.game_state, b.player_role.role, b.parameters
         kicking_off = role is Role.striker and game.kicking_team == game.team_number
         name = "striker_kicking_off" if kicking_off else role.name if role is not Role.none else "defender"
         x, y, rotation = getattr(p, f"ready_{name}")
         if name == "defender":  # two defenders: one on each side (even numbers where configured)
             y *= b.defender_side()
+        pose = b.robot_pose
+        if pose.valid and pose.x > -CROSSED:  # in the opponent half: over the halfway line first, beside the centre
+            side = math.copysign(max(abs(pose.y), CROSS_BESIDE), pose.y if pose.y else y or 1.0)
+            x, y, rotation = -2 * CROSSED, side, math.atan2(side - pose.y, -2 * CROSSED - pose.x)
         self.go([x, y, rotation])
 
     @state
