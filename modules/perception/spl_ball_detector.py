@@ -50,6 +50,8 @@ class Spot:
     y: float
     radius: float
     expected: float
+    edge: bool = False
+    """found by ``edge_spots`` (the field's edge, where the hall behind is)"""
 
 
 @requires(CameraImageTop, CameraImageBottom, SegmentedImage, FieldColor, FieldBoundary, CameraMatrixBuffer)
@@ -132,6 +134,27 @@ class SPLBallDetector(Module):
         """... and this mean saturation inside at most"""
         second_look_min: float = bounded(-5.0, 10.0, 3.0)
         """the classifier's score (a logit) a candidate that passed only the looser checks needs"""
+        edge_search: bool = True
+        """far balls on the field's edge: also look for ball-coloured blobs in a band round the field boundary"""
+        edge_above: int = bounded(0, 60, 14)
+        """px above the field boundary the band reaches (a far ball lies on the edge and reaches over it) ..."""
+        edge_below: int = bounded(0, 60, 20)
+        """... and px below it"""
+        edge_max_radius: float = bounded(1.0, 30.0, 9.0)
+        """px: the band looks only for balls at most this large (nearer ones stand out on the green)"""
+        edge_white: float = bounded(0.5, 3.0, 1.1)
+        """in the band, ball white is brighter than this share of the carpet's value ..."""
+        edge_black: float = bounded(0.05, 1.0, 0.5)
+        """... and ball black darker than this share; between is the hall, which is no ball"""
+        edge_max_spots: int = bounded(0, 20, 6)
+        """candidates from the band checked per image, beside ``max_spots``"""
+        edge_green_below: float = bounded(0.0, 1.0, 0.6)
+        """the carpet's share of the lower half of the ring round a candidate from the band (a ball lies on the carpet)"""
+        edge_white_halves: float = bounded(0.0, 1.0, 0.3)
+        """the share of white a candidate from the band needs in each of its left and right halves"""
+        edge_classifier_min: float = bounded(-5.0, 10.0, 2.0)
+        """the classifier's score (a logit) a candidate from the band needs (the hall behind holds more that is no ball);
+        the band's candidates whose square reaches out of the image are none"""
 
     parameters: Parameters
 
@@ -152,8 +175,11 @@ class SPLBallDetector(Module):
             with self.image:
                 hsv, green = self.segmented_image.hsv(camera), self.segmented_image.green(camera)
                 sampled = carpet_sample(hsv, green)  # one sample of the carpet for every measure of the light below
-                spots = self.spots(self.strict_green(hsv, green, sampled), self.field_boundary.rows(camera), projection,
-                                   self.dark_pixels(hsv, green, sampled))
+                strict = self.strict_green(hsv, green, sampled)
+                boundary = self.field_boundary.rows(camera)
+                spots = self.spots(strict, boundary, projection, self.dark_pixels(hsv, green, sampled))
+                if self.parameters.edge_search and len(sampled) >= 10:
+                    spots += self.edge_spots(hsv, strict, boundary, projection, byte_median(sampled[:, 2]), spots)
                 white = self.segmented_image.white(camera)
                 light: tuple[float, float] | None = None
                 for spot in spots:
@@ -186,10 +212,17 @@ class SPLBallDetector(Module):
         assert self.model is not None
         height, width = green.shape
         side = 1.1 * spot.radius  # the classifier's square round the spot
-        if not self.parameters.classifier_at_edge and not (side <= spot.x <= width - side and side <= spot.y <= height - side):
-            return score
+        if not (side <= spot.x <= width - side and side <= spot.y <= height - side):
+            return 0.0 if spot.edge else score if not self.parameters.classifier_at_edge else self.decide(hsv, green, spot, score, light)
+        return self.decide(hsv, green, spot, score, light)
+
+    def decide(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, score: float, light: tuple[float, float] | None) -> float:
+        """``score`` if the classifier's score reaches ``classifier_min`` (``edge_classifier_min`` for the band's
+        candidates), else 0."""
+        assert self.model is not None
         row = features(hsv, green, spot.x, spot.y, spot.radius, *(light or carpet(hsv, green)))
-        return score if float(self.model.scores(row)[0]) >= self.parameters.classifier_min else 0.0
+        least = self.parameters.edge_classifier_min if spot.edge else self.parameters.classifier_min
+        return score if float(self.model.scores(row)[0]) >= least else 0.0
 
     def second_look(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, sampled: np.ndarray | None = None) -> float:
         """A score if ``spot``, which failed the checks, passes the looser ones (``second_*``) and the classifier takes
@@ -367,6 +400,109 @@ class SPLBallDetector(Module):
             free[start:] &= (xs[start:] - spot.x) ** 2 + (ys[start:] - spot.y) ** 2 > (spot.expected * 1.5) ** 2
         return chosen
 
+    def edge_spots(self, hsv: np.ndarray, green: np.ndarray, boundary: np.ndarray, projection: ImageProjection, carpet_value: float,
+                   taken: list[Spot]) -> list[Spot]:
+        """Far balls on the field's edge: there a ball reaches over the carpet into the hall, whose non-green merges with it
+        in ``spots``' distance transform. In a band round the boundary only ball-coloured pixels count (white: brighter
+        than the carpet, without colour; black: far darker than it), so the hall's middle greys part the ball from what
+        is behind it; peaks of their distance transform whose thickness fits a small ball there, with black pixels
+        near, away from the spots ``taken`` already."""
+        p = self.parameters
+        height, width = green.shape
+        if boundary.size != width:
+            return []
+        top = max(0, int(boundary.min()) - p.edge_above)
+        bottom = min(height, int(boundary.max()) + p.edge_below + 1)
+        if bottom - top < 3:
+            return []
+        rows = np.arange(top, bottom)[:, None]
+        band = (rows >= boundary[None, :] - p.edge_above) & (rows <= boundary[None, :] + p.edge_below)
+        value, saturation = hsv[top:bottom, :, 2], hsv[top:bottom, :, 1]
+        black = value <= p.edge_black * carpet_value
+        white = (value >= p.edge_white * carpet_value) & (saturation <= p.saturation_max)
+        ballish = (cv2.morphologyEx(((white | black) & ~green[top:bottom]).view(np.uint8), cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8))
+                   & band.view(np.uint8))
+        if not ballish.any():
+            return []
+        thickness = cv2.distanceTransform(ballish, cv2.DIST_L2, 3)
+        peaks = (thickness >= p.min_radius) & (thickness >= cv2.dilate(thickness, np.ones((3, 3), np.uint8)))
+        index = np.flatnonzero(peaks)
+        if len(index) == 0:
+            return []
+        ys, xs = np.divmod(index, width)
+        radii = thickness.ravel()[index]
+        centres, hits = projection.to_ground(xs, ys + top, BALL_RADIUS)
+        points = np.column_stack([centres, np.full(len(xs), BALL_RADIUS)])
+        distance = np.linalg.norm(points - projection.translation, axis=1)
+        expected = np.where(hits, projection.fx * BALL_RADIUS / np.maximum(distance, 1.0), 0.0)
+        fits = hits & (expected <= p.edge_max_radius) & (radii >= p.size_low * expected) & (radii <= p.size_high * expected + 1.0)
+        if not fits.any():
+            return []
+        xs, ys, radii, expected = xs[fits], ys[fits], radii[fits], expected[fits]
+        patched = self.dark_share(black, xs, ys, np.maximum(radii, 1.0)) >= p.dark_spot_min
+        xs, ys, radii, expected = xs[patched], ys[patched] + top, radii[patched], expected[patched]
+        order = np.argsort(np.abs(np.log(np.maximum(radii, 0.5) / np.maximum(expected, 0.5))))
+        chosen: list[Spot] = []
+        for i in order:
+            x, y, r, e = float(xs[i]), float(ys[i]), float(radii[i]), float(expected[i])
+            if any((x - s.x) ** 2 + (y - s.y) ** 2 <= (max(s.expected, e) * 1.5) ** 2 for s in (*taken, *chosen)):
+                continue
+            for _ in range(2):  # the peak lies off the centre of a ball this small: the centroid of its pixels round it
+                x, y = self.centroid(ballish, x, y - top, e)
+                y += top
+            if self.green_below(green, x, y, e) < p.edge_green_below:
+                continue  # not on the carpet: a shoe or a box on the hall's floor beyond it
+            if self.white_halves(value, x, y - top, e) < p.edge_white_halves:
+                continue  # white beside black, not black among white: a pair of shoes, a white box with a dark one
+            chosen.append(Spot(x, y, max(r, e), e, edge=True))
+            if len(chosen) >= p.edge_max_spots:
+                break
+        return chosen
+
+    @staticmethod
+    def green_below(green: np.ndarray, x: float, y: float, radius: float) -> float:
+        """The carpet's share of the lower half of the ring 1.2 to 1.7 radii round (x, y): a ball lies on the carpet."""
+        height, width = green.shape
+        reach = int(math.ceil(1.7 * radius)) + 1
+        x0, x1 = max(0, int(x) - reach), min(width, int(x) + reach + 1)
+        y0, y1 = max(0, int(y)), min(height, int(y) + reach + 1)
+        if x1 <= x0 or y1 <= y0:
+            return 0.0
+        yy, xx = np.mgrid[y0:y1, x0:x1]
+        d = np.hypot(xx - x, yy - y)
+        ring = (d >= 1.2 * radius) & (d <= 1.7 * radius) & (yy > y)
+        return float(green[y0:y1, x0:x1][ring].mean()) if ring.any() else 0.0
+
+    @staticmethod
+    def white_halves(value: np.ndarray, x: float, y: float, radius: float) -> float:
+        """The lesser share of white (at least 0.6 of the brightest) in the left and the right half of the disc of
+        ``radius`` round (x, y) in the value image: a ball's black patches lie among its white, on both sides."""
+        height, width = value.shape
+        reach = int(math.ceil(radius))
+        x0, x1 = max(0, int(round(x)) - reach), min(width, int(round(x)) + reach + 1)
+        y0, y1 = max(0, int(round(y)) - reach), min(height, int(round(y)) + reach + 1)
+        yy, xx = np.mgrid[y0:y1, x0:x1]
+        disc = (xx - x) ** 2 + (yy - y) ** 2 <= radius**2
+        patch = value[y0:y1, x0:x1]
+        if not disc.any():
+            return 0.0
+        white = patch >= 0.6 * float(patch[disc].max())
+        shares = [float(white[disc & side].mean()) for side in (xx < x, xx > x) if (disc & side).any()]
+        return min(shares) if len(shares) == 2 else 0.0
+
+    @staticmethod
+    def centroid(mask: np.ndarray, x: float, y: float, radius: float) -> tuple[float, float]:
+        """The centroid of ``mask``'s pixels within ``radius`` (px) of (x, y); (x, y) if there are none."""
+        height, width = mask.shape
+        reach = int(math.ceil(radius))
+        x0, x1 = max(0, int(round(x)) - reach), min(width, int(round(x)) + reach + 1)
+        y0, y1 = max(0, int(round(y)) - reach), min(height, int(round(y)) + reach + 1)
+        yy, xx = np.mgrid[y0:y1, x0:x1]
+        near = (mask[y0:y1, x0:x1] > 0) & ((xx - x) ** 2 + (yy - y) ** 2 <= radius**2)
+        if not near.any():
+            return x, y
+        return float(xx[near].mean()), float(yy[near].mean())
+
     def check(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, beside_post: bool = False,
               parameters: Parameters | None = None) -> tuple[float, bool]:
         """(0 if the spot is no ball, else a score in (0, 1]: how well it fits; whether a post rises over
@@ -417,8 +553,12 @@ class SPLBallDetector(Module):
     def post_columns(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float) -> tuple[int, np.ndarray]:
         """(first column, flags): for the columns within three radii of the spot, whether something white
         rises above the spot's row there (a goal post, or a robot's leg), judged on the rows 1.5 to 4
-        radii above it."""
+        radii above it. White is measured against the brighter of ``white`` and the spot's own white: where the
+        image's white is taken too low, the hall's grey behind a far ball would be a post."""
         p = self.parameters
+        r = max(1, int(spot.radius))
+        own = hsv[max(0, int(spot.y) - r) : int(spot.y) + r + 1, max(0, int(spot.x) - r) : int(spot.x) + r + 1, 2]
+        white = max(white, float(own.max())) if own.size else white
         x0, x1 = max(0, int(spot.x - 3 * spot.radius)), min(green.shape[1], int(spot.x + 3 * spot.radius) + 1)
         y0, y1 = int(max(0, spot.y - 4 * spot.radius)), int(max(0, spot.y - 1.5 * spot.radius))
         if y1 - y0 < 2 or x1 <= x0:
