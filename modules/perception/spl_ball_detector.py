@@ -152,7 +152,7 @@ class SPLBallDetector(Module):
         """the carpet's share of the lower half of the ring round a candidate from the band (a ball lies on the carpet)"""
         edge_white_halves: float = bounded(0.0, 1.0, 0.3)
         """the share of white a candidate from the band needs in each of its left and right halves"""
-        edge_classifier_min: float = bounded(-5.0, 10.0, 2.0)
+        edge_classifier_min: float = bounded(-5.0, 10.0, 3.0)
         """the classifier's score (a logit) a candidate from the band needs (the hall behind holds more that is no ball);
         the band's candidates whose square reaches out of the image are none"""
 
@@ -411,6 +411,11 @@ class SPLBallDetector(Module):
         height, width = green.shape
         if boundary.size != width:
             return []
+        columns = np.linspace(0, width - 1, 9).astype(int)  # a ball on the edge would be too large for the band here?
+        centres, hits = projection.to_ground(columns, np.minimum(boundary[columns], height - 1), BALL_RADIUS)
+        ranges = np.linalg.norm(np.column_stack([centres, np.full(len(columns), BALL_RADIUS)]) - projection.translation, axis=1)
+        if not (hits & (projection.fx * BALL_RADIUS / np.maximum(ranges, 1.0) <= p.edge_max_radius)).any():
+            return []  # the bottom camera, or the top one looking down: the edge is near, its balls stand out on the green
         top = max(0, int(boundary.min()) - p.edge_above)
         bottom = min(height, int(boundary.max()) + p.edge_below + 1)
         if bottom - top < 3:
