@@ -448,7 +448,7 @@ class SPLBallDetector(Module):
         xs, ys, radii, expected = xs[patched], ys[patched] + top, radii[patched], expected[patched]
         order = np.argsort(np.abs(np.log(np.maximum(radii, 0.5) / np.maximum(expected, 0.5))))
         chosen: list[Spot] = []
-        for i in order[: 4 * p.edge_max_spots]:  # the best fitting few: a noisy hall has thousands of peaks
+        for i in order[: 10 * p.edge_max_spots]:  # the best fitting few: a noisy hall has thousands of peaks
             x, y, r, e = float(xs[i]), float(ys[i]), float(radii[i]), float(expected[i])
             if any((x - s.x) ** 2 + (y - s.y) ** 2 <= (max(s.expected, e) * 1.5) ** 2 for s in (*taken, *chosen)):
                 continue
