@@ -198,7 +198,7 @@ def test_every_plot_has_its_own_labelled_axis_and_a_read_out_under_the_mouse(pag
         assert axis["widest"] <= axis["size"], axis  # negative labels fit their axis
     box = page.locator("[data-view=plots] .u-over").bounding_box()
     page.mouse.move(box["x"] + box["width"] * 0.7, box["y"] + box["height"] / 2)
-    readout = wait_for(page, """(() => { const values = [...document.querySelectorAll('[data-view=plots] .u-legend .u-series')]
+    readout = wait_for(page, r"""(() => { const values = [...document.querySelectorAll('[data-view=plots] .u-legend .u-series')]
       .slice(1).map((row) => row.querySelector('.u-value')?.textContent); return values.length && values.every((v) => /\d/.test(v)) && values; })()""")
     assert len(readout) == count
     legend = page.locator("[data-view=plots] .u-legend").bounding_box()
