@@ -46,7 +46,9 @@ import math
 import os
 import sys
 import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -68,32 +70,43 @@ KIDNAP_BALL = (-2500.0, 800.0)  # within 4 m of each of them
 KIDNAPS_PER_SEED = 10  # kidnappings anywhere per seed
 
 
+def judged_scenes(renderer: SceneRenderer, perception: Perception, frames: int, seed: int,
+                  make_scene: Callable[[np.random.Generator], Any],
+                  prepare: Callable[[dict[str, Any]], None] | None = None) -> Iterator[tuple[float, dict[str, Any], BallPercept, bool]]:
+    """``frames`` seeded scenes from ``make_scene``, rendered and perceived, each judged against ground truth:
+    (the ball's distance in mm, the views, the BallPercept, whether the percept is on the true ball).
+    ``prepare`` may change the views before perception (the far part scales the bottom image down)."""
+    rng = np.random.default_rng(seed)
+    scenes = 0
+    while scenes < frames:
+        scene = make_scene(rng)
+        if scene is None:
+            continue
+        pose, head, ball = scene
+        scenes += 1
+        views = renderer.frames(pose, head, ball)
+        if prepare is not None:
+            prepare(views)
+        percept = perception(views)[BallPercept]
+        distance = math.hypot(ball[0] - pose[0], ball[1] - pose[1])
+        truth = views["top"].ball  # the same robot-frame position for both cameras
+        close = math.hypot(percept.x - truth[0], percept.y - truth[1]) < max(150.0, 0.1 * distance)
+        in_view = max(v.ball_pixels for v in views.values()) > 0
+        yield distance, views, percept, close and in_view
+
+
 def ball_detection(engine: str, frames: int, seed: int = 0, realism: str = "off") -> dict[str, float]:
     """Precision and recall of the whole ball pipeline (SPLBallDetector, BallLocator) on rendered scenes,
     plain or as a real camera sees them (``realism``: the platform's ``--realism`` level)."""
     true_positive = false_positive = shown = found = 0
     with SceneRenderer(engine, realism=realism, seed=seed) as renderer:
-        perception = Perception()
-        rng = np.random.default_rng(seed)
-        scenes = 0
-        while scenes < frames:
-            scene = random_ball_scene(rng)
-            if scene is None:
-                continue
-            pose, head, ball = scene
-            distance = math.hypot(ball[0] - pose[0], ball[1] - pose[1])
-            scenes += 1
-            views = renderer.frames(pose, head, ball)
-            percept = perception(views)[BallPercept]
-            truth = views["top"].ball  # the same robot-frame position for both cameras
-            close = math.hypot(percept.x - truth[0], percept.y - truth[1]) < max(150.0, 0.1 * distance)
-            in_view = max(v.ball_pixels for v in views.values()) > 0
+        for distance, views, percept, right in judged_scenes(renderer, Perception(), frames, seed, random_ball_scene):
             if percept.seen:
-                true_positive += close and in_view
-                false_positive += not (close and in_view)
+                true_positive += right
+                false_positive += not right
             if distance <= 4000.0 and max(v.ball_visible for v in views.values()) >= 0.5:
                 shown += 1
-                found += percept.seen and close
+                found += percept.seen and right
     return {"ball_frames": frames, "ball_frames_showing_a_ball": shown, "ball_precision": round(true_positive / max(1, true_positive + false_positive), 4),
             "ball_recall": round(found / max(1, shown), 4), "ball_false_positives": false_positive}
 
@@ -107,35 +120,23 @@ def far_ball_detection(engine: str, frames: int, seed: int = 0, realism: str = "
     detector_ms: list[float] = []
     bands = (4500.0, 6000.0, 7500.0, 9001.0)  # recall by distance: 4.5-6, 6-7.5, 7.5-9 m
     shown_in, found_in = [0] * (len(bands) - 1), [0] * (len(bands) - 1)
+    def scaled_bottom(views: dict[str, Any]) -> None:
+        views["bottom"].image = cv2.resize(views["bottom"].image, (320, 240), interpolation=cv2.INTER_AREA)
+
     with SceneRenderer(engine, resolution="640x480", realism=realism, seed=seed) as renderer:
         perception = Perception()
-        rng = np.random.default_rng(seed)
-        scenes = 0
-        while scenes < frames:
-            scene = random_far_ball_scene(rng)
-            if scene is None:
-                continue
-            pose, head, ball = scene
-            scenes += 1
-            views = renderer.frames(pose, head, ball)
-            bottom = views["bottom"]
-            bottom.image = cv2.resize(bottom.image, (320, 240), interpolation=cv2.INTER_AREA)
-            percept = perception(views)[BallPercept]
+        for distance, views, percept, right in judged_scenes(renderer, perception, frames, seed, random_far_ball_scene, scaled_bottom):
             names, times = perception.manager.last_times_ms()
             detector_ms.append(times[names.index("SPLBallDetector")])
-            top = views["top"]
-            distance = math.hypot(ball[0] - pose[0], ball[1] - pose[1])
-            close = math.hypot(percept.x - top.ball[0], percept.y - top.ball[1]) < max(150.0, 0.1 * distance)
-            in_view = max(v.ball_pixels for v in views.values()) > 0
             if percept.seen:
-                true_positive += close and in_view
-                false_positive += not (close and in_view)
-            if top.ball_visible >= 0.5:
+                true_positive += right
+                false_positive += not right
+            if views["top"].ball_visible >= 0.5:
                 shown += 1
-                found += percept.seen and close
+                found += percept.seen and right
                 band = min(len(shown_in) - 1, max(0, int(np.searchsorted(bands, distance, side="right")) - 1))
                 shown_in[band] += 1
-                found_in[band] += percept.seen and close
+                found_in[band] += percept.seen and right
     return {"ball_far_frames": frames, "ball_far_frames_showing_a_ball": shown,
             "ball_far_precision": round(true_positive / max(1, true_positive + false_positive), 4),
             "ball_far_recall": round(found / max(1, shown), 4), "ball_far_false_positives": false_positive,
