@@ -16,6 +16,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from tafel.platforms.realism import RealismLevel
 from tafel.representations import field
 from tafel.representations.field import circle_segments, goal_post_positions, line_segments, mark_centres
 
@@ -237,6 +238,21 @@ def scene_look(seed: int, greens: list[tuple[float, float, float]], texture: flo
     """The scene of run ``seed``: one of ``greens`` for the carpet, the rest as the level says."""
     green = greens[int(np.random.default_rng([seed, 59]).integers(len(greens)))]
     return SceneLook(seed=seed, carpet=tuple(float(c) for c in green), texture=texture, clutter=clutter, nets=nets)  # type: ignore[arg-type]
+
+
+def level_look(seed: int, level: RealismLevel | None) -> SceneLook | None:
+    """The scene of run ``seed`` at a ``--realism`` level (None: the plain scene)."""
+    if level is None:
+        return None
+    return scene_look(seed, level.carpet_greens, level.carpet_texture, level.hall_clutter, level.goal_nets)
+
+
+def carpet_texture_png(look: SceneLook) -> bytes:
+    """``carpet_texture`` as a PNG file, as the engines load it."""
+    ok, png = cv2.imencode(".png", cv2.cvtColor(carpet_texture(look), cv2.COLOR_RGB2BGR))
+    if not ok:
+        raise RuntimeError("OpenCV could not encode the carpet's texture")
+    return png.tobytes()
 
 
 def carpet_texture(look: SceneLook, size: int = 256) -> np.ndarray:

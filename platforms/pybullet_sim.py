@@ -25,7 +25,6 @@ import tempfile
 from multiprocessing.connection import Connection
 from typing import Any
 
-import cv2
 import numpy as np
 
 from tafel.core.runtime.platform import PlatformError, PlatformOptionError
@@ -35,7 +34,7 @@ from tafel.platforms.field_world import (
     SceneLook,
     ball_mesh,
     ball_texture_png,
-    carpet_texture,
+    carpet_texture_png,
     cylinder_mesh,
     field_parts,
 )
@@ -345,10 +344,7 @@ class PybulletPlatform(SimulatedRobotPlatform):
 
     def _carpet_texture(self, look: SceneLook) -> int:
         """One seeded metre of the realistic carpet, MuJoCo's (``field_world.carpet_texture``)."""
-        ok, png = cv2.imencode(".png", cv2.cvtColor(carpet_texture(look), cv2.COLOR_RGB2BGR))
-        if not ok:
-            raise RuntimeError("OpenCV could not encode the carpet's texture")
-        return self._load_texture(png.tobytes())
+        return self._load_texture(carpet_texture_png(look))
 
     def _load_texture(self, png: bytes) -> int:
         """A texture from PNG bytes, through a temporary file (PyBullet loads textures only from files)."""

@@ -13,10 +13,9 @@ import re
 from dataclasses import dataclass
 from xml.sax.saxutils import quoteattr
 
-import cv2
 import numpy as np
 
-from tafel.platforms.field_world import NET_FRICTION, SceneLook, ball_mesh, ball_texture_png, carpet_texture, field_parts
+from tafel.platforms.field_world import NET_FRICTION, SceneLook, ball_mesh, ball_texture_png, carpet_texture_png, field_parts
 from tafel.representations import field
 from tafel.representations.nao import (
     ACCELEROMETER_POSITION,
@@ -269,10 +268,7 @@ def mjcf_assets(ball_color: str = "spl", look: SceneLook | None = None) -> dict[
     """The files ``mjcf`` refers to, for ``MjModel.from_xml_string(xml, assets)``: made here, never read from disk."""
     assets = {BALL_TEXTURE_FILE: ball_texture_png()} if ball_color == "spl" else {}
     if look and look.texture:
-        ok, png = cv2.imencode(".png", cv2.cvtColor(carpet_texture(look), cv2.COLOR_RGB2BGR))
-        if not ok:
-            raise RuntimeError("OpenCV could not encode the carpet's texture")
-        assets[CARPET_TEXTURE_FILE] = png.tobytes()
+        assets[CARPET_TEXTURE_FILE] = carpet_texture_png(look)
     return assets
 
 

@@ -21,7 +21,7 @@ from tafel.core.framework.manager import Blackboard
 from tafel.core.framework.values import Range, convert, refusal
 from tafel.core.runtime.platform import Platform, PlatformOptionError, seed_number
 from tafel.platforms.actuators import ActuatorGuard
-from tafel.platforms.field_world import BALL_COLORS, scene_look
+from tafel.platforms.field_world import BALL_COLORS, level_look
 from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS, NetworkedPlatform
 from tafel.platforms.realism import LEVELS, CameraRealism, image_shift, parse_realism, realism_level
 from tafel.platforms.robot_model import STANDING_HEIGHT
@@ -152,7 +152,7 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         self.last_camera: dict[str, tuple[int, np.ndarray]] = {}  # camera -> (time_ns, rotation) at its last image
         level = self.realism_level
         #: what the engines add to the world with --realism (None: the plain scene)
-        self.scene_look = scene_look(self.seed, level.carpet_greens, level.carpet_texture, level.hall_clutter, level.goal_nets) if level else None
+        self.scene_look = level_look(self.seed, level)
         self.shadows = bool(level and level.shadows)
         self.viewer_requested = bool(self.options.get("viewer"))
         self.rng = np.random.default_rng(self.seed)

@@ -27,7 +27,7 @@ from multiprocessing.connection import Connection, Listener, wait
 from pathlib import Path
 from typing import Any, TextIO
 
-from tafel.platforms.field_world import scene_look
+from tafel.platforms.field_world import level_look
 from tafel.platforms.match_robot import AUTHKEY_ENV
 from tafel.platforms.match_world import TICK_NS, MatchWorld, Side
 from tafel.platforms.realism import parse_realism, realism_level
@@ -95,7 +95,7 @@ class Match:
         #: --realism: every robot's camera pipeline (seeded by its own seed) and the world's hall (seeded by --seed)
         self.realism = parse_realism(getattr(args, "realism", "off"))
         level = realism_level(self.realism)
-        look = scene_look(args.seed, level.carpet_greens, level.carpet_texture, level.hall_clutter, level.goal_nets) if level else None
+        look = level_look(args.seed, level)
         self.world = MatchWorld([(x, y) for x, y, _ in places], offscreen=(max(width, 640), max(height, 480)), look=look,
                                 shadows=bool(level and level.shadows))
         for player, (x, y, heading) in zip(self.players, places):
