@@ -13,6 +13,7 @@ import pytest
 from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.kicking import KickParameters, approach_and_kick
 from tafel.modules.behavior.striker import Striker
+from tafel.modules.motion.keyframes import MotionFileError
 from tafel.modules.motion.walk_kicks import WALK_KICKS_FILE, kick_swing, load_walk_kicks
 from tafel.modules.motion.walking_engine import WalkingEngine
 from tafel.representations.modeling import BallModel
@@ -108,6 +109,20 @@ def test_the_walk_kicks_file_is_checked_key_by_key(tmp_path: Path) -> None:
         load_walk_kicks(broken)
     broken.write_text(text.replace("extend_to = 0.7", "extend_to = 0.2", 1), encoding="utf-8")
     with pytest.raises(ValueError, match="extend_from < extend_to"):
+        load_walk_kicks(broken)
+
+
+def test_a_missing_unreadable_or_non_numeric_walk_kicks_file_says_what_is_wrong(tmp_path: Path) -> None:
+    """Bad motion files get the motion files' own error (``MotionFileError``) with what would be right."""
+    with pytest.raises(MotionFileError, match="no motion file .*walk_kicks.toml; the motions are"):
+        load_walk_kicks(tmp_path / "walk_kicks.toml")
+    broken = tmp_path / "walk_kicks.toml"
+    broken.write_text("[short\nduration = 0.4", encoding="utf-8")
+    with pytest.raises(MotionFileError, match="not valid TOML"):
+        load_walk_kicks(broken)
+    text = WALK_KICKS_FILE.read_text(encoding="utf-8")
+    broken.write_text(text.replace("extend_to = 0.7", 'extend_to = "fast"', 1), encoding="utf-8")
+    with pytest.raises(MotionFileError, match=r"\[short\] needs a number for each of"):
         load_walk_kicks(broken)
 
 

@@ -21,6 +21,7 @@ import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -89,21 +90,26 @@ def motions_folder(folder: str = "") -> Path:
     return Path(folder) if folder else SHIPPED_MOTIONS
 
 
+def read_motion_file(path: Path) -> dict[str, Any]:
+    """The TOML of a motion file, or a ``MotionFileError`` that says what is wrong with it."""
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        known = sorted(p.stem for p in path.parent.glob("*.toml"))
+        raise MotionFileError(f"no motion file {path}; the motions are {', '.join(known) or 'none'}") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise MotionFileError(f"{path}: not valid TOML: {exc}") from None
+    except OSError as exc:
+        raise MotionFileError(f"{path}: cannot read it ({exc.strerror or exc})") from None
+
+
 def load_motion(name: str, folder: str = "", _loading: tuple[str, ...] = ()) -> KeyframeMotion:
     """Read and check ``NAME.toml``; mirrored motions are built from their original, ``then`` is appended."""
     path = motions_folder(folder) / f"{name}.toml"
     if name in _loading:
         raise MotionFileError(f"{path}: motions refer to each other in a circle: {' -> '.join([*_loading, name])}")
     _loading = (*_loading, name)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        known = sorted(p.stem for p in motions_folder(folder).glob("*.toml"))
-        raise MotionFileError(f"no motion file {path}; the motions are {', '.join(known) or 'none'}") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise MotionFileError(f"{path}: not valid TOML: {exc}") from None
-    except OSError as exc:
-        raise MotionFileError(f"{path}: cannot read it ({exc.strerror or exc})") from None
+    data = read_motion_file(path)
     if "mirror" in data:
         original = load_motion(str(data["mirror"]), folder, _loading)
         return KeyframeMotion(name, str(data.get("description", f"{original.description}, mirrored")),

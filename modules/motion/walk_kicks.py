@@ -9,13 +9,12 @@ engine (``WalkingEngine``) plays it when the ``MotionRequest`` asks for a ``walk
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, fields
 from pathlib import Path
 
 import numpy as np
 
-from tafel.modules.motion.keyframes import SHIPPED_MOTIONS
+from tafel.modules.motion.keyframes import SHIPPED_MOTIONS, MotionFileError, read_motion_file
 from tafel.representations.motion_control import Foot, WalkKick
 
 WALK_KICKS_FILE = SHIPPED_MOTIONS / "walk_kicks.toml"
@@ -42,16 +41,19 @@ class KickStep:
 
 def load_walk_kicks(path: Path = WALK_KICKS_FILE) -> dict[WalkKick, KickStep]:
     """The kicks in ``path`` by strength (tables ``[short]`` and ``[long]``), each key checked."""
-    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    data = read_motion_file(path)
     names = [f.name for f in fields(KickStep)]
     kicks = {}
     for kick in (WalkKick.short, WalkKick.long):
         table = data.get(kick.name)
         if not isinstance(table, dict) or sorted(table) != sorted(names):
-            raise ValueError(f"{path}: [{kick.name}] needs exactly {', '.join(names)}")
-        step = KickStep(**{name: float(table[name]) for name in names})
+            raise MotionFileError(f"{path}: [{kick.name}] needs exactly {', '.join(names)}")
+        try:
+            step = KickStep(**{name: float(table[name]) for name in names})
+        except (TypeError, ValueError):
+            raise MotionFileError(f"{path}: [{kick.name}] needs a number for each of {', '.join(names)}") from None
         if not 0.0 <= step.extend_from < step.extend_to <= step.put_down_from < 1.0 or step.duration <= 0.0:
-            raise ValueError(f"{path}: [{kick.name}] needs 0 <= extend_from < extend_to <= put_down_from < 1 and duration > 0")
+            raise MotionFileError(f"{path}: [{kick.name}] needs 0 <= extend_from < extend_to <= put_down_from < 1 and duration > 0")
         kicks[kick] = step
     return kicks
 
