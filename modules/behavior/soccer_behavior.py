@@ -19,7 +19,7 @@ from tafel.representations.behavior import ActivationGraph, OptionGraph
 from tafel.representations.game import GameState, SetPlay
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
-from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType, Odometry
+from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType, Odometry, WalkKick
 from tafel.representations.obstacles import ROBOT_RADIUS, ObstacleKind, Obstacles
 from tafel.representations.team import PlayerRole, TeamMates
 
@@ -151,7 +151,7 @@ class SoccerBehavior(Module):
             self.option_graph.root, self.option_graph.options = graph.root, graph.options
         busy = {info.name: getattr(out, info.name) for info in fields_of(MotionRequest)} if self.motion_info.busy else None
         self.keep_out, self.indirect = [], False
-        out.motion = MotionType.stand
+        out.motion, out.walk_kick = MotionType.stand, WalkKick.none  # each frame's request starts afresh
         self.options.run(self, self.frame_info.time_s, self.activation_graph)
         self.stay_on_field()
         if busy is not None:  # a kick or get-up plays to its end: the options went on, the request stays

@@ -54,9 +54,9 @@ class Striker(Module):
         p, ball, out = self.parameters, self.ball_model, self.motion_request
         if self.motion_info.busy:  # a kick or get-up plays to its end
             return
+        out.walk_kick = WalkKick.none  # a walk kick is asked for only in the frames that mean it
         if not ball.valid:
-            out.motion, out.walk_x, out.walk_y = MotionType.walk, 0.0, 0.0
-            out.walk_rotation, out.walk_kick = p.search_turn, WalkKick.none
+            out.motion, out.walk_x, out.walk_y, out.walk_rotation = MotionType.walk, 0.0, 0.0, p.search_turn
             return
         target_x, target_y, direction = approach_and_kick(ball, goal_direction(ball, self.robot_pose, self.odometry),
                                                         self.kick_tuning.apply(p), out)
