@@ -36,6 +36,16 @@ def outside(x: float, y: float, discs: Sequence[Disc], margin: float = 0.0) -> t
     return x, y
 
 
+def hit(x: float, y: float, cx: float, cy: float, reach: float) -> float | None:
+    """Where along (0..1) the straight way from the origin to (x, y) comes nearest (cx, cy), if that is
+    within ``reach`` of it; None if the way keeps out. From within the disc: 0 when the way leads further
+    in, None when it leads out."""
+    if math.hypot(cx, cy) < reach:
+        return 0.0 if cx * x + cy * y > 0.0 else None
+    t = max(0.0, min(1.0, (cx * x + cy * y) / max(x * x + y * y, 1e-9)))
+    return t if math.hypot(t * x - cx, t * y - cy) < reach else None
+
+
 def blocking(x: float, y: float, discs: Sequence[Disc], margin: float = 0.0) -> tuple[float, Disc] | None:
     """The first disc (grown by ``margin``) the straight walk from the origin to (x, y) runs into, and how
     far along (0..1). A disc that holds the target is left out (the robot has to go in); one that holds
@@ -49,11 +59,7 @@ def blocking(x: float, y: float, discs: Sequence[Disc], margin: float = 0.0) -> 
         reach = radius + margin
         if math.hypot(x - cx, y - cy) < reach:
             continue
-        if math.hypot(cx, cy) < reach:
-            t = 0.0 if cx * x + cy * y > 0.0 else None
-        else:
-            t = max(0.0, min(1.0, (cx * x + cy * y) / length_sq))
-            t = t if math.hypot(t * x - cx, t * y - cy) < reach else None
+        t = hit(x, y, cx, cy, reach)
         if t is not None and (first is None or t < first[0]):
             first = (t, disc)
     return first
@@ -102,16 +108,7 @@ def free_direction(x: float, y: float, discs: Sequence[Disc], margin: float, pre
 def clear(x: float, y: float, discs: Sequence[Disc], margin: float) -> bool:
     """Whether the straight way from the origin to (x, y) keeps out of every disc (grown by ``margin``),
     the end included; a disc that holds the robot: the way does not lead further in."""
-    for cx, cy, radius in discs:
-        reach = radius + margin
-        if math.hypot(cx, cy) < reach:
-            if cx * x + cy * y > 0.0:
-                return False
-            continue
-        t = max(0.0, min(1.0, (cx * x + cy * y) / max(x * x + y * y, 1e-9)))
-        if math.hypot(t * x - cx, t * y - cy) < reach:
-            return False
-    return True
+    return all(hit(x, y, cx, cy, radius + margin) is None for cx, cy, radius in discs)
 
 
 def detour(x: float, y: float, discs: Sequence[Disc], margin: float = 100.0, prefer: int = 0) -> tuple[float, float, int]:
