@@ -1,5 +1,5 @@
 """A robot that walks to the ball and kicks it with the behaviour's own kicking (``kicking.approach_and_kick``),
-the ball as ground truth gives it: for the walk-kick tests and ``benchmarks/walking.py``'s ``walk_kicks``."""
+the ball as ground truth gives it: for the walk-kick tests and ``benchmarks/kicks.py``."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import math
 from dataclasses import dataclass, replace
 
 from tafel.modules.behavior.kicking import KickParameters, approach_and_kick
+from tafel.representations.geometry import Pose2D
 from tafel.representations.modeling import BallModel
 from tafel.representations.motion_control import MotionRequest, MotionType, WalkKick
 from tests.support.driven import Driven
@@ -42,8 +43,8 @@ def kick_trial(engine: str, seed: int, direction_deg: float, strength: WalkKick 
         if moved_at is None:
             rx, ry, rh = driven.sim.platform.robot_pose()
             bx, by = driven.sim.platform.ball_position()
-            c, s = math.cos(-rh), math.sin(-rh)
-            ball = BallModel(valid=True, x=c * (bx - rx) - s * (by - ry), y=s * (bx - rx) + c * (by - ry))
+            ball_x, ball_y = Pose2D(rx, ry, rh).to_local(bx, by)
+            ball = BallModel(valid=True, x=ball_x, y=ball_y)
             approach_and_kick(ball, math.remainder(wanted - rh, math.tau), p, request, strength)
             driven.request = replace(request)
             if asked_at is None and (request.walk_kick is not WalkKick.none or request.motion is MotionType.kick):
