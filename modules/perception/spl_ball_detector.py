@@ -32,6 +32,13 @@ def carpet_sample(hsv: np.ndarray, green: np.ndarray) -> np.ndarray:
     return hsv[::4, ::4][green[::4, ::4]]
 
 
+def square_inside(spot: Spot, shape: tuple[int, ...]) -> bool:
+    """Whether the classifier's square round ``spot`` (1.1 radii either side) lies within an image of ``shape``."""
+    height, width = shape[:2]
+    side = 1.1 * spot.radius
+    return side <= spot.x <= width - side and side <= spot.y <= height - side
+
+
 def carpet(hsv: np.ndarray, green: np.ndarray, sampled: np.ndarray | None = None) -> tuple[float, float]:
     """The carpet's median value and saturation (sampled), the measures of the light; (128, 128) without carpet.
     ``sampled``: ``carpet_sample(hsv, green)`` where it is at hand."""
@@ -197,7 +204,8 @@ class SPLBallDetector(Module):
                         light = light or carpet(hsv, green, sampled)
                         score = self.classify(hsv, green, spot, score, light)
                     elif not score and not under_post and self.parameters.classifier and self.parameters.second_look:
-                        score = self.second_look(hsv, green, spot, white, sampled)
+                        light = light or carpet(hsv, green, sampled)
+                        score = self.second_look(hsv, green, spot, white, light)
                     if self.draw_candidates:
                         self.draw_candidates.canvas(Canvas.image(camera)).circle(spot.x, spot.y, spot.radius, color="blue" if score else "gray")
                     if score:
@@ -209,40 +217,32 @@ class SPLBallDetector(Module):
         left to the checks: its square reaches out of the image, and the classifier, which learned far
         more edge-cut things that are no ball (dark corners, the hall), turns down the balls there too.
         ``light``: ``carpet(hsv, green)`` where it is at hand."""
-        assert self.model is not None
-        height, width = green.shape
-        side = 1.1 * spot.radius  # the classifier's square round the spot
-        if not (side <= spot.x <= width - side and side <= spot.y <= height - side):
+        if not square_inside(spot, green.shape):
             return 0.0 if spot.edge else score if not self.parameters.classifier_at_edge else self.decide(hsv, green, spot, score, light)
         return self.decide(hsv, green, spot, score, light)
 
-    def decide(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, score: float, light: tuple[float, float] | None) -> float:
-        """``score`` if the classifier's score reaches ``classifier_min`` (``edge_classifier_min`` for the band's
-        candidates), else 0."""
+    def decide(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, score: float, light: tuple[float, float] | None,
+               least: float | None = None) -> float:
+        """``score`` if the classifier's score reaches ``least`` (by default ``classifier_min``,
+        ``edge_classifier_min`` for the band's candidates), else 0."""
         assert self.model is not None
         row = features(hsv, green, spot.x, spot.y, spot.radius, *(light or carpet(hsv, green)))
-        least = self.parameters.edge_classifier_min if spot.edge else self.parameters.classifier_min
+        if least is None:
+            least = self.parameters.edge_classifier_min if spot.edge else self.parameters.classifier_min
         return score if float(self.model.scores(row)[0]) >= least else 0.0
 
-    def second_look(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, sampled: np.ndarray | None = None) -> float:
+    def second_look(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, light: tuple[float, float] | None = None) -> float:
         """A score if ``spot``, which failed the checks, passes the looser ones (``second_*``) and the classifier takes
         it for a ball with a score of ``second_look_min`` at least; else 0. A small ball blurred by the head's turn has
         grey, not black, patches, and a colour cast gives its white some colour: the checks alone would take dark
         corners and robots' joints then, the classifier tells them apart. Not at the image's edge, where the
         classifier does not decide."""
         p = self.parameters
-        height, width = green.shape
-        side = 1.1 * spot.radius
-        if not (side <= spot.x <= width - side and side <= spot.y <= height - side):
+        if not square_inside(spot, green.shape):
             return 0.0
         loose = replace(p, dark_ratio=p.second_dark_ratio, black_contrast=p.second_black_contrast, saturation_max=p.second_saturation_max)
         score = self.check(hsv, green, spot, white, parameters=loose)[0]
-        if not score:
-            return 0.0
-        if self.model is None:
-            self.model = BallClassifier()
-        row = features(hsv, green, spot.x, spot.y, spot.radius, *carpet(hsv, green, sampled))
-        return score if float(self.model.scores(row)[0]) >= p.second_look_min else 0.0
+        return self.decide(hsv, green, spot, score, light, least=p.second_look_min) if score else 0.0
 
     def dark_pixels(self, hsv: np.ndarray, green: np.ndarray, sampled: np.ndarray | None = None) -> np.ndarray | None:
         """Pixels darker than ``black_contrast`` times the carpet's median value (the ball's black patches
