@@ -33,7 +33,7 @@ import numpy as np
 from tafel.core.framework.manager import Blackboard
 from tafel.core.runtime.platform import EndOfData, PlatformError, PlatformOptionError
 from tafel.platforms.match_world import Side, Snapshot
-from tafel.platforms.mujoco_sim import GL_BACKEND, MujocoRobot, close_renderers, mujoco
+from tafel.platforms.mujoco_sim import GL_BACKEND, MujocoRobot, close_renderers, mujoco, set_render_flags
 from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS
 from tafel.platforms.robot_model import mjcf_assets, robot_prefix
 from tafel.platforms.simulated import SimulatedRobotPlatform
@@ -103,8 +103,7 @@ class MatchRobotPlatform(SimulatedRobotPlatform):
                 raise PlatformError(f"MuJoCo cannot render headless with MUJOCO_GL={GL_BACKEND} ({exc}); use --cameras off") from None
             if self.realism_level is not None:  # as the MuJoCo platform renders with --realism; off renders as it always did
                 for renderer in self.renderers.values():
-                    renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = int(self.shadows)
-                    renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
+                    set_render_flags(renderer, self.shadows)
         if "cognition" in contexts:
             self.network.open()
 

@@ -141,6 +141,12 @@ class MujocoBall:
         mujoco.mj_forward(self.model, data)
 
 
+def set_render_flags(renderer: Any, shadows: bool) -> None:
+    """How a camera renders the scene: the hall's shadows as the realism level says, no mirror-like floor."""
+    renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = int(shadows)
+    renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
+
+
 def close_renderers(renderers: dict[str, Any]) -> None:
     """Close MuJoCo renderers; closing must never raise (it also runs after errors)."""
     for renderer in renderers.values():
@@ -181,8 +187,7 @@ class MujocoPlatform(SimulatedRobotPlatform):
         try:
             for camera in ("top", "bottom"):
                 renderer = mujoco.Renderer(self.model, self.height, self.width)
-                renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = int(self.shadows)
-                renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
+                set_render_flags(renderer, self.shadows)
                 self.renderers[camera] = renderer
         except Exception as exc:  # noqa: BLE001 - the GL stack raises several kinds
             self.stop()
