@@ -25,8 +25,6 @@ from tafel.modules.perception.goal_post_detector import (
     band_passes,
     edge_peaks,
     exact_norms,
-    exact_to_ground,
-    exact_to_image,
     rising_rows,
     runs_of_rows,
     segment_medians,
@@ -696,9 +694,9 @@ def test_the_geometry_of_many_posts_at_once_is_each_ones(seed: int, yaw: float, 
     projection = ImageProjection(CameraMatrix(rotation, np.array([*rng.normal(0, 50, 2), height]), True), 640, 480,
                                  math.radians(56.3), math.radians(43.7))
     xs, ys = rng.uniform(-20, 660, count), rng.uniform(-20, 500, count)
-    ground, hits = exact_to_ground(projection, xs, ys)
+    ground, hits = projection.to_ground(xs, ys, exact=True)
     points = np.column_stack([rng.normal(0, 3000, (count, 2)), rng.uniform(0, 800, count)])
-    pixels, fronts = exact_to_image(projection, points)
+    pixels, fronts = projection.to_image(points, exact=True)
     for k in range(count):
         one, hit = projection.to_ground(xs[k : k + 1], ys[k : k + 1])
         assert hit[0] == hits[k] and np.array_equal(one[0], ground[k])

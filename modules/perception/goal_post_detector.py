@@ -152,31 +152,6 @@ def segment_medians(values: np.ndarray, lengths: np.ndarray) -> np.ndarray:
     return np.asarray(np.where((lengths % 2 == 1)[:, None], upper, ((lower + upper) / 2).astype(np.float32)))
 
 
-def exact_rays(projection: ImageProjection, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
-    """``projection.rays`` of each pixel as one call for that pixel alone gives it, to the last bit: a
-    stack of 1 x 3 products (numpy's product of many rows at once rounds differently)."""
-    camera = np.stack([np.ones_like(xs, dtype=float), -(np.asarray(xs, float) - projection.width / 2) / projection.fx,
-                       -(np.asarray(ys, float) - projection.height / 2) / projection.fy], axis=-1)
-    return np.asarray((camera[:, None, :] @ projection.rotation.T)[:, 0])
-
-
-def exact_to_ground(projection: ImageProjection, xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``projection.to_ground`` (on the ground) of each pixel as one call for it alone gives it."""
-    rays = exact_rays(projection, xs, ys)
-    hits = rays[:, 2] < -1e-6
-    scale = np.where(hits, (0.0 - projection.translation[2]) / np.where(hits, rays[:, 2], -1.0), 0.0)
-    return projection.translation[:2] + scale[:, None] * rays[:, :2], hits
-
-
-def exact_to_image(projection: ImageProjection, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``projection.to_image`` of each point as one call for it alone gives it."""
-    local = ((np.asarray(points, float) - projection.translation)[:, None, :] @ projection.rotation)[:, 0]
-    front = local[:, 0] > 1.0
-    depth = np.where(front, local[:, 0], 1.0)
-    return np.stack([projection.width / 2 - projection.fx * local[:, 1] / depth,
-                     projection.height / 2 - projection.fy * local[:, 2] / depth], axis=1), front
-
-
 def row_norms(vectors: np.ndarray) -> np.ndarray:
     """``np.linalg.norm(vectors, axis=1)`` of real vectors, as numpy computes it (the square root of the
     squares summed along the rows) without its Python around it: called a few dozen times a frame."""
@@ -426,7 +401,7 @@ class GoalPostDetector(Module):
         carpet below the boundary between them) whose band passed its checks: the post, if its width and
         height fit one, else None; and for those posts in turn the rows in which the white must rise along
         its axis and those in which it must reach down to the foot (for ``upright``). All at once, by the
-        very operations the pixel-by-pixel code did for each (``exact_rays``, ``exact_norms``, numpy's
+        very operations the pixel-by-pixel code did for each (``ImageProjection``'s ``exact``, ``exact_norms``, numpy's
         linspace), so the posts are the same to the last bit."""
         p = self.parameters
         height = self.colour.shape[0]
@@ -436,18 +411,18 @@ class GoalPostDetector(Module):
         post_width = right - left
         centre = (left + right) / 2
         column = (left + right) // 2  # int(centre)
-        ground, hit = exact_to_ground(projection, centre, foot + 0.5)
+        ground, hit = projection.to_ground(centre, foot + 0.5, exact=True)
         distance = exact_norms(np.column_stack([ground, np.zeros(len(left))]) - projection.translation)
         expected = projection.fx * GOAL_POST_DIAMETER / np.where(hit, distance, 1.0)
         fits = hit & ~((post_width - expected > p.width_tolerance * expected + 1.5) | (post_width < p.width_low * expected - 1.0))
         # the foot near the boundary: the boundary no farther behind it than max_behind
         eye = projection.translation[:2]
         direction = (ground - eye) / np.maximum(exact_norms(ground - eye), 1.0)[:, None]
-        behind, front = exact_to_image(projection, np.column_stack([ground + direction * p.max_behind, np.zeros(len(left))]))
+        behind, front = projection.to_image(np.column_stack([ground + direction * p.max_behind, np.zeros(len(left))]), exact=True)
         fits &= ~(front & (top[column] < behind[:, 1] - 2.0 - 0.01 * height))
         # the post rises from the foot along its projected axis: white, of one colour, unlike what is beside it
         post_centre = ground + direction * GOAL_POST_DIAMETER / 2
-        summit, front = exact_to_image(projection, np.column_stack([post_centre, np.full(len(left), p.rise * GOAL_HEIGHT)]))
+        summit, front = projection.to_image(np.column_stack([post_centre, np.full(len(left), p.rise * GOAL_HEIGHT)]), exact=True)
         fits &= front & (summit[:, 1] < foot)
         upper = np.maximum(0, np.trunc(np.where(fits, summit[:, 1], 0.0))).astype(int)  # int(): towards zero
         fits &= ~(foot - upper < p.min_height * post_width)

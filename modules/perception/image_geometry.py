@@ -47,6 +47,11 @@ def ground_point(ray_camera: np.ndarray, rotation: np.ndarray, translation: np.n
     return np.asarray(translation) + scale * direction
 
 
+def rows_times(rows: np.ndarray, matrix: np.ndarray, exact: bool) -> np.ndarray:
+    """``rows @ matrix``; ``exact``: each row's product as for that row alone (a stack of 1 x n products)."""
+    return np.asarray((rows[:, None, :] @ matrix)[:, 0]) if exact else rows @ matrix
+
+
 class ImageProjection:
     """One camera's matrix and intrinsics, with vectorized conversions between pixels and the ground."""
 
@@ -56,23 +61,26 @@ class ImageProjection:
         self.width, self.height = width, height
         self.fx, self.fy = focal_lengths(width, height, horizontal_fov, vertical_fov)
 
-    def rays(self, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
-        """Directions (N x 3, robot frame, not normalized) of the pixels (xs, ys)."""
+    def rays(self, xs: np.ndarray, ys: np.ndarray, exact: bool = False) -> np.ndarray:
+        """Directions (N x 3, robot frame, not normalized) of the pixels (xs, ys). ``exact``: each row as a
+        call for that pixel alone gives it, to the last bit (numpy's product of many rows at once rounds
+        differently; a stack of 1 x 3 products does not)."""
         camera = np.stack([np.ones_like(xs, dtype=float), -(np.asarray(xs, float) - self.width / 2) / self.fx,
                            -(np.asarray(ys, float) - self.height / 2) / self.fy], axis=-1)
-        return camera @ self.rotation.T
+        return rows_times(camera, self.rotation.T, exact)
 
-    def to_ground(self, xs: np.ndarray, ys: np.ndarray, z: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    def to_ground(self, xs: np.ndarray, ys: np.ndarray, z: float = 0.0, exact: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """The points (N x 2, mm, robot frame) where the pixels' rays meet the plane at height ``z``, and
-        which of them do (rays at or above the horizon do not)."""
-        rays = self.rays(xs, ys)
+        which of them do (rays at or above the horizon do not). ``exact``: as for ``rays``."""
+        rays = self.rays(xs, ys, exact)
         hits = rays[:, 2] < -1e-6
         scale = np.where(hits, (z - self.translation[2]) / np.where(hits, rays[:, 2], -1.0), 0.0)
         return self.translation[:2] + scale[:, None] * rays[:, :2], hits
 
-    def to_image(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Pixels (N x 2) of robot-frame points (N x 3, mm), and which lie in front of the camera."""
-        local = (np.asarray(points, float) - self.translation) @ self.rotation
+    def to_image(self, points: np.ndarray, exact: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Pixels (N x 2) of robot-frame points (N x 3, mm), and which lie in front of the camera.
+        ``exact``: as for ``rays``."""
+        local = rows_times(np.asarray(points, float) - self.translation, self.rotation, exact)
         front = local[:, 0] > 1.0
         depth = np.where(front, local[:, 0], 1.0)
         return np.stack([self.width / 2 - self.fx * local[:, 1] / depth, self.height / 2 - self.fy * local[:, 2] / depth], axis=1), front
