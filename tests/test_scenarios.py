@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from tafel.core.logs import LogReader
 from tafel.tools.simulation.batch import BatchInfo, run_jobs
 from tafel.tools.simulation.scenario_file import ScenarioError, load_scenario
-from tafel.tools.simulation.scenarios import _Judge, perturbed_start, run_seed, summarize, wilson_interval
+from tafel.tools.simulation.scenarios import _Judge, perturbed_start, play, run_seed, summarize, wilson_interval
 
 REPO = Path(__file__).resolve().parent.parent
 SHIPPED = sorted((REPO / "config" / "scenarios").glob("*.toml"))
@@ -410,3 +410,52 @@ def test_the_striker_scores_from_its_own_half_in_three_of_four_perturbed_runs(tm
     rows = rows_of(tmp_path / "runs.csv")
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
     assert sum(r["success"] == "True" for r in rows) >= 3, rows
+
+
+LOCALIZED_IN_THE_OPPONENT_HALF = """
+duration_s = 3.0
+required_success_rate = 1.0
+cameras = {cameras}
+
+[[robots]]
+start = [2400.0, 0.0, 0.0]
+told_pose = {told}
+
+[ball]
+position = [3000.0, 0.0]
+
+[[success]]
+predicate = "representation"
+name = "RobotPose"
+field = "x"
+at_least = 1800.0
+after_s = 1.0
+for_s = 1.0
+
+[[success]]
+predicate = "representation"
+name = "RobotPose"
+field = "valid"
+equals = true
+after_s = 1.0
+for_s = 1.0
+"""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("told", "cameras"), [("true", "true"), ("false", "false")])
+def test_a_robot_started_in_the_opponent_half_knows_where_it_is_only_when_told(tmp_path: Path, told: str, cameras: str) -> None:
+    """The rules never place a robot in the opponent half in PLAYING, so one started there is taken for its
+    twin in the own half unless the scenario tells it the start (``told_pose``), as kick_to_goal does."""
+    scenario = load_scenario(write(tmp_path, LOCALIZED_IN_THE_OPPONENT_HALF.format(told=told, cameras=cameras)))
+    assert scenario.told_pose is (told == "true")
+    row = play(scenario, 1)
+    assert row["success"] is (told == "true"), row["reason"]
+
+
+def test_told_pose_is_true_or_false(tmp_path: Path) -> None:
+    text = GOOD.replace("start = [0.0, 0.0, 0.0]", "start = [0.0, 0.0, 0.0]\ntold_pose = 1")
+    with pytest.raises(ScenarioError, match="told_pose"):
+        load_scenario(write(tmp_path, text))
+    assert load_scenario(write(tmp_path, GOOD)).told_pose is False
+    assert load_scenario(REPO / "config" / "scenarios" / "kick_to_goal.toml").told_pose is True

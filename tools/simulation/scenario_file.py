@@ -94,6 +94,9 @@ class Scenario:
     robot_start: tuple[float, float, float]
     ball: tuple[float, float]
     success: tuple[Condition, ...]
+    #: the localization is told the start pose (``KnownPose``), as a team tells a robot it placed by hand
+    #: for a drill; without it a start the rules never give (the opponent half in PLAYING) is taken for its twin
+    told_pose: bool = False
     description: str = ""
     platform: str = "mujoco"
     cameras: bool = True
@@ -254,7 +257,7 @@ def load_scenario(path: str | Path) -> Scenario:
     if len(robots) != 1:
         raise f.error(("robots", 0) if robots else (), None,
                       f"a scenario has exactly one [[robots]] table with start = [x_mm, y_mm, rotation_deg], got {len(robots)}")
-    f.only(("robots", 0), robots[0], ["start"])
+    f.only(("robots", 0), robots[0], ["start", "told_pose"])
     ball = top.get("ball", {})
     if not isinstance(ball, dict):
         raise f.error((), "ball", "ball is a table: [ball] with position = [x_mm, y_mm] and velocity = [vx, vy] (mm/s)")
@@ -280,6 +283,7 @@ def load_scenario(path: str | Path) -> Scenario:
         required_success_rate=f.take((), top, "required_success_rate", "rate"),
         overrides=overrides,
         robot_start=f.take(("robots", 0), robots[0], "start", "pose"),
+        told_pose=f.take(("robots", 0), robots[0], "told_pose", "bool", False),
         ball=f.take(("ball",), ball, "position", "place", (0.0, 0.0)),
         ball_velocity_mm_s=f.take(("ball",), ball, "velocity", "pair", (0.0, 0.0)),
         perturbation=_perturbation(f, top),
