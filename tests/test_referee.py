@@ -7,6 +7,8 @@ import math
 import socket
 from collections.abc import Iterator
 
+import mujoco
+import numpy as np
 import pytest
 
 from tafel.platforms.match_world import MatchWorld, Side
@@ -169,14 +171,18 @@ def shoot_out() -> Iterator[tuple[Referee, socket.socket]]:
 
 def take_shot(ref: Referee, outcome: str) -> None:
     """Wait for the shot's PLAYING, then let it end as ``outcome``: the ball into the goal, wide over the
-    goal line, or left on the penalty mark until the time is up."""
+    goal line, off a post, onto the keeper, into the field (where it stops), or left on the penalty mark
+    until the time is up."""
     until(ref, State.playing, limit=ref.now + 10.0)
     sign = 1.0 if ref.game.kicking_team == 1 else -1.0  # the goal the kicking team attacks
-    if outcome == "goal":
-        ref.world.move_ball(sign * 4600.0, 200.0)
-    elif outcome == "missed":
-        ref.world.move_ball(sign * 4600.0, 1500.0)
-    run(ref, 30.1 if outcome == "time" else TICK)
+    if outcome == "post":
+        ref.world.move_ball(sign * 4460.0, 760.0)  # beside the post's centre (4550, 800)
+        run(ref, TICK)
+    spots = {"goal": (4600.0, 200.0), "wide": (4600.0, 1500.0), "post": (3000.0, 1500.0), "saved": (4250.0, 0.0),
+             "missed": (2000.0, 1500.0)}
+    if outcome in spots:
+        ref.world.move_ball(sign * spots[outcome][0], spots[outcome][1])
+    run(ref, {"time": 30.1, "goal": TICK, "wide": TICK}.get(outcome, 1.1))  # the others end when the ball stopped
     assert ref.game.state is State.finished and ref.shots[-1].outcome == outcome
 
 
@@ -212,12 +218,12 @@ def test_the_shoot_out_packets_say_penalty_shoot_who_kicks_and_who_plays_and_the
     run(ref, 20.0)
     assert ref.shots[-1].outcome == "time"  # 30 s and nobody kicked
     take_shot(ref, "goal")
-    take_shot(ref, "missed")
+    take_shot(ref, "wide")
     # 2:0 with one shot each left: team 2 can no longer draw level, so the shoot-out is over, as GameController3 decides
     run(ref, 2.1)
     assert ref.over and ref.winner == 1 and ref.shoot_out_score() == "2:0" and ref.score() == "0:0"
     assert [(s.team, s.striker, s.keeper, s.outcome) for s in ref.shots] == [(1, 2, 1, "goal"), (2, 2, 1, "time"), (1, 2, 1, "goal"),
-                                                                             (2, 2, 1, "missed")]
+                                                                             (2, 2, 1, "wide")]
     assert ref.events[-1].what == "SHOOT-OUT OVER 2:0, team 1 wins"
 
 
@@ -231,6 +237,142 @@ def test_a_level_shoot_out_goes_to_sudden_death_where_the_second_team_always_ans
     take_shot(ref, "goal")  # the second team answers and wins
     run(ref, 2.1)
     assert ref.over and ref.winner == 2 and ref.shoot_out_score() == "1:2"
+
+
+def test_in_sudden_death_the_better_ranked_shot_of_a_pair_wins_and_a_seeded_coin_decides_a_pair_still_level(
+        shoot_out: tuple[Referee, socket.socket]) -> None:
+    """The rules rank each sudden-death shot: goal, saved, post, wide, any other kick, no kick."""
+    ref, _ = shoot_out
+    ref.penalty_shots, ref.sudden_death_shots = 1, 3
+    for outcome in ("goal", "goal", "post", "post", "missed", "missed"):  # 1:1, then two pairs that rank the same
+        take_shot(ref, outcome)
+    assert not ref.over and ref.winner is None
+    take_shot(ref, "saved")
+    take_shot(ref, "wide")  # saved ranks above wide: team 1 wins with the goals level
+    run(ref, 2.1)
+    assert ref.over and ref.winner == 1 and ref.shoot_out_score() == "1:1" and len(ref.shots) == 8
+    assert ref.events[-1].what == "SHOOT-OUT OVER 1:1, team 1 wins (saved ranks above wide)"
+    # level after every sudden-death shot: a coin toss, the same for the same seed, either team for some seed
+    tosses = []
+    for seed in (*range(8), 3):
+        ref.seed = seed
+        ref.shots[-2].outcome = ref.shots[-1].outcome = "time"
+        ref.decide(ref.now)
+        assert ref.events[-1].what.endswith("wins (a coin toss)")
+        tosses.append(ref.winner)
+    assert tosses[3] == tosses[-1] and set(tosses) == {1, 2}
+
+
+def test_a_shoot_out_level_after_its_sudden_death_ends_with_a_coin_toss(shoot_out: tuple[Referee, socket.socket]) -> None:
+    ref, _ = shoot_out
+    ref.penalty_shots, ref.sudden_death_shots = 1, 1
+    for outcome in ("missed", "missed", "time", "time"):
+        take_shot(ref, outcome)
+    run(ref, 2.1)
+    assert ref.over and ref.winner in (1, 2) and ref.events[-1].what == f"SHOOT-OUT OVER 0:0, team {ref.winner} wins (a coin toss)"
+
+
+def penalty_shot_playing(ref: Referee) -> tuple[float, int, int]:
+    """The first shot's PLAYING: (the sign of the attacked goal's x, the striker's and the keeper's world index)."""
+    until(ref, State.playing, limit=ref.now + 10.0)
+    return 1.0, 1, 2  # team 1's player 2 kicks at +x, team 2's player 1 keeps
+
+
+@pytest.mark.parametrize("where", ["in front of its line", "fallen"])
+def test_a_keeper_off_its_line_or_fallen_before_the_kick_ends_the_shot_with_a_goal_and_a_foul(
+        shoot_out: tuple[Referee, socket.socket], where: str) -> None:
+    ref, _ = shoot_out
+    _, _, keeper = penalty_shot_playing(ref)
+    ref.world.move_robot(keeper, 4400.0, 400.0, math.pi)  # along its line: allowed
+    run(ref, 1.0)
+    assert ref.game.state is State.playing and ref.fouls == []
+    if where == "fallen":
+        ref.world.robots[keeper].place(ref.world.data, np.array([4.4, 0.4, 0.1]), np.array([1.0, 0.0, 0.0, 0.0]))
+        mujoco.mj_forward(ref.world.model, ref.world.data)
+    else:
+        ref.world.move_robot(keeper, 3900.0, 400.0, math.pi)  # 0.6 m into the field
+    run(ref, TICK)
+    assert ref.game.state is State.finished and ref.shots[-1].outcome == "goal" and ref.shoot_out_score() == "1:0"
+    foul = ref.fouls[-1]
+    assert (foul.time_s, foul.team, foul.player, foul.penalty) == (pytest.approx(ref.now), 2, 1, Penalty.none)
+    assert foul.reason == f"keeper {'fell' if where == 'fallen' else 'left its goal line'} before the penalty shot's kick: goal awarded"
+
+
+def test_after_the_kick_the_keeper_may_leave_its_line_and_fall_for_long_without_a_call(shoot_out: tuple[Referee, socket.socket]) -> None:
+    ref, _ = shoot_out
+    _, _, keeper = penalty_shot_playing(ref)
+    ref.world.move_ball(3600.0, 0.0)  # kicked, rolling slowly towards the touchline: the shot goes on
+    run(ref, TICK)
+    ref.world.robots[keeper].place(ref.world.data, np.array([3.9, 0.0, 0.1]), np.array([1.0, 0.0, 0.0, 0.0]))
+    mujoco.mj_forward(ref.world.model, ref.world.data)
+    for step in range(24):
+        ref.world.move_ball(3600.0, 50.0 * step)
+        run(ref, 0.5)
+    assert ref.game.state is State.playing and ref.fouls == []  # 12 s down: the rules spare the keeper
+
+
+@pytest.mark.parametrize("how", ["again", "dribbled"])
+def test_the_striker_playing_the_ball_a_second_time_ends_the_shot(shoot_out: tuple[Referee, socket.socket], how: str) -> None:
+    ref, _ = shoot_out
+    _, striker, _ = penalty_shot_playing(ref)
+    if how == "again":  # kicked 0.7 m, then walked after it
+        ref.world.move_ball(3900.0, 0.0)
+        run(ref, 1.0)
+        ref.world.move_robot(striker, 3750.0, 0.0, 0.0)
+    else:  # pushed along by its feet
+        ref.world.move_ball(3700.0, 0.0)
+        ref.world.move_robot(striker, 3550.0, 0.0, 0.0)
+    run(ref, TICK)
+    assert ref.game.state is State.finished and ref.shots[-1].outcome == "second touch" and ref.fouls == []
+    assert ref.events[-2].what == "PENALTY SHOT 1 team 1 player 2: SECOND TOUCH"
+
+
+def test_a_ball_kicked_before_the_shot_time_is_up_may_still_roll_in(shoot_out: tuple[Referee, socket.socket]) -> None:
+    ref, _ = shoot_out
+    penalty_shot_playing(ref)
+    run(ref, 29.5)
+    ref.world.move_ball(3700.0, 0.0)  # a late kick
+    run(ref, 0.8)
+    ref.world.move_ball(4200.0, 0.0)
+    run(ref, 0.5)
+    assert ref.game.state is State.playing and ref.clock == 0.0
+    ref.world.move_ball(4600.0, 0.0)
+    run(ref, TICK)
+    assert ref.shots[-1].outcome == "goal"
+
+
+@pytest.mark.parametrize("who", ["striker", "keeper"])
+def test_walking_in_the_set_of_a_penalty_shot_is_motion_in_set_out_for_the_shot_and_without_its_striker_the_shot_ends(
+        shoot_out: tuple[Referee, socket.socket], who: str) -> None:
+    ref, _ = shoot_out
+    until(ref, State.set)
+    run(ref, 1.5)
+    assert ref.fouls == []
+    index, team, number, x = (1, 1, 2, 3100.0) if who == "striker" else (2, 2, 1, 4150.0)
+    ref.world.move_robot(index, x, 0.0, 0.0)  # the striker walks up to the ball, the keeper off its line, before the whistle
+    run(ref, TICK)
+    foul = ref.fouls[-1]
+    assert (foul.team, foul.player, foul.penalty, foul.reason) == (team, number, Penalty.illegal_motion_in_set, "walked in SET of a penalty shot")
+    robot = ref.game.teams[team - 1].players[number - 1]
+    assert (robot.penalty, robot.secs_till_unpenalised) == (Penalty.illegal_motion_in_set, 15)  # GameController3's 15 s
+    if who == "striker":
+        until(ref, State.finished)
+        playing = next(e.time_s for e in ref.events if e.what == "PLAYING")
+        assert ref.shots[-1].outcome == "foul" and ref.shots[-1].time_s == playing  # at PLAYING's first tick
+    else:
+        until(ref, State.playing)
+        run(ref, 20.0)  # the 15 s do not run out within the shot: the keeper stays off and the shot goes on
+        assert ref.game.state is State.playing and robot.penalty is Penalty.illegal_motion_in_set and len(ref.fouls) == 1
+
+
+def test_a_striker_leaving_the_field_before_its_kick_is_penalized_and_its_shot_ends(shoot_out: tuple[Referee, socket.socket]) -> None:
+    ref, _ = shoot_out
+    _, striker, _ = penalty_shot_playing(ref)
+    run(ref, 3.0)
+    ref.world.move_robot(striker, 3000.0, 3400.0, 0.0)
+    run(ref, TICK)
+    assert [(f.team, f.player, f.penalty) for f in ref.fouls] == [(1, 2, Penalty.leaving_the_field)]
+    assert ref.shots[-1].outcome == "foul" and ref.game.state is State.finished
 
 
 def test_a_called_free_kick_puts_the_ball_where_the_set_play_does_and_each_set_play_notes_how_near_the_defenders_came(

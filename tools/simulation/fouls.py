@@ -21,13 +21,13 @@ import math
 from dataclasses import dataclass
 
 from tafel.representations import field as pitch
-from tafel.representations.game import Penalty, State
+from tafel.representations.game import GamePhase, Penalty, State
 from tafel.tools.simulation.officiating import HALF_LINE_X, HALF_LINE_Y, Event, Officiating, Player
 
 #: GameController3's penalty durations (s, its champions_cup parameters); the incremental ones grow
 PENALTY_S = {Penalty.player_pushing: 45.0, Penalty.illegal_position: 45.0, Penalty.illegal_position_in_set: 15.0,
-             Penalty.leaving_the_field: 45.0, Penalty.inactive_player: 45.0, Penalty.local_game_stuck: 45.0,
-             Penalty.request_for_pickup: 45.0}
+             Penalty.illegal_motion_in_set: 15.0, Penalty.leaving_the_field: 45.0, Penalty.inactive_player: 45.0,
+             Penalty.local_game_stuck: 45.0, Penalty.request_for_pickup: 45.0}
 INCREMENTAL = (Penalty.player_pushing, Penalty.illegal_position, Penalty.leaving_the_field)
 PENALTY_INCREMENT_S = 10.0  # s longer for each incremental penalty of the team before
 CENTRE_CIRCLE_R, FREE_KICK_DISTANCE = pitch.CENTER_CIRCLE_DIAMETER / 2, 750.0  # mm
@@ -140,7 +140,8 @@ class Fouls(Officiating):
 
     def penalties(self, now: float, dt: float) -> None:
         """Count the penalties down (in READY and PLAYING, as GameController3 does) and bring robots back."""
-        counting = self.game.state in (State.ready, State.playing)
+        # not in the shoot-out: a robot penalized there stays off until its shot ends (the next shot's substitutes)
+        counting = self.game.state in (State.ready, State.playing) and self.game.game_phase is not GamePhase.penalty_shoot
         for player in self.players:
             robot = self.game.teams[player.team].players[player.number - 1]
             if player.penalized_until_s < 0 or robot.penalty is Penalty.substitute:

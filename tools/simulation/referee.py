@@ -77,6 +77,8 @@ class Referee(ShootOut, SetPlays):
     """one of ``SHOOT_OUT``"""
     penalty_shots: int = PENALTY_SHOTS
     sudden_death_shots: int = SUDDEN_DEATH_SHOTS
+    seed: int = 0
+    """the shoot-out's coin toss (the match's ``--seed``)"""
     calls: list[Call] = field(default_factory=list)
     events: list[Event] = field(default_factory=list)
     fouls: list[Foul] = field(default_factory=list)
@@ -117,6 +119,7 @@ class Referee(ShootOut, SetPlays):
         # the shoot-out's state (shoot_out.py)
         self.shoot_out_goals, self.winner, self.shot = [0, 0], None, None
         self.mark, self.kicked, self.keeper_touched, self.ball_track = (0.0, 0.0), False, False, []
+        self.post_hit, self.striker_released, self.placed = False, False, {}
         self.shoot_out_initial_s = self.initial_s
         if self.shoot_out == "only":
             self.start_shoot_out(0.0)
