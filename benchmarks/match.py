@@ -13,8 +13,15 @@
 - The bytes per team message and the messages each robot and each team sent per minute of PLAYING.
 - The fouls the simulated referee called per team and minute of PLAYING, in every match played
   (``fouls_per_minute_*``; the goal is none of the own team's).
+- ``--team-play``: instead of all that, Tafel against Tafel, 2v2, cameras off, ``--seconds`` of game
+  (600: two halves of 5 minutes) for each of ``--seeds``: per seed the score, each team's completed
+  passes (``passes``: the ball kicked by one robot and next touched by a teammate 1 m or more away, no
+  opponent's touch between, from ground truth: ``tools/simulation/passes.py``), own goals and fouls; and
+  over the seeds the fewest goals and passes of a team. Target (issue 36): goals on both sides, no own
+  goal, at least 3 completed passes per team, in every seed (and no fouls, issue 32).
 
     python benchmarks/match.py [--short]
+    python benchmarks/match.py --team-play [--seconds 600] [--seeds 1,2,3]
 
 Prints one JSON line. ``--short`` plays a tenth as long (a smoke test of the benchmark itself).
 """
@@ -32,10 +39,10 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parent.parent
 
 
-def play(*args: str) -> dict:
+def play(*args: str, seed: int = 1) -> dict:
     with tempfile.TemporaryDirectory() as folder:
         result = Path(folder) / "result.json"
-        done = subprocess.run([sys.executable, "-m", "tafel.tools.cli", "match", "--speed", "max", "--seed", "1", "--result", str(result),
+        done = subprocess.run([sys.executable, "-m", "tafel.tools.cli", "match", "--speed", "max", "--seed", str(seed), "--result", str(result),
                                *args], capture_output=True, text=True, cwd=folder, env={**os.environ, "PYTHONPATH": str(REPO)})
         if not result.exists():
             raise RuntimeError(f"tafel match {' '.join(args)} failed: {done.stderr[-2000:]}")
@@ -59,11 +66,42 @@ def fouls_per_minute(result: dict) -> list[float]:
     return [round(team["fouls"] / minutes, 3) if minutes else 0.0 for team in result["teams"]]
 
 
+def team_play(result: dict) -> dict:
+    """One Tafel-against-Tafel match's figures: score, each team's goals, passes, own goals and fouls (team 1 first)."""
+    teams = result["teams"]
+    return {"score": result["score"], "goals": [team["score"] for team in teams], "passes": [team["passes"] for team in teams],
+            "own_goals": [team["own_goals"] for team in teams], "fouls": [team["fouls"] for team in teams],
+            "pass_distances_m": [round(p["distance_mm"] / 1000.0, 1) for p in result["passes"]], "simulated_s": result["simulated_s"],
+            "realtime_factor": result["realtime_factor"]}
+
+
+def team_play_summary(matches: dict[str, dict]) -> dict:
+    """Over the seeds' matches: the fewest goals and passes any team had in a match, all own goals and fouls, and
+    whether every match met issue 36's target (goals on both sides, no own goal, 3 passes per team) with no foul."""
+    games = list(matches.values())
+    least_goals = min((g for m in games for g in m["goals"]), default=0)
+    least_passes = min((n for m in games for n in m["passes"]), default=0)
+    own_goals, fouls = sum(sum(m["own_goals"]) for m in games), sum(sum(m["fouls"]) for m in games)
+    return {"least_goals_per_team": least_goals, "least_passes_per_team": least_passes, "own_goals": own_goals, "fouls": fouls,
+            "target_met": bool(games) and least_goals >= 1 and least_passes >= 3 and own_goals == 0 and fouls == 0}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--short", action="store_true", help="a tenth as long")
     parser.add_argument("--only-speed", action="store_true", help="only the real-time factors with cameras on (no goals or messages)")
+    parser.add_argument("--team-play", action="store_true", help="only Tafel against Tafel, 2v2, cameras off: goals, passes, fouls per seed")
+    parser.add_argument("--seconds", type=float, default=600.0, help="s of game per --team-play match (default 600)")
+    parser.add_argument("--seeds", default="1,2,3", help="the --team-play matches' seeds (default 1,2,3)")
     args = parser.parse_args()
+    if args.team_play:
+        matches = {}
+        for seed in (int(s) for s in args.seeds.split(",")):
+            seconds = max(2.0, args.seconds * (0.1 if args.short else 1.0))
+            matches[f"seed_{seed}"] = team_play(play("--teams", "2v2", "--cameras", "off", "--seconds", f"{seconds:g}", seed=seed))
+        print(json.dumps({"team_play_2v2": matches, **team_play_summary(matches), "cpu_count": os.cpu_count(),
+                          "load_average_1min": round(os.getloadavg()[0], 2)}))
+        return
     scale = 0.1 if args.short else 1.0
     figures: dict[str, object] = {}
     for cameras, seconds in ((("on", 16.0),) if args.only_speed else (("off", 60.0), ("on", 16.0))):
@@ -86,6 +124,7 @@ def main() -> None:
     figures.update({
         "goals_in_5_minutes_2v2_against_standing_team": standing["teams"][0]["score"],
         "goals_conceded": standing["teams"][1]["score"],
+        "passes_2v2_against_standing_team": standing["teams"][0]["passes"],
         "playing_minutes": round(minutes, 2),
         "bytes_per_team_message": standing["bytes_per_team_message"],
         "team_messages_per_minute_per_team": round(messages / minutes, 1) if minutes else 0.0,

@@ -6,13 +6,14 @@ the parameters and the helpers below."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from tafel.core import Module, bounded, fields_of, provides, requires, uses
 from tafel.debug import Canvas, DebugRequest
 from tafel.modules.behavior.kicking import KickParameters, goal_direction, kick_tuning
 from tafel.modules.behavior.options import OptionRunner
 from tafel.modules.behavior.options.soccer import FREE_KICKS, OWN_GOAL_X, PlaySoccer
+from tafel.modules.behavior.passing import PassParameters, best_shot, choose_pass, pass_kick
 from tafel.modules.behavior.paths import Disc, detour, outside
 from tafel.representations import field as pitch
 from tafel.representations.behavior import ActivationGraph, OptionGraph
@@ -38,7 +39,8 @@ class SoccerBehavior(Module):
       the striker nearer the centre when its team kicks off). At a penalty kick: the defending
       goalkeeper on its goal line, everybody else outside that penalty area; the kicking team's
       striker behind the penalty mark (``ready_penalty_kicker``);
-    - PLAYING: the role's play. The striker kicks towards the opponent goal (``kicking``), searching
+    - PLAYING: the role's play. The striker kicks through the goal mouth's most open lane (``kicking``), or
+      passes to a teammate better placed to score by the pass rule of ``passing.py`` (``kick_plan``), searching
       by turning when no one knows where the ball is; the goalkeeper stands between the ball and the
       goal's centre and clears a ball that comes into its penalty area; the supporter waits behind
       and beside the ball; defenders stand between the ball and the own goal. Without an own sighting
@@ -81,7 +83,7 @@ class SoccerBehavior(Module):
     kick_tuning = kick_tuning()
 
     @dataclass
-    class Parameters(KickParameters):
+    class Parameters(KickParameters, PassParameters):
         search_turn: float = bounded(0.0, 2.0, 0.6)
         """rad/s while nobody knows where the ball is"""
         ready_goalkeeper: list[float] = field(default_factory=lambda: [-4200.0, 0.0, 0.0])
@@ -132,6 +134,11 @@ class SoccerBehavior(Module):
         """mm beyond the field's lines a walk may lead at most (the torso 0.3 m beyond one has left the field)"""
         detour_memory_s: float = bounded(0.0, 10.0, 1.5)
         """s a side chosen round an obstacle is kept for one dead ahead (no zigzag)"""
+        pass_decide_s: float = bounded(0.0, 10.0, 1.0)
+        """s a choice between a pass and a shot (and where to) is kept before it is made again: the approach
+        does not waver between two kick poses"""
+        pass_mate_age: float = bounded(0.0, 10.0, 2.5)
+        """s: a teammate whose last message is older is not passed to"""
 
     parameters: Parameters
 
@@ -143,6 +150,9 @@ class SoccerBehavior(Module):
         """this frame's kick is an own free kick's: indirect, never straight at the goal"""
         self.detour_side, self.detour_s = 0, -math.inf
         """the side last chosen round an obstacle, and when (s)"""
+        self.aim: tuple[float, float] | None = None
+        self.aim_is_pass, self.aim_s = False, -math.inf
+        """where the ball is played (field mm: a pass's target or the shot's point), whether it is a pass, and when chosen (s)"""
 
     def execute(self) -> None:
         out = self.motion_request
@@ -226,6 +236,35 @@ class SoccerBehavior(Module):
             ty = by + (math.copysign(beside, by if by else 1.0) - by) * (tx - bx) / to_line  # aim beside it instead
         rx, ry = pose.to_robot(tx, ty)
         return math.atan2(ry - ball.y, rx - ball.x)
+
+    def kick_plan(self) -> tuple[float, KickParameters, WalkKick]:
+        """The kick this frame (``passing``): the direction (rad, robot frame), the kick's parameters (tuned live)
+        and the walk kick's strength. A shot aims through the goal mouth's most open lane; a pass (by the pass
+        rule) goes to the point ahead of the teammate, by the walk kick its distance asks for (beyond it the
+        keyframe kick). The choice is kept ``pass_decide_s``; an own free kick is indirect; without a pose,
+        the goal's way by odometry."""
+        ball, pose, p = self.ball_model, self.robot_pose, self.parameters
+        tuned = self.kick_tuning.apply(p)
+        if self.indirect:
+            return self.indirect_direction(), tuned, WalkKick.long
+        if not pose.valid:
+            return goal_direction(ball, pose, self.odometry), tuned, WalkKick.long
+        bx, by = ball.field_position(pose)
+        now = self.frame_info.time_s
+        if self.aim is None or now - self.aim_s >= p.pass_decide_s or now < self.aim_s:
+            opponents = [pose.to_field(o.x, o.y) for o in self.obstacles.obstacles if o.kind is ObstacleKind.robot]
+            mates = [(m.message.x, m.message.y) for m in self.team_mates.fresh(p.pass_mate_age)
+                     if m.message.pose_valid and not (m.message.fallen or m.message.penalized)]
+            target = choose_pass((bx, by), mates, opponents, p)
+            self.aim, self.aim_is_pass, self.aim_s = target or best_shot((bx, by), opponents, p)[0], target is not None, now
+        ax, ay = pose.to_robot(*self.aim)
+        direction = math.atan2(ay - ball.y, ax - ball.x)
+        if not self.aim_is_pass:
+            return direction, tuned, WalkKick.long
+        strength = pass_kick(math.hypot(ax - ball.x, ay - ball.y), p)
+        if strength is WalkKick.none:  # farther than the walk kicks go: the keyframe kick
+            return direction, replace(tuned, walk_kick=False), WalkKick.long
+        return direction, replace(tuned, walk_kick=True), strength
 
     def keeper_clears(self) -> bool:
         """Whether the ball is in the own penalty area and near enough for the goalkeeper to clear it."""

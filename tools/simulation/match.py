@@ -31,8 +31,9 @@ from tafel.platforms.field_world import level_look
 from tafel.platforms.match_robot import AUTHKEY_ENV
 from tafel.platforms.match_world import TICK_NS, MatchWorld, Side
 from tafel.platforms.realism import parse_realism, realism_level
-from tafel.representations.game import GamePhase, SetPlay
+from tafel.representations.game import GamePhase, SetPlay, State
 from tafel.tools.simulation.officiating import Player
+from tafel.tools.simulation.passes import PassCounter
 from tafel.tools.simulation.referee import Referee
 from tafel.tools.simulation.rules import MAX_PLAYERS_PER_TEAM
 from tafel.tools.simulation.set_plays import Call
@@ -110,6 +111,8 @@ class Match:
         self.key = secrets.token_hex(16)
         self.listener = Listener(("127.0.0.1", 0), backlog=2 * MAX_PLAYERS_PER_TEAM, authkey=self.key.encode())  # all join at once
         self.robots: list[Robot] = []
+        #: completed passes and own goals, from ground truth (``passes.py``)
+        self.passes = PassCounter([player.team for player in self.players])
         #: CPU seconds of the world's process and of each robot's at the kickoff and at the final whistle
         self.cpu_at: dict[str, list[float | None]] = {}
 
@@ -216,7 +219,13 @@ class Match:
                 self.world.drive(index, targets, stiffness)
             previous = self.world.time_ns
             self.world.step_to(time_ns)
+            self.watch_passes(time_ns * 1e-9)
+            events = len(self.referee.events)
             self.referee.tick(time_ns * 1e-9, (time_ns - previous) * 1e-9)
+            for event in self.referee.events[events:]:  # a goal: whose last touch it was
+                conceding = 1 - TEAM_NUMBERS.index(int(event.what.split()[1])) if event.what.startswith("GOAL ") else None
+                if conceding is not None and self.passes.goal(conceding):
+                    print(f"[match] t={event.time_s:.1f}s own goal: team {TEAM_NUMBERS[conceding]}", flush=True)
             if self.referee.score() != last_score:
                 last_score = self.referee.score()
                 print(f"[match] t={time_ns * 1e-9:.1f}s goal: {TEAM_NUMBERS[0]}:{TEAM_NUMBERS[1]} {last_score}", flush=True)
@@ -238,6 +247,19 @@ class Match:
                 delay = started + time_ns * 1e-9 / speed - time.monotonic()
                 if delay > 0:
                     time.sleep(delay)
+
+    def watch_passes(self, now: float) -> None:
+        """Show the pass counter this tick's ground truth (before the referee judges it: a goal's last touch
+        is still known), and print a completed pass."""
+        game = self.referee.game
+        playing = game.state is State.playing and game.game_phase is GamePhase.normal
+        on_field = {player.index for player in self.referee.on_field()}
+        robots = [self.world.robot_pose(p.index)[:2] if p.index in on_field else None for p in self.players]
+        done = self.passes.observe(now, self.world.ball_position(), robots, playing)
+        if done is not None:
+            kicker, receiver = self.players[done.kicker], self.players[done.receiver]
+            print(f"[match] t={now:.1f}s pass: team {TEAM_NUMBERS[done.team]} player {kicker.number} to player {receiver.number}, "
+                  f"{done.distance_mm / 1000.0:.1f} m", flush=True)
 
     def finish(self, reason: str) -> dict[str, Any]:
         for robot in self.robots:
@@ -262,10 +284,13 @@ class Match:
                        "team_messages": referee.messages[t], "team_messages_heard": referee.messages_heard[t],
                        "message_budget_left": referee.game.teams[t].message_budget,
                        "fouls": sum(f.team == TEAM_NUMBERS[t] for f in referee.fouls),
+                       "passes": self.passes.count(t), "own_goals": self.passes.own_goals[t],
                        "illegal_communication": referee.illegal_communication[t]} for t in (0, 1)],
             "fouls": [{"time_s": round(f.time_s, 2), "team": f.team, "player": f.player, "penalty": f.penalty.name, "reason": f.reason}
                       for f in referee.fouls],
             "score": referee.score(),
+            "passes": [{"time_s": round(p.time_s, 2), "team": TEAM_NUMBERS[p.team], "kicker": self.players[p.kicker].number,
+                        "receiver": self.players[p.receiver].number, "distance_mm": round(p.distance_mm)} for p in self.passes.passes],
             **({"shoot_out": {"score": referee.shoot_out_score(), "winner": referee.winner,
                               "shots": [{"time_s": round(s.time_s, 2), "team": s.team, "striker": s.striker, "keeper": s.keeper,
                                          "outcome": s.outcome, "sudden_death": s.sudden_death} for s in referee.shots]}}
@@ -326,10 +351,11 @@ def command_match(args: argparse.Namespace, extra: Sequence[str]) -> int:
     if args.result is not None:
         args.result.write_text(line + "\n")
     fouls = ":".join(str(team["fouls"]) for team in result["teams"])
+    passes = ":".join(str(team["passes"]) for team in result["teams"])
     shoot_out = result.get("shoot_out")
     decided = "" if shoot_out is None else (f", shoot-out {shoot_out['score']} ("
                                             + (f"team {shoot_out['winner']} wins)" if shoot_out["winner"] else "undecided: a coin toss)"))
     realism = "" if match.realism == "off" else f", realism {match.realism}"
-    print(f"[match] {reason}; score {TEAM_NUMBERS[0]}:{TEAM_NUMBERS[1]} {result['score']}{decided}, fouls {fouls}{realism}", flush=True)
+    print(f"[match] {reason}; score {TEAM_NUMBERS[0]}:{TEAM_NUMBERS[1]} {result['score']}{decided}, fouls {fouls}, passes {passes}{realism}", flush=True)
     print(line, flush=True)
     return 0 if reason == "the game is over" else 1

@@ -124,8 +124,8 @@ class Striker(Option["SoccerBehavior"]):
         """Walk behind the ball on the kick's line and kick (``kicking.approach_and_kick``); far from the
         spot, facing the way (so that the robot sees what it walks into), round the robots in it."""
         ball, p, out = b.ball_model, b.parameters, b.motion_request
-        direction = b.indirect_direction() if b.indirect else goal_direction(ball, b.robot_pose, b.odometry)
-        approach_and_kick(ball, direction, b.kick_tuning.apply(p), out)
+        direction, kick, strength = b.kick_plan()  # a shot, or a pass by the pass rule (``passing.py``)
+        approach_and_kick(ball, direction, kick, out, strength)
         if out.motion is MotionType.walk_to and math.hypot(ball.x, ball.y) > p.near_ball:  # near it a duel is no push
             x, y, detoured = b.avoid(out.target_x, out.target_y)
             if detoured or math.hypot(x, y) > p.face_the_way:
