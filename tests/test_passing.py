@@ -77,3 +77,21 @@ def test_the_striker_turns_its_kick_to_a_better_placed_teammate_with_a_walk_kick
     assert marked.target_rotation == pytest.approx(0.0, abs=0.1)
     fallen = striker([TeamMessage(team=1, player=3, pose_valid=True, fallen=True, x=-1000.0, y=1500.0)])
     assert fallen.target_rotation == pytest.approx(0.0, abs=0.1)
+
+
+def test_the_goalkeeper_clearing_passes_out_to_an_open_striker_ahead() -> None:
+    """In a 2v2 the striker is the teammate better placed to score: the keeper's clearance goes to it."""
+    team = TeamInfo(team_number=1, players=[RobotInfo() for _ in range(20)])
+    state = GameState(state=State.playing, teams=[team, TeamInfo(team_number=2)], team_number=1, player_number=1, kicking_team=1)
+
+    def keeper(mates: list[TeamMessage]) -> MotionRequest:
+        harness = ModuleHarness(SoccerBehavior, state, PlayerRole(role=Role.goalkeeper), RobotPose(valid=True, x=-4200.0, y=0.0),
+                                BallModel(valid=True, seen=True, x=500.0, y=0.0), TeamMates(mates=[TeamMate(m, age=0.3) for m in mates]),
+                                MotionInfo(), Obstacles())
+        return harness.execute()[MotionRequest]
+
+    clear = keeper([])
+    assert clear.motion is MotionType.walk_to and clear.target_rotation == pytest.approx(0.0, abs=0.1)  # up the field
+    out = keeper([TeamMessage(team=1, player=2, pose_valid=True, x=-2200.0, y=-1500.0)])
+    aim = math.atan2(-1500.0, -2200.0 + 3700.0)  # from the ball at (-3700, 0) to the striker: about -0.79 rad
+    assert out.motion is MotionType.walk_to and out.target_rotation == pytest.approx(aim, abs=0.15)
