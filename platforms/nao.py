@@ -1,4 +1,4 @@
-"""The real NAO V6: LoLA for joints, IMU, foot pressure, touch, battery and LEDs; V4L2 for the cameras.
+"""The real NAO V6: LoLA for joints, IMU, foot pressure, touch, battery, sonars and LEDs; V4L2 for the cameras.
 
 LoLA (the robot's low-level daemon) sends one msgpack map every 12 ms over the Unix socket
 ``/tmp/robocup``; every packet is answered with exactly one actuator map. The packets drive the motion
@@ -46,6 +46,7 @@ from tafel.representations.motion import (
 )
 from tafel.representations.nao import HORIZONTAL_FOV, VERTICAL_FOV
 from tafel.representations.perception import CameraImageBottom, CameraImageTop
+from tafel.representations.sonar import SonarData
 
 log = logging.getLogger("tafel.platform.nao")
 
@@ -98,6 +99,15 @@ def convert_inertial(accelerometer: np.ndarray, gyroscope: np.ndarray, angles: n
                               gyroscope=np.asarray(gyroscope, dtype=float).copy(), angles=np.asarray(angles, dtype=float).copy())
 
 
+def sonar_data(values: Mapping[str, np.ndarray]) -> SonarData:
+    """LoLA's ``Sonar`` array (left, right: m to the nearest echo) as ``SonarData``; not valid where the
+    packet held none (it is not checked like the rest: a robot without sonars still walks)."""
+    sonar = values.get("Sonar")
+    if sonar is None:
+        return SonarData(valid=False)
+    return SonarData(left=float(sonar[0]), right=float(sonar[1]), valid=True)
+
+
 def parse_sensors(packet: Any) -> dict[str, np.ndarray]:
     """The sensor arrays of one LoLA packet, checked: a clear error for anything malformed."""
     if not isinstance(packet, dict):
@@ -112,6 +122,9 @@ def parse_sensors(packet: Any) -> dict[str, np.ndarray]:
             values[key] = np.asarray(raw, dtype=float)
         except (TypeError, ValueError):
             raise LolaProtocolError(f"malformed LoLA packet: {key} holds something that is not a number") from None
+    sonar = packet.get("Sonar")  # left, right (m): kept where it is two finite numbers
+    if isinstance(sonar, (list, tuple)) and len(sonar) == 2 and all(isinstance(v, (int, float)) and math.isfinite(v) for v in sonar):
+        values["Sonar"] = np.asarray(sonar, dtype=float)
     return values
 
 
@@ -120,7 +133,7 @@ class NaoPlatform(NetworkedPlatform, Platform):
     description = "the real NAO V6: LoLA (msgpack over /tmp/robocup) and both cameras through V4L2"
     clock = "own"
     provides: ClassVar[Mapping[str, tuple[type, ...]]] = {
-        "motion": (JointSensorData, InertialSensorData, FsrData, TouchSensorData, BatteryData),
+        "motion": (JointSensorData, InertialSensorData, FsrData, TouchSensorData, BatteryData, SonarData),
         "cognition": (CameraImageTop, CameraImageBottom, *NETWORK_INPUTS),
     }
     consumes: ClassVar[Mapping[str, tuple[type, ...]]] = {"motion": (JointCommand, LedRequest), "cognition": NETWORK_OUTPUTS}
@@ -278,6 +291,7 @@ class NaoPlatform(NetworkedPlatform, Platform):
             blackboard.set(FsrData(pressure=values["FSR"]))
             blackboard.set(TouchSensorData(pressed=values["Touch"]))
             blackboard.set(battery_data(values["Battery"]))
+            blackboard.set(sonar_data(values))
         elif context == "cognition":
             self.time_ns = clock.now_ns()
             self.network.receive(blackboard, self.time_ns)

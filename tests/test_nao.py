@@ -14,8 +14,10 @@ import pytest
 
 from tafel.core.logs import read_log
 from tafel.core.logs.serialization import deserialize
-from tafel.platforms.nao import CROUCH, LolaProtocolError, battery_data, convert_inertial, crouch_pose, parse_sensors
+from tafel.platforms.nao import CROUCH, LolaProtocolError, battery_data, convert_inertial, crouch_pose, parse_sensors, sonar_data
 from tafel.representations.motion import JOINT_INDEX, BatteryData, FsrData, InertialSensorData, TouchSensorData
+from tafel.representations.obstacles import Obstacles
+from tafel.representations.sonar import SONAR_ANGLE, SonarData
 from tests.support.fake_lola import KEY_ORDER, PACKET_SIZE, FakeLola, sensor_packet
 from tests.test_cli_runtime import REPO
 
@@ -62,8 +64,10 @@ def test_the_default_program_runs_both_contexts_with_web_view_debug_server_and_r
 @pytest.mark.slow
 def test_every_packet_gets_exactly_one_well_formed_answer(lola: FakeLola, tmp_path: Path) -> None:
     log = tmp_path / "nao.mcap"
+    lola.sonar = (0.6, 2.4)  # something 0.6 m away on the left
     result = run_nao(lola.path, "--frames", "200", "--record", str(log),
-                     "--record-reps", "InertialSensorData,FsrData,TouchSensorData,BatteryData")
+                     "--record-reps", "InertialSensorData,FsrData,TouchSensorData,BatteryData,SonarData,Obstacles",
+                     modules=f'["{LOOK_LEFT}", "{STAND}", "ObstacleModeler"]')
     finished(lola)
     assert result.returncode == 0, result.stderr
     assert "motion: 200 frames" in result.stdout
@@ -82,6 +86,13 @@ def test_every_packet_gets_exactly_one_well_formed_answer(lola: FakeLola, tmp_pa
     assert deserialize(TouchSensorData, next(m.data for m in contents.messages if m.topic == "motion/TouchSensorData")).pressed.shape == (14,)
     battery = deserialize(BatteryData, next(m.data for m in contents.messages if m.topic == "motion/BatteryData"))
     assert battery.charge == pytest.approx(0.99) and battery.current == pytest.approx(0.016) and battery.charging
+    # the sonars: read in motion, filtered there (SonarFilter), walked round in cognition (ObstacleModeler)
+    sonar = deserialize(SonarData, next(m.data for m in contents.messages if m.topic == "motion/SonarData"))
+    assert sonar.valid and (sonar.left, sonar.right) == pytest.approx((0.6, 2.4), abs=1e-5)
+    seen = [deserialize(Obstacles, m.data).obstacles for m in contents.messages if m.topic == "cognition/Obstacles"]
+    assert seen and seen[-1], "the echo on the left is no obstacle in cognition"
+    ahead = seen[-1][0]
+    assert math.hypot(ahead.x, ahead.y) == pytest.approx(600.0, abs=5.0) and math.atan2(ahead.y, ahead.x) == pytest.approx(SONAR_ANGLE)
 
 
 @pytest.mark.slow
@@ -215,3 +226,15 @@ def test_the_battery_reads_a_real_packet_in_the_order_the_teams_read_it() -> Non
     assert battery.current == pytest.approx(0.016)
     assert battery.temperature == pytest.approx(3.6)
     assert not battery_data([0.5, 0.0, -1.2, 3.0]).charging
+
+
+def test_the_sonars_are_read_where_a_packet_holds_them_and_only_then() -> None:
+    """LoLA's ``Sonar`` (left, right in m) as ``SonarData``; a packet without it (or with something else
+    there) still drives the robot, with no sonar reading."""
+    import msgpack
+
+    good = msgpack.unpackb(sensor_packet([0.0] * 25, [0.0] * 25, 0, sonar=(0.45, 5.0)))
+    sonar = sonar_data(parse_sensors(good))
+    assert sonar.valid and (sonar.left, sonar.right) == pytest.approx((0.45, 5.0), abs=1e-6)
+    for broken in ({k: v for k, v in good.items() if k != "Sonar"}, dict(good, Sonar=[0.4]), dict(good, Sonar=["x", 1.0])):
+        assert not sonar_data(parse_sensors(broken)).valid

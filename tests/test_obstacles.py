@@ -10,9 +10,12 @@ from hypothesis import strategies as st
 
 from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.paths import blocking, outside, waypoint
-from tafel.modules.modeling.obstacle_modeler import ObstacleModeler
+from tafel.modules.modeling.obstacle_modeler import GOAL_POSTS, ObstacleModeler
+from tafel.modules.motion.sonar_filter import SonarFilter
 from tafel.representations.modeling import RobotPose
-from tafel.representations.obstacles import ObstacleKind, Obstacles, RobotsPercept, SeenRobot
+from tafel.representations.motion_control import FallPhase, FallState
+from tafel.representations.obstacles import ROBOT_RADIUS, ObstacleKind, Obstacles, RobotsPercept, SeenRobot
+from tafel.representations.sonar import SONAR_ANGLE, SonarData, SonarEcho, SonarPercept
 from tafel.representations.team import TeamMate, TeamMates, TeamMessage
 
 
@@ -67,3 +70,52 @@ def test_a_target_in_a_forbidden_disc_moves_to_its_edge(zones: list, x: float, y
     ox, oy = outside(x, y, zones)
     for cx, cy, radius in zones:
         assert math.hypot(ox - cx, oy - cy) >= radius - 1e-6
+
+
+def sonar_filter(left_m: float, right_m: float, *, frames: int = 30, upright: bool = True) -> SonarPercept:
+    harness = ModuleHarness(SonarFilter, SonarData(left=left_m, right=right_m, valid=True),
+                            FallState() if upright else FallState(phase=FallPhase.lying_front))
+    return harness.execute(frames)[SonarPercept]
+
+
+def test_a_near_echo_is_an_obstacle_in_the_middle_of_its_sonars_cone_and_both_alike_one_straight_ahead() -> None:
+    left = sonar_filter(0.6, 5.0)
+    assert len(left.echoes) == 1 and left.right == 0.0
+    echo = left.echoes[0]
+    assert math.hypot(echo.x, echo.y) == pytest.approx(600.0) and math.atan2(echo.y, echo.x) == pytest.approx(SONAR_ANGLE)
+    right = sonar_filter(5.0, 0.9).echoes
+    assert len(right) == 1 and math.atan2(right[0].y, right[0].x) == pytest.approx(-SONAR_ANGLE)
+    both = sonar_filter(0.7, 0.75).echoes
+    assert [(round(e.x), round(e.y)) for e in both] == [(725, 0)]
+
+
+def test_echoes_of_the_own_arms_far_ones_and_any_while_not_upright_are_no_obstacles() -> None:
+    assert sonar_filter(0.15, 0.2).echoes == []  # the own arms, the floor
+    assert sonar_filter(2.4, 5.0).echoes == []  # beyond what the sonars measure reliably
+    assert sonar_filter(0.6, 0.6, upright=False).echoes == []
+
+
+def test_one_stray_packet_is_no_obstacle_but_an_echo_that_stays_is() -> None:
+    harness = ModuleHarness(SonarFilter, SonarData(left=5.0, right=5.0, valid=True), FallState())
+    harness.execute(10)
+    harness.set(SonarData(left=0.5, right=5.0, valid=True))
+    assert harness.execute()[SonarPercept].echoes == []  # smoothed: one packet moves the distance a little
+    assert harness.execute(20)[SonarPercept].echoes != []
+
+
+def test_sonar_echoes_become_obstacles_and_stay_put_while_the_robot_turns() -> None:
+    harness = ModuleHarness(ObstacleModeler, RobotPose(valid=True), SonarPercept(echoes=[SonarEcho(500.0, 0.0)]))
+    found = harness.execute()[Obstacles].obstacles
+    assert [(round(o.x), round(o.y), o.kind) for o in found] == [(500, 0, ObstacleKind.robot)]
+    assert harness.blackboard[Obstacles].clearance == pytest.approx(500.0 - ROBOT_RADIUS)
+    harness.set(SonarPercept(echoes=[]), RobotPose(valid=True, rotation=math.pi / 2))
+    held = harness.execute()[Obstacles].obstacles
+    assert len(held) == 1 and (held[0].x, held[0].y) == pytest.approx((0.0, -500.0), abs=1e-6)
+
+
+def test_a_robot_seen_at_a_goal_post_is_the_post() -> None:
+    post = GOAL_POSTS[0]
+    pose = RobotPose(valid=True, x=post[0] + 1000.0, y=post[1], rotation=math.pi)  # facing the post, 1 m away
+    seen = RobotsPercept(robots=[SeenRobot(1000.0, 0.0), SeenRobot(1000.0, 600.0)])
+    found = ModuleHarness(ObstacleModeler, pose, seen).execute()[Obstacles].obstacles
+    assert [(round(o.x), round(o.y)) for o in found] == [(1000, 600)]

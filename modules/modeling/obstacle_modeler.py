@@ -6,25 +6,33 @@ import math
 from dataclasses import dataclass
 
 from tafel.core import Module, bounded, provides, requires, uses
+from tafel.representations.field import GOAL_INNER_WIDTH, GOAL_POST_DIAMETER, LENGTH
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import RobotPose
 from tafel.representations.obstacles import ROBOT_RADIUS, Obstacle, ObstacleKind, Obstacles, RobotsPercept
+from tafel.representations.sonar import SonarPercept
 from tafel.representations.team import TeamMates
+
+#: the goal posts' centres on the field (mm)
+GOAL_POSTS = [(sx * LENGTH / 2, sy * (GOAL_INNER_WIDTH + GOAL_POST_DIAMETER) / 2) for sx in (-1, 1) for sy in (-1, 1)]
 
 
 @requires(FrameInfo)
-@uses(RobotsPercept, TeamMates, RobotPose)
+@uses(RobotsPercept, SonarPercept, TeamMates, RobotPose)
 @provides(Obstacles)
 class ObstacleModeler(Module):
-    """Keeps the robots seen (``RobotsPercept``) for ``memory_s`` s, on the field while the pose is
+    """Keeps the robots seen (``RobotsPercept``: in the images or, in ``--cameras off`` matches, from
+    ground truth) and heard (``SonarPercept``'s echoes) for ``memory_s`` s, on the field while the pose is
     valid (so that they stay put while this robot turns and walks), and adds every teammate that said
     where it is within ``mate_timeout`` s and is not penalized (a penalized robot is off the field).
     A teammate's radius grows with the age of its message (``mate_spread`` mm/s: it may have walked
     meanwhile); a seen robot within ``same_robot`` mm of a teammate is that teammate, and one seen
-    again within two robot radii of where it was remembered replaces that memory."""
+    again within two robot radii of where it was remembered replaces that memory. Something seen within
+    ``post_radius`` mm of a goal post (where the pose puts them) is that post, not a robot."""
 
     frame_info: FrameInfo
     robots_percept: RobotsPercept
+    sonar_percept: SonarPercept
     team_mates: TeamMates
     robot_pose: RobotPose
     obstacles: Obstacles
@@ -42,6 +50,8 @@ class ObstacleModeler(Module):
         """mm: a seen robot this near a teammate is the teammate"""
         max_distance: float = bounded(500.0, 15000.0, 4000.0)
         """mm: obstacles farther away are left out"""
+        post_radius: float = bounded(0.0, 1000.0, 300.0)
+        """mm round a goal post within which what is seen is the post"""
 
     parameters: Parameters
 
@@ -51,8 +61,10 @@ class ObstacleModeler(Module):
     def execute(self) -> None:
         p, pose, now, out = self.parameters, self.robot_pose, self.frame_info.time_s, self.obstacles
         obstacles: list[Obstacle] = []
+        seen = [(r.x, r.y) for r in self.robots_percept.robots] + [(e.x, e.y) for e in self.sonar_percept.echoes]
         if pose.valid:
-            fresh = [(*pose.to_field(r.x, r.y), now) for r in self.robots_percept.robots]
+            fresh = [(*pose.to_field(x, y), now) for x, y in seen]
+            fresh = [(x, y, t) for x, y, t in fresh if all(math.hypot(x - px, y - py) > p.post_radius for px, py in GOAL_POSTS)]
             kept = [(x, y, t) for x, y, t in self.seen
                     if now - t <= p.memory_s and all(math.hypot(x - fx, y - fy) > 2 * ROBOT_RADIUS for fx, fy, _ in fresh)]
             self.seen = fresh + kept  # a robot seen again replaces its memory
@@ -67,7 +79,7 @@ class ObstacleModeler(Module):
                 obstacles.append(Obstacle(x, y, ROBOT_RADIUS, ObstacleKind.robot, now - when))
         else:  # without a pose: what is seen now, in the robot frame
             self.seen = []
-            obstacles = [Obstacle(r.x, r.y, ROBOT_RADIUS, ObstacleKind.robot, 0.0) for r in self.robots_percept.robots]
+            obstacles = [Obstacle(x, y, ROBOT_RADIUS, ObstacleKind.robot, 0.0) for x, y in seen]
         obstacles = sorted((o for o in obstacles if math.hypot(o.x, o.y) <= p.max_distance), key=lambda o: math.hypot(o.x, o.y))
         out.obstacles = obstacles
         out.clearance = max(0.0, min((math.hypot(o.x, o.y) - o.radius for o in obstacles), default=0.0))

@@ -24,7 +24,7 @@ BODY_ID, HEAD_ID = "P0000073A07S94700014", "P0000074A05S93J00024"  # 20 characte
 def sensor_packet(positions: list[float], stiffness: list[float], index: int, *,
                   accelerometer: tuple[float, float, float] = (0.1, 0.0, -9.81),
                   gyroscope: tuple[float, float, float] = (0.0, 0.0, 0.01),
-                  angles: tuple[float, float] = (0.0, 0.01)) -> bytes:
+                  angles: tuple[float, float] = (0.0, 0.01), sonar: tuple[float, float] = (2.0, 2.0)) -> bytes:
     """One packet as LoLA sends it: its key order, 20-character IDs, float32 values, exactly 896 bytes.
 
     The accelerometer is in LoLA's convention (-9.81 on z when upright).
@@ -33,7 +33,7 @@ def sensor_packet(positions: list[float], stiffness: list[float], index: int, *,
         "RobotConfig": [BODY_ID, "6.0.0", HEAD_ID, "6.0.0"],
         "Accelerometer": list(accelerometer), "Angles": list(angles), "Battery": [0.99, -32552.0, 0.016, 3.6],  # NaoTH's real packet (charging)
         "Current": [0.1] * 25, "FSR": [0.6] * 8, "Gyroscope": list(gyroscope), "Position": list(positions),
-        "Sonar": [2.0, 2.0], "Stiffness": list(stiffness), "Temperature": [35.0] * 25, "Touch": [0.0] * 14,
+        "Sonar": list(sonar), "Stiffness": list(stiffness), "Temperature": [35.0] * 25, "Touch": [0.0] * 14,
         "Status": [index % 2] * 25,
     }
     data = msgpack.Packer(use_single_float=True).pack({key: values[key] for key in KEY_ORDER})
@@ -52,6 +52,7 @@ class FakeLola:
         self.sizes: set[int] = set()
         self.positions = [0.0] * 25
         self.stiffness = [0.0] * 25
+        self.sonar = (2.0, 2.0)  # m: what the left and right sonars hear
         self.stop = threading.Event()
         self.server = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
         self.server.bind(str(path))
@@ -74,7 +75,7 @@ class FakeLola:
                 if self.garbage_after is not None and self.sent >= self.garbage_after:
                     data = b"\xc1" * PACKET_SIZE  # 0xc1 is never used by msgpack
                 else:
-                    data = sensor_packet(self.positions, self.stiffness, self.sent)
+                    data = sensor_packet(self.positions, self.stiffness, self.sent, sonar=self.sonar)
                 self.sizes.add(len(data))
                 try:
                     client.sendall(data)
