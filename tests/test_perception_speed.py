@@ -33,7 +33,7 @@ from tafel.modules.perception.goal_post_detector import (
 )
 from tafel.modules.perception.image_geometry import ImageProjection, camera_views, own_body_mask
 from tafel.modules.perception.line_detector import CIRCLE_RADIUS, LineDetector, green_on_both_sides, longest_arc, white_runs
-from tafel.modules.perception.spl_ball_detector import SPLBallDetector, Spot, carpet, carpet_sample
+from tafel.modules.perception.spl_ball_detector import SPLBallDetector, Spot, carpet, carpet_sample, centroids, green_below, white_halves
 from tafel.platforms.images import posed_image
 from tafel.representations.field import BALL_RADIUS, GOAL_HEIGHT, GOAL_POST_DIAMETER
 from tafel.representations.motion import CameraMatrix
@@ -154,6 +154,106 @@ def reference_spots(self: SPLBallDetector, green: np.ndarray, boundary: np.ndarr
     return chosen
 
 
+def reference_green_below(green: np.ndarray, x: float, y: float, radius: float) -> float:
+    height, width = green.shape
+    reach = int(math.ceil(1.7 * radius)) + 1
+    x0, x1 = max(0, int(x) - reach), min(width, int(x) + reach + 1)
+    y0, y1 = max(0, int(y)), min(height, int(y) + reach + 1)
+    if x1 <= x0 or y1 <= y0:
+        return 0.0
+    yy, xx = np.mgrid[y0:y1, x0:x1]
+    d = np.hypot(xx - x, yy - y)
+    ring = (d >= 1.2 * radius) & (d <= 1.7 * radius) & (yy > y)
+    return float(green[y0:y1, x0:x1][ring].mean()) if ring.any() else 0.0
+
+
+def reference_white_halves(value: np.ndarray, x: float, y: float, radius: float) -> float:
+    height, width = value.shape
+    reach = int(math.ceil(radius))
+    x0, x1 = max(0, int(round(x)) - reach), min(width, int(round(x)) + reach + 1)
+    y0, y1 = max(0, int(round(y)) - reach), min(height, int(round(y)) + reach + 1)
+    yy, xx = np.mgrid[y0:y1, x0:x1]
+    disc = (xx - x) ** 2 + (yy - y) ** 2 <= radius**2
+    patch = value[y0:y1, x0:x1]
+    if not disc.any():
+        return 0.0
+    white = patch >= 0.6 * float(patch[disc].max())
+    shares = [float(white[disc & side].mean()) for side in (xx < x, xx > x) if (disc & side).any()]
+    return min(shares) if len(shares) == 2 else 0.0
+
+
+def reference_centroid(mask: np.ndarray, x: float, y: float, radius: float) -> tuple[float, float]:
+    height, width = mask.shape
+    reach = int(math.ceil(radius))
+    x0, x1 = max(0, int(round(x)) - reach), min(width, int(round(x)) + reach + 1)
+    y0, y1 = max(0, int(round(y)) - reach), min(height, int(round(y)) + reach + 1)
+    yy, xx = np.mgrid[y0:y1, x0:x1]
+    near = (mask[y0:y1, x0:x1] > 0) & ((xx - x) ** 2 + (yy - y) ** 2 <= radius**2)
+    if not near.any():
+        return x, y
+    return float(xx[near].mean()), float(yy[near].mean())
+
+
+def reference_edge_spots(self: SPLBallDetector, hsv: np.ndarray, green: np.ndarray, boundary: np.ndarray, projection: ImageProjection,
+                         carpet_value: float, taken: list[Spot]) -> list[Spot]:
+    """The band search over the whole band (every column, down to its lowest row), one candidate after the other."""
+    p = self.parameters
+    height, width = green.shape
+    if boundary.size != width:
+        return []
+    columns = np.linspace(0, width - 1, 9).astype(int)
+    centres, hits = projection.to_ground(columns, np.minimum(boundary[columns], height - 1), BALL_RADIUS)
+    ranges = np.linalg.norm(np.column_stack([centres, np.full(len(columns), BALL_RADIUS)]) - projection.translation, axis=1)
+    if not (hits & (projection.fx * BALL_RADIUS / np.maximum(ranges, 1.0) <= p.edge_max_radius)).any():
+        return []
+    top = max(0, int(boundary.min()) - p.edge_above)
+    bottom = min(height, int(boundary.max()) + p.edge_below + 1)
+    if bottom - top < 3:
+        return []
+    rows = np.arange(top, bottom)[:, None]
+    band = (rows >= boundary[None, :] - p.edge_above) & (rows <= boundary[None, :] + p.edge_below)
+    value, saturation = hsv[top:bottom, :, 2], hsv[top:bottom, :, 1]
+    black = value <= p.edge_black * carpet_value
+    white = (value >= p.edge_white * carpet_value) & (saturation <= p.saturation_max)
+    ballish = (cv2.morphologyEx(((white | black) & ~green[top:bottom]).astype(np.uint8), cv2.MORPH_CLOSE, np.ones((3, 3), np.uint8))
+               & band.astype(np.uint8))
+    if not ballish.any():
+        return []
+    thickness = cv2.distanceTransform(ballish, cv2.DIST_L2, 3)
+    peaks = (thickness >= p.min_radius) & (thickness >= cv2.dilate(thickness, np.ones((3, 3), np.uint8)))
+    ys, xs = np.nonzero(peaks)
+    if len(xs) == 0:
+        return []
+    radii = thickness[ys, xs]
+    centres, hits = projection.to_ground(xs, ys + top, BALL_RADIUS)
+    points = np.column_stack([centres, np.full(len(xs), BALL_RADIUS)])
+    distance = np.linalg.norm(points - projection.translation, axis=1)
+    expected = np.where(hits, projection.fx * BALL_RADIUS / np.maximum(distance, 1.0), 0.0)
+    fits = hits & (expected <= p.edge_max_radius) & (radii >= p.size_low * expected) & (radii <= p.size_high * expected + 1.0)
+    if not fits.any():
+        return []
+    xs, ys, radii, expected = xs[fits], ys[fits], radii[fits], expected[fits]
+    patched = reference_dark_share(black, xs, ys, np.maximum(radii, 1.0)) >= p.dark_spot_min
+    xs, ys, radii, expected = xs[patched], ys[patched] + top, radii[patched], expected[patched]
+    order = np.argsort(np.abs(np.log(np.maximum(radii, 0.5) / np.maximum(expected, 0.5))))
+    chosen: list[Spot] = []
+    for i in order[: 10 * p.edge_max_spots]:
+        x, y, r, e = float(xs[i]), float(ys[i]), float(radii[i]), float(expected[i])
+        if any((x - s.x) ** 2 + (y - s.y) ** 2 <= (max(s.expected, e) * 1.5) ** 2 for s in (*taken, *chosen)):
+            continue
+        for _ in range(2):
+            x, y = reference_centroid(ballish, x, y - top, e)
+            y += top
+        if reference_green_below(green, x, y, e) < p.edge_green_below:
+            continue
+        if reference_white_halves(value, x, y - top, e) < p.edge_white_halves:
+            continue
+        chosen.append(Spot(x, y, max(r, e), e, edge=True))
+        if len(chosen) >= p.edge_max_spots:
+            break
+    return chosen
+
+
 def reference_check(self: SPLBallDetector, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float,
                     beside_post: bool = False) -> tuple[float, bool]:
     p = self.parameters
@@ -271,6 +371,65 @@ def test_spl_checks_anywhere_are_the_loops(painted: tuple[np.ndarray, np.ndarray
             assert self.check(hsv, green, spot, white, beside) == reference_check(self, hsv, green, spot, white, beside)
         moved, old = self.beside_post(hsv, green, spot, white), reference_beside_post(self, hsv, green, spot, white)
         same_spots([moved] if moved else [], [old] if old else [])
+
+
+#: the band search's parameters that let the most candidates through to its last checks (where the loops ran)
+LOOSE_BAND = {"dark_spot_min": 0.0, "edge_green_below": 0.0, "edge_white_halves": 0.0, "edge_max_spots": 20}
+
+
+def same_band_spots(self: SPLBallDetector, hsv: np.ndarray, green: np.ndarray, boundary: np.ndarray, projection: ImageProjection,
+                    taken: list[Spot]) -> int:
+    """The band search's spots, asserted those of the loops over the whole band, with the module's parameters and with
+    ``LOOSE_BAND``; how many the loose search found."""
+    sampled = carpet_sample(hsv, green)
+    if len(sampled) < 10:
+        return 0
+    strict, value = self.strict_green(hsv, green, sampled), byte_median(sampled[:, 2])
+    found = 0
+    for loose in (False, True):
+        if loose:
+            self.parameters = SPLBallDetector.Parameters(**LOOSE_BAND)
+        spots = self.edge_spots(hsv, strict, boundary, projection, value, list(taken))
+        same_spots(spots, reference_edge_spots(self, hsv, strict, boundary, projection, value, list(taken)))
+        assert all(spot.edge for spot in spots)
+        found = len(spots)
+    self.parameters = SPLBallDetector.Parameters()
+    return found
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([(640, 480), (320, 240), (120, 90)]), st.floats(-0.05, 0.35))
+def test_the_band_search_is_the_loops_over_the_whole_band(seed: int, size: tuple[int, int], pitch: float) -> None:
+    """Painted scenes seen level to pitched down: the band search narrowed to where a ball is small finds the spots that
+    the search of the whole band, one candidate after the other, found."""
+    hsv, green, boundary, _ = scene(seed, *size)
+    self = detector()
+    projection = level_projection(*size, pitch)
+    taken = self.spots(green, boundary, projection)[:3]
+    same_band_spots(self, hsv, green, boundary, projection, taken)
+
+
+@settings(max_examples=200)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(0, 12), st.integers(1, 12))
+def test_the_band_candidates_measures_at_once_are_each_ones(seed: int, height: int, width: int, left: int, count: int) -> None:
+    """Centroids, the carpet below and the white halves of many points at once: to the last bit the loops' for each,
+    for points anywhere in the image, of radii from under a pixel to a dozen, whole and half-way ones too."""
+    rng = np.random.default_rng(seed)
+    mask = rng.random((height, width)) < rng.random()
+    value = rng.integers(0, 256, (height, width)).astype(np.uint8)
+    xs = rng.uniform(0, width - 1, count)
+    ys = rng.uniform(0, height - 1, count)
+    halves = rng.random(count) < 0.3
+    xs[halves], ys[halves] = np.round(xs[halves] * 2) / 2, np.round(ys[halves] * 2) / 2
+    radii = np.where(rng.random(count) < 0.3, rng.integers(1, 10, count).astype(float), rng.uniform(0.3, 12.0, count))
+    shifted = np.zeros((height, left + width), np.uint8)  # the mask as the columns from ``left`` on of a wider image
+    shifted[:, left:] = mask
+    x, y = centroids(mask.view(np.uint8), xs + left, ys, radii, left)
+    below, whites = green_below(mask, xs, ys, radii), white_halves(value, xs, ys, radii)
+    for i in range(count):
+        assert (x[i], y[i]) == reference_centroid(shifted, xs[i] + left, ys[i], radii[i])
+        assert below[i] == reference_green_below(mask, xs[i], ys[i], radii[i])
+        assert whites[i] == reference_white_halves(value, xs[i], ys[i], radii[i])
 
 
 # -------------------------------------------------------------- LineDetector and FieldBoundaryDetector
@@ -632,19 +791,25 @@ def recorded_frames() -> Iterator[dict[str, Any]]:
             yield {"top": empty, "bottom": empty, camera: view}
 
 
-def test_goal_posts_in_recorded_frames_are_the_loops() -> None:
+def test_goal_posts_and_the_band_search_in_recorded_frames_are_the_loops() -> None:
     """On every real image (at both resolutions; renders where the set is absent), after the perception
-    before it has run: the same posts as the loops, bit for bit."""
-    found = 0
+    before it has run: the same posts as the loops, bit for bit, and the band search's spots as the loops over the
+    whole band found them."""
+    found = spots = 0
     for frames in recorded_frames():
         perception = Perception()
         perception(frames)  # type: ignore[arg-type]
         self = perception.manager.module("GoalPostDetector")
+        ball = perception.manager.module("SPLBallDetector")
+        assert isinstance(ball, SPLBallDetector)
         for camera, image, projection in camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer):
             boundary = self.field_boundary.rows(camera)
             if boundary.size == projection.width:
                 found += len(same_posts_as_the_loops(self, camera, np.asarray(image.image), boundary, projection))
+            hsv, green = ball.segmented_image.hsv(camera), ball.segmented_image.green(camera)
+            spots += same_band_spots(ball, hsv, green, boundary, projection, [])
     assert found > 0  # the frames held posts, so the whole of the check ran
+    assert spots > 0  # the loose band search found spots, so the whole of it ran
 
 
 def post_scene(seed: int, width: int, height: int, pitch: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, np.ndarray, ImageProjection]:
