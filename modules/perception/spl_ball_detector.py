@@ -11,7 +11,7 @@ import numpy as np
 from tafel.core import Module, bounded, provides, requires
 from tafel.debug import Canvas, DebugRequest, Stopwatch
 from tafel.modules.perception.ball_classifier import BallClassifier, features
-from tafel.modules.perception.field_color_provider import below, byte_median, white_pixels
+from tafel.modules.perception.field_color_provider import below, byte_median, byte_percentile, white_pixels
 from tafel.modules.perception.image_geometry import ImageProjection, camera_views
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import CameraMatrixBuffer
@@ -30,6 +30,10 @@ from tafel.representations.perception import (
 #: distance transform of the pixels within 17 px), its black patches (a square of its thickness) and its centre
 #: moved twice by up to a radius (9 px), then its disc (9 px); beyond them, the band's pixels change nothing
 EDGE_REACH = 30
+
+#: the tests of ``SPLBallDetector.verdict`` whose thresholds the second look loosens: a spot that failed another one
+#: (too few pixels, under a post, too much green round it) fails it again with the looser thresholds
+LOOSER_TESTS = ("saturation", "dark", "black")
 
 
 def carpet_sample(hsv: np.ndarray, green: np.ndarray) -> np.ndarray:
@@ -263,7 +267,7 @@ class SPLBallDetector(Module):
                 white = self.segmented_image.white(camera)
                 light: tuple[float, float] | None = None
                 for spot in spots:
-                    score, under_post = self.check(hsv, green, spot, white)
+                    score, under_post, failed = self.verdict(hsv, green, spot, white)
                     if under_post:  # perhaps a ball behind a post, merged with it in the image: look beside it
                         beside = self.beside_post(hsv, green, spot, white)
                         score = self.check(hsv, green, beside, white, beside_post=True)[0] if beside else 0.0
@@ -276,7 +280,8 @@ class SPLBallDetector(Module):
                     if score and self.parameters.classifier:
                         light = light or carpet(hsv, green, sampled)
                         score = self.classify(hsv, green, spot, score, light)
-                    elif not score and not under_post and self.parameters.classifier and self.parameters.second_look:
+                    elif (not score and failed in LOOSER_TESTS and self.parameters.classifier  # the second look's looser
+                          and self.parameters.second_look):  # thresholds decide only where one of theirs failed
                         light = light or carpet(hsv, green, sampled)
                         score = self.second_look(hsv, green, spot, white, light)
                     if self.draw_candidates:
@@ -313,9 +318,13 @@ class SPLBallDetector(Module):
         p = self.parameters
         if not square_inside(spot, green.shape):
             return 0.0
-        loose = replace(p, dark_ratio=p.second_dark_ratio, black_contrast=p.second_black_contrast, saturation_max=p.second_saturation_max)
-        score = self.check(hsv, green, spot, white, parameters=loose)[0]
+        score = self.check(hsv, green, spot, white, parameters=self.looser())[0]
         return self.decide(hsv, green, spot, score, light, least=p.second_look_min) if score else 0.0
+
+    def looser(self) -> SPLBallDetector.Parameters:
+        """The second look's thresholds: the module's with ``second_*`` for the tests of ``LOOSER_TESTS``."""
+        p = self.parameters
+        return replace(p, dark_ratio=p.second_dark_ratio, black_contrast=p.second_black_contrast, saturation_max=p.second_saturation_max)
 
     def dark_pixels(self, hsv: np.ndarray, green: np.ndarray, sampled: np.ndarray | None = None) -> np.ndarray | None:
         """Pixels darker than ``black_contrast`` times the carpet's median value (the ball's black patches
@@ -582,6 +591,13 @@ class SPLBallDetector(Module):
         it). ``white``: the value (V) of the image's brightest non-green pixels. ``beside_post``: the
         spot was moved off a post already (its edge may still be in the way above). ``parameters``: other
         thresholds than the module's (``second_look``)."""
+        score, under_post, _ = self.verdict(hsv, green, spot, white, beside_post, parameters)
+        return score, under_post
+
+    def verdict(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, beside_post: bool = False,
+                parameters: Parameters | None = None) -> tuple[float, bool, str]:
+        """``check``'s (score, under a post) and the test a spot that is no ball failed (``LOOSER_TESTS``: one that the
+        second look's thresholds loosen; "" for a ball)."""
         p = parameters or self.parameters
         height, width = green.shape
         r = spot.radius
@@ -592,36 +608,50 @@ class SPLBallDetector(Module):
         inside, around = d <= 0.9 * r, (d >= 1.2 * r) & (d <= 1.7 * r)
         n_inside, n_around = np.count_nonzero(inside), np.count_nonzero(around)
         if n_inside < 3 or n_around < 3:
-            return 0.0, False
+            return 0.0, False, "size"
         patch_green, patch = green[y0:y1, x0:x1], hsv[y0:y1, x0:x1]
         solid = inside & ~patch_green  # the ball's own pixels: green ones would count as dark next to white
         if np.count_nonzero(solid) < 3:
-            return 0.0, False
-        if not beside_post:
-            first, posts = self.post_columns(hsv, green, spot, white)
-            if 0 <= int(spot.x) - first < len(posts) and posts[int(spot.x) - first]:
-                return 0.0, True
+            return 0.0, False, "size"
+        if not beside_post and self.under_post(hsv, green, spot, white):
+            return 0.0, True, "post"
         # the tests one by one, the cheapest first: most spots fail one of the first
         green_inside = np.count_nonzero(patch_green & inside) / n_inside
         green_around = np.count_nonzero(patch_green & around) / n_around
         if green_inside > p.green_inside_max or green_around < p.green_around_min:
-            return 0.0, False
+            return 0.0, False, "green"
         saturation = float(patch[..., 1][inside].mean())
         if saturation > p.saturation_max:
-            return 0.0, False
-        value = patch[..., 2][solid].astype(float)
-        bright = np.percentile(value, 90)
+            return 0.0, False, "saturation"
+        own = patch[..., 2][solid]
+        bright = byte_percentile(own, 90)  # np.percentile's, from the bytes' histogram
+        value = own.astype(float)
         is_dark = value < p.dark_ratio * bright
         dark = np.count_nonzero(is_dark) / len(value)
         if not p.dark_share_min <= dark <= p.dark_share_max:
-            return 0.0, False
+            return 0.0, False, "dark"
         carpet = patch[..., 2][around & patch_green]
-        field_value = float(np.median(carpet if carpet.size >= 3 else patch[..., 2][around]))
+        field_value = byte_median(carpet if carpet.size >= 3 else patch[..., 2][around])
         black = value[is_dark]
         darkest = float(black.mean()) if black.size else math.inf  # the black patches' value
         if darkest > p.black_contrast * field_value:
-            return 0.0, False
-        return float(min(1.0, 0.5 + dark + 0.3 * green_around - green_inside)), False
+            return 0.0, False, "black"
+        return float(min(1.0, 0.5 + dark + 0.3 * green_around - green_inside)), False, ""
+
+    def under_post(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float) -> bool:
+        """Whether ``post_columns`` flags the spot's own column (only that column measured)."""
+        p = self.parameters
+        column = int(spot.x)
+        x0, x1 = max(0, int(spot.x - 3 * spot.radius)), min(green.shape[1], int(spot.x + 3 * spot.radius) + 1)
+        y0, y1 = int(max(0, spot.y - 4 * spot.radius)), int(max(0, spot.y - 1.5 * spot.radius))
+        if not x0 <= column < x1 or y1 - y0 < 2:
+            return False
+        r = max(1, int(spot.radius))
+        own = hsv[max(0, int(spot.y) - r) : int(spot.y) + r + 1, max(0, int(spot.x) - r) : int(spot.x) + r + 1, 2]
+        white = max(white, float(own.max())) if own.size else white
+        above = hsv[y0:y1, column]
+        whites = (above[:, 2] >= p.post_white * white) & (above[:, 1] <= p.saturation_max) & ~green[y0:y1, column]
+        return bool(np.count_nonzero(whites) / len(whites) >= p.post_share)
 
     def post_columns(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float) -> tuple[int, np.ndarray]:
         """(first column, flags): for the columns within three radii of the spot, whether something white
