@@ -12,18 +12,18 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from tafel.core import Module, bounded, provides, requires, uses
+from tafel.core import Module, bounded, provides, uses
 from tafel.representations.motion_control import FallState
 from tafel.representations.sonar import SONAR_ANGLE, SonarData, SonarEcho, SonarPercept
 
 
-@requires(SonarData)
-@uses(FallState)
+@uses(SonarData, FallState)
 @provides(SonarPercept)
 class SonarFilter(Module):
     """Each side: ``smoothing`` of the new reading per packet; an echo between ``nearest`` and
     ``farthest`` mm is an obstacle ``SONAR_ANGLE`` to its side; both within ``same_distance`` mm of
-    each other: one obstacle straight ahead at their mean."""
+    each other: one obstacle straight ahead at their mean. Platforms without sonars (the simulators)
+    provide no ``SonarData``: then there are no echoes."""
 
     sonar_data: SonarData
     fall_state: FallState
