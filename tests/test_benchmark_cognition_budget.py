@@ -1,0 +1,47 @@
+"""benchmarks/cognition_budget.py's figures: each cognition frame's wall time and its thread's CPU time."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from pathlib import Path
+from types import ModuleType
+
+import cv2
+import numpy as np
+import pytest
+
+from tafel.platforms.images import standing_camera
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+def benchmark() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("cognition_budget_benchmark", REPO / "benchmarks" / "cognition_budget.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.slow
+def test_each_frame_has_its_wall_time_and_its_cpu_time(tmp_path: Path) -> None:
+    """A painted field (carpet below, hall above) seen by both cameras: the default cognition runs each frame once, and
+    each frame has a wall time and the cognition thread's CPU time (what a loaded machine disturbs least)."""
+    budget = benchmark()
+    pairs = []
+    for shade in (0, 30):
+        shots = []
+        for camera, (width, height) in (("top", (640, 480)), ("bottom", (320, 240))):
+            image = np.empty((height, width, 3), np.uint8)
+            image[:] = (40, 140 + shade, 50)
+            image[: height // 3] = (120, 110, 100)
+            cv2.circle(image, (width // 2, 2 * height // 3), height // 20, (240, 240, 240), -1)
+            shots.append(budget.Shot(image, standing_camera(camera), math.radians(56.3), math.radians(43.7)))
+        pairs.append((shots[0], shots[1]))
+    source = tmp_path / "top.png"
+    cv2.imwrite(str(source), pairs[0][0].image)
+    whole, cpu, modules = budget.cognition(source, pairs, 3)
+    assert len(whole) == len(cpu) == 3
+    assert all(seconds > 0.0 for seconds in whole + cpu)
+    assert "SPLBallDetector" in modules and len(modules["SPLBallDetector"]) == 3
