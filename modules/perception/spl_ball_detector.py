@@ -436,8 +436,13 @@ class SPLBallDetector(Module):
         height, width = green.shape
         known = boundary.size == width
         top = max(0, int(boundary.min() - p.above_boundary)) if known else 0  # nothing above the field is looked at
-        field = np.arange(top, height)[:, None] >= boundary[None, :] - p.above_boundary if known else np.ones((height - top, width), bool)
-        solid = (~green[top:] & field).view(np.uint8)
+        solid = ~green[top:]
+        if known:  # on the field: from the boundary (less above_boundary) down; below its lowest row, every row is
+            lowest = boundary - p.above_boundary
+            limit = float(lowest.max())
+            rows = min(height - top, max(0, math.ceil(limit) - top)) if math.isfinite(limit) else height - top
+            solid[:rows] &= np.arange(top, top + rows)[:, None] >= lowest[None, :]
+        solid = solid.view(np.uint8)
         if not solid.any():
             return []
         thickness = cv2.distanceTransform(solid, cv2.DIST_L2, 3)
@@ -458,7 +463,12 @@ class SPLBallDetector(Module):
         xs, ys, radii, expected = xs[fits], ys[fits], radii[fits], expected[fits]
         if dark is not None:  # a ball has black patches: spots without dark pixels near their centre are none
             # (a field without any green leaves the distance transform unbounded: radii beyond the image are none)
-            patched = self.dark_share(dark, xs, ys, np.clip(radii, 1.0, max(height, width))) >= p.dark_spot_min
+            reach = np.clip(radii, 1.0, max(height, width))
+            if len(xs):  # only the rows the squares reach: the image's integral costs by its rows
+                first, last = max(0, int((ys - reach).min())), min(height, int((ys + reach).max()) + 1)
+                patched = self.dark_share(dark[first:last], xs, ys - first, reach) >= p.dark_spot_min
+            else:
+                patched = np.zeros(0, bool)
             xs, ys, radii, expected = xs[patched], ys[patched], radii[patched], expected[patched]
         # the spots most like a ball's size first: lines are thinner, robots and the border thicker
         order = np.argsort(np.abs(np.log(np.maximum(radii, 0.5) / np.maximum(expected, 0.5))))
