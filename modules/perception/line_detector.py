@@ -191,7 +191,12 @@ class LineDetector(Module):
         ignored = obstacles[grid]
         boundary = self.field_boundary.rows(camera)
         if boundary.size == width:
-            ignored = ignored | (np.arange(height)[grid[0]][:, None] < boundary[grid[1]][None, :])
+            rows, limits = np.arange(height)[grid[0]], boundary[grid[1]]
+            highest = float(limits.max()) if limits.size else 0.0
+            # off the field: above the boundary; only the rows above its lowest point are compared
+            above = int(np.searchsorted(rows, highest)) if math.isfinite(highest) else len(rows)
+            ignored = ignored.copy()
+            ignored[:above] |= rows[:above, None] < limits[None, :]
         return ignored
 
     def obstacles(self, camera: str, projection: ImageProjection) -> np.ndarray:
