@@ -3,8 +3,9 @@
     MUJOCO_GL=egl python benchmarks/robots.py [--seeds 1 2 3] [--scenes 40] [--real FOLDER]
 
 Scenes: one robot (the viewer) stands anywhere on the field with its head turned anywhere it looks
-in a game; ``others`` robots stand at random places, most of them within 3 m in front of it, all in
-the stand pose, facing anywhere. Both cameras are rendered (top 640x480, bottom 320x240, as on the
+in a game; up to ``others`` robots (none in some scenes) stand at random places, most of them within
+3 m in front of it, all in the stand pose, facing anywhere; the ball lies within 2 m in front of the
+viewer, where a player looks. Both cameras are rendered (top 640x480, bottom 320x240, as on the
 NAO) and the program's perception runs on them (``tools.simulation.scene_frames.Perception`` plus
 ``RobotDetector``). A robot counts as visible when its torso lies within ``--max-distance`` (mm) of
 the viewer and its feet are in one camera's view; a robot found matches a visible robot within
@@ -93,16 +94,16 @@ class RobotScenes:
         self.poses = poses
         return torso_in_robot
 
-    def render(self, viewer: tuple[float, float, float], head: tuple[float, float], others: list[tuple[float, float, float]]
-               ) -> tuple[dict[str, tuple[np.ndarray, CameraMatrix]], list[tuple[float, float]]]:
-        """Both cameras' images and matrices of robot 0 at ``viewer``, the others at ``others``; and where
-        the others' centres (torsos) are in the viewer's robot frame (mm)."""
+    def render(self, viewer: tuple[float, float, float], head: tuple[float, float], others: list[tuple[float, float, float]],
+               ball: tuple[float, float] = (0.0, 8000.0)) -> tuple[dict[str, tuple[np.ndarray, CameraMatrix]], list[tuple[float, float]]]:
+        """Both cameras' images and matrices of robot 0 at ``viewer``, the others at ``others``, the ball at
+        ``ball`` (field mm); and where the others' centres (torsos) are in the viewer's robot frame (mm)."""
         for k, pose in enumerate(others, start=1):
             self.place(k, pose)
         for k in range(len(others) + 1, len(self.robots)):
             self.place(k, (-4000.0 + 300.0 * k, 4500.0, 0.0))  # beside the field, out of the way
         torso_in_robot = self.place(0, viewer, head)
-        self.world.ball.place(self.data, 0.0, 8000.0)
+        self.world.ball.place(self.data, *ball)
         mujoco.mj_forward(self.model, self.data)
         shots = {}
         for camera, mount in MOUNTS.items():
@@ -162,9 +163,13 @@ def visible(point: tuple[float, float], shots: dict[str, tuple[np.ndarray, Camer
     return False
 
 
-def scene(rng: np.random.Generator, others: int) -> tuple[tuple[float, float, float], tuple[float, float], list[tuple[float, float, float]]]:
-    """The viewer's pose and head, and the others' poses (field mm, rad): most of them in front of the
-    viewer within 3 m, none nearer than 300 mm to another."""
+Scene = tuple[tuple[float, float, float], tuple[float, float], list[tuple[float, float, float]], tuple[float, float]]
+
+
+def scene(rng: np.random.Generator, others: int) -> Scene:
+    """The viewer's pose and head, the others' poses (field mm, rad): most of them in front of the
+    viewer within 3 m, none nearer than 300 mm to another; and the ball, in front of the viewer (where
+    a player looks) within 2 m, on the field."""
     viewer = (rng.uniform(-3500, 3500), rng.uniform(-2500, 2500), rng.uniform(-math.pi, math.pi))
     head = (rng.uniform(-0.8, 0.8), rng.uniform(-0.1, 0.45))
     places: list[tuple[float, float, float]] = []
@@ -178,7 +183,11 @@ def scene(rng: np.random.Generator, others: int) -> tuple[tuple[float, float, fl
             continue
         if all(math.hypot(x - px, y - py) > 400 for px, py, _ in [*places, viewer]):
             places.append((x, y, rng.uniform(-math.pi, math.pi)))
-    return viewer, head, places
+    while True:
+        distance, bearing = rng.uniform(250, 2000), viewer[2] + head[0] + rng.uniform(-0.4, 0.4)
+        ball = (viewer[0] + distance * math.cos(bearing), viewer[1] + distance * math.sin(bearing))
+        if abs(ball[0]) < 4500 and abs(ball[1]) < 3000 and all(math.hypot(ball[0] - px, ball[1] - py) > 250 for px, py, _ in places):
+            return viewer, head, places, ball
 
 
 def judge(found: list[tuple[float, float]], truth: list[tuple[float, float]], seen: list[bool], tolerance: float
@@ -209,8 +218,8 @@ def rendered(seeds: list[int], scenes: int, others: int, tolerance: float, max_d
             rng = np.random.default_rng(seed)
             counts = [0, 0, 0]
             for _ in range(scenes):
-                viewer, head, places = scene(rng, int(rng.integers(1, others + 1)))
-                shots, truth = world.render(viewer, head, places)
+                viewer, head, places, ball = scene(rng, int(rng.integers(0, others + 1)))
+                shots, truth = world.render(viewer, head, places, ball)
                 inputs = {c: (img, m, horizontal_fov(*SIZES[c]), VERTICAL_FOV) for c, (img, m) in shots.items()}
                 found = detection(inputs)
                 seen = [visible(t, shots, max_distance) for t in truth]

@@ -107,6 +107,8 @@ class RobotDetector(Module):
         """mm: a foot this near the own centre, where the own body may show in the image, is the own body's"""
         bottom_max_distance: float = bounded(300.0, 5000.0, 1500.0)
         """mm: the bottom camera looks down at the near ground; farther things at its upper edge are posts and legs cut off"""
+        same_direction: float = bounded(0.0, 1.0, 0.3)
+        """rad: a robot the top image's lower edge cuts off is the bottom camera's robot this near in bearing"""
         same_robot: float = bounded(0.0, 1000.0, 350.0)
         """mm: robots of both cameras this near each other are one"""
 
@@ -118,15 +120,24 @@ class RobotDetector(Module):
         if not self.field_color.valid:
             return
         robots: list[SeenRobot] = []
-        for camera, _, projection in camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer):
+        bottom_bearings: list[float] = []  # of the robots the bottom camera found
+        views = camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer)
+        for camera, _, projection in sorted(views, key=lambda view: view[0] != "bottom"):  # the bottom camera first
             green = self.segmented_image.green(camera)
             boundary = self.field_boundary.rows(camera)
             if green.shape != (projection.height, projection.width) or boundary.size != projection.width:
                 continue
             feet = self.feet(camera, green, boundary, projection)
-            for robot in self.clusters(camera, feet, projection):
+            for robot, cut in self.clusters(camera, feet, projection):
+                # feet below the top image are the bottom camera's to find; where it found none in that
+                # direction (its upper edge cut the robot), the top image's lower edge is as near as it is known
+                bearing = math.atan2(robot.y, robot.x)
+                if cut and any(abs(math.remainder(bearing - other, math.tau)) < p.same_direction for other in bottom_bearings):
+                    continue
                 if all(math.hypot(robot.x - other.x, robot.y - other.y) > p.same_robot for other in robots):
                     robots.append(robot)
+                    if camera == "bottom":
+                        bottom_bearings.append(bearing)
             if self.draw:
                 canvas = self.draw.canvas(Canvas.image(camera))
                 for foot in feet:
@@ -166,8 +177,10 @@ class RobotDetector(Module):
         top = ys[run_top[found_rows, found_cols]] - row_step / 2.0  # the run's highest pixel
         edge = boundary[xs[found_cols]]
         tall = ~front_high | (top <= high + row_step)
-        # cut off by the field's boundary or the image's upper edge: at least low_height mm of it below
-        cut = ((top <= edge + row_step) & (~front_low | (top <= low + row_step))) | (top <= row_step)
+        # cut off by the field's boundary or the image's upper edge, with at least low_height mm of it below
+        # (a ball or a post's foot at the bottom image's upper edge shows less)
+        cut = (((top <= edge + row_step) & (~front_low | (top <= low + row_step)))
+               | ((top <= row_step) & front_low & (low >= 0.0)))
         keep = hits & (distance <= p.max_distance + p.centre_behind) & (tall | cut)
         own = np.zeros(count, bool)
         near = keep & ((distance < p.own_reach) | ((found_rows == n_rows - 1) & (camera == "bottom")))
@@ -181,10 +194,10 @@ class RobotDetector(Module):
         return [Foot(float(ground[k, 0]), float(ground[k, 1]), int(found_cols[k]), float(foot_x[k]), float(foot_y[k]), float(top[k]), bool(own[k]))
                 for k in chosen[::-1][first]]
 
-    def clusters(self, camera: str, feet: list[Foot], projection: ImageProjection) -> list[SeenRobot]:
-        """Feet of neighbouring columns whose runs overlap in the image as robots (robot frame, mm). Feet
-        cut off by the image's lower edge are left to the bottom camera (which sees them) and, in the
-        bottom camera, where the own body may show or in a lower corner (real lenses darken them)."""
+    def clusters(self, camera: str, feet: list[Foot], projection: ImageProjection) -> list[tuple[SeenRobot, bool]]:
+        """Feet of neighbouring columns whose runs overlap in the image as robots (robot frame, mm), and
+        whether the top image's lower edge cut them off. Feet cut off by the image's lower edge where the
+        own body may show or in a lower corner (real lenses darken them) are left out."""
         p = self.parameters
         groups: list[list[Foot]] = []
         for foot in feet:
@@ -210,11 +223,12 @@ class RobotDetector(Module):
             x, y = x + p.centre_behind * math.cos(bearing), y + p.centre_behind * math.sin(bearing)
             if math.hypot(x, y) > (p.max_distance if camera == "top" else p.bottom_max_distance):
                 continue
-            if nearest.image_y >= bottom and (camera == "top" or nearest.own or at_edge):
+            cut = nearest.image_y >= bottom
+            if cut and (nearest.own or at_edge):  # the own body, or a lower corner (real lenses darken them)
                 continue
             if any(math.hypot(x - post.x, y - post.y) < p.post_distance for post in self.goal_post_percept.posts):
                 continue
-            robots.append(SeenRobot(x, y))
+            robots.append((SeenRobot(x, y), cut and camera == "top"))
         return robots
 
     def merged(self, groups: list[list[Foot]], projection: ImageProjection) -> list[list[Foot]]:
