@@ -57,9 +57,12 @@ def test_the_same_robot_dribbling_is_no_pass_and_a_placed_ball_breaks_the_chain(
     assert placed.passes == []
 
 
-def test_an_own_goal_is_a_goal_last_touched_by_the_conceding_team() -> None:
+def test_an_own_goal_is_a_goal_last_touched_by_the_conceding_team_not_a_failed_save() -> None:
     counter = PassCounter(TEAMS)
-    counter.observe(0.0, (-4000.0, 0.0), [(-4200.0, 0.0), AWAY, AWAY, AWAY], True)  # team 0's robot plays it into its own goal
+    counter.observe(0.0, (-4000.0, 0.0), [(-3800.0, 0.0), AWAY, AWAY, AWAY], True)  # team 0's robot plays it into its own goal
     assert counter.goal(conceding_team=0) and counter.own_goals == [1, 0]
+    saved = PassCounter(TEAMS)  # team 1 shoots at team 0's goal (at -x); team 0's keeper on the line touches it, it goes in
+    roll(saved, (-1900.0, 0.0), (-4600.0, 0.0), [(-4300.0, 0.0), AWAY, (-1750.0, 0.0), AWAY])
+    assert saved.last_toucher == 0 and not saved.goal(conceding_team=0) and saved.own_goals == [0, 0]
     counter.observe(1.0, (4000.0, 0.0), [(3800.0, 0.0), AWAY, AWAY, AWAY], True)  # team 0 scores at the other end
     assert not counter.goal(conceding_team=1) and counter.own_goals == [1, 0]

@@ -224,8 +224,12 @@ class Match:
             self.referee.tick(time_ns * 1e-9, (time_ns - previous) * 1e-9)
             for event in self.referee.events[events:]:  # a goal: whose last touch it was
                 conceding = 1 - TEAM_NUMBERS.index(int(event.what.split()[1])) if event.what.startswith("GOAL ") else None
-                if conceding is not None and self.passes.goal(conceding):
-                    print(f"[match] t={event.time_s:.1f}s own goal: team {TEAM_NUMBERS[conceding]}", flush=True)
+                toucher = self.passes.last_toucher
+                if conceding is not None and toucher is not None:
+                    own = self.passes.goal(conceding)
+                    player = self.players[toucher]
+                    print(f"[match] t={event.time_s:.1f}s last touch: team {TEAM_NUMBERS[player.team]} player {player.number}"
+                          + (f": own goal of team {TEAM_NUMBERS[conceding]}" if own else ""), flush=True)
             if self.referee.score() != last_score:
                 last_score = self.referee.score()
                 print(f"[match] t={time_ns * 1e-9:.1f}s goal: {TEAM_NUMBERS[0]}:{TEAM_NUMBERS[1]} {last_score}", flush=True)
