@@ -1,5 +1,6 @@
 """LookAtBallBehavior: look at the ball while it is seen, glancing round now and then for the
-localization; sweep the head to find it when it is not; hold the head still while penalized."""
+localization; sweep the head to find it when it is not (first where a teammate's ball would be, while
+the own pose is unsure); hold the head still while penalized."""
 
 from __future__ import annotations
 
@@ -7,10 +8,12 @@ import math
 from dataclasses import dataclass
 
 from tafel.core import Module, provides, requires, uses
+from tafel.modules.modeling.mirror_hypotheses import freshest_team_ball
 from tafel.representations.behavior import HOLD_SPEED, HeadMotionRequest
 from tafel.representations.game import GameState
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
+from tafel.representations.team import TeamMates
 
 
 def sweep(start: float, direction: float, distance: float, amplitude: float) -> float:
@@ -24,7 +27,7 @@ def sweep(start: float, direction: float, distance: float, amplitude: float) -> 
 
 
 @requires(BallModel, FrameInfo)
-@uses(RobotPose, GameState)
+@uses(RobotPose, GameState, TeamMates)
 @provides(HeadMotionRequest)
 class LookAtBallBehavior(Module):
     """Points the head at the ball model's position while the ball is being seen. Once it has not been
@@ -35,6 +38,11 @@ class LookAtBallBehavior(Module):
     not valid) the head glances left and right for lines and goals, unless the ball is close: then the
     striker needs it in view, and the ball model follows the robot's steps meanwhile anyway.
 
+    While the pose is not valid (a robot carried elsewhere: the field cannot tell it from its twin, only
+    the team's ball can) and the particles have gathered, the search looks first where a teammate's ball
+    would be from the estimate and from its twin, each within the head's reach for ``candidate_dwell`` s,
+    then sweeps; the sweep reaches ``search_amplitude_lost`` then, to show the field round the robot.
+
     While penalized the head holds still where it is (``max_speed`` 0): the rules allow a penalized
     robot no motion at all until the GameController unpenalizes it. Then it looks for the ball anew."""
 
@@ -42,6 +50,7 @@ class LookAtBallBehavior(Module):
     frame_info: FrameInfo
     robot_pose: RobotPose
     game_state: GameState
+    team_mates: TeamMates
     head_motion_request: HeadMotionRequest
 
     @dataclass
@@ -72,11 +81,25 @@ class LookAtBallBehavior(Module):
         glance_min_ball_distance: float = 900.0
         """mm: nearer balls are never looked away from"""
 
+        search_amplitude_lost: float = 2.0
+        """rad, largest head yaw while searching with the pose not valid"""
+        candidate_dwell: float = 0.8
+        """s the head looks where a teammate's ball would be from one twin while the pose is not valid ..."""
+        candidate_deviation: float = 400.0
+        """mm: ... once the particles have gathered this close (RobotPose.deviation) ..."""
+        candidate_range: float = 5000.0
+        """mm: ... for a place this near ..."""
+        candidate_reach: float = 2.4
+        """rad: ... this far to either side (the head turns to 2.09, the top camera sees 0.5 beyond) ..."""
+        team_ball_age: float = 3.0
+        """s: ... reported this recently"""
+
     parameters: Parameters
 
     def __init__(self) -> None:
         self.search_start: tuple[float, float, float] | None = None  # (time s, yaw rad, direction)
         self.last_glance = 0.0  # s when the last glance started
+        self.candidates_since: float | None = None  # s since when the search has had a teammate's ball to look at
 
     def execute(self) -> None:
         p, ball, request = self.parameters, self.ball_model, self.head_motion_request
@@ -93,13 +116,51 @@ class LookAtBallBehavior(Module):
             request.pitch = math.atan2(p.camera_height, distance) - p.camera_tilt
             request.max_speed = p.track_speed
             return
+        if self.look_at_candidates(now):
+            return
+        amplitude = p.search_amplitude if self.robot_pose.valid else p.search_amplitude_lost
         if self.search_start is None:
-            yaw = max(-p.search_amplitude, min(p.search_amplitude, request.yaw))
+            yaw = max(-amplitude, min(amplitude, request.yaw))
             self.search_start = (now, yaw, -1.0 if yaw > 0 else 1.0)
         started, yaw, direction = self.search_start
-        request.yaw = sweep(yaw, direction, (now - started) * p.search_speed, p.search_amplitude)
+        request.yaw = sweep(yaw, direction, (now - started) * p.search_speed, amplitude)
         request.pitch = p.search_pitch
         request.max_speed = p.search_speed * 1.5  # the request itself moves at search speed; keep up with it
+
+    def candidates(self) -> list[tuple[float, float]]:
+        """Where a teammate's ball would be (robot frame, mm) from the estimate and from its twin, those
+        within the head's reach; none while the pose is valid or the particles are spread."""
+        p, pose = self.parameters, self.robot_pose
+        if pose.valid or pose.deviation > p.candidate_deviation:
+            return []
+        team = freshest_team_ball(self.team_mates, p.team_ball_age)
+        if team is None:
+            return []
+        # seen from the twin (turned by 180 degrees about the centre spot), a point lies where its mirror
+        # image lies seen from the estimate
+        places = [pose.to_robot(team.x, team.y), pose.to_robot(-team.x, -team.y)]
+        return [(x, y) for x, y in places
+                if abs(math.atan2(y, x)) <= p.candidate_reach and 0.0 < math.hypot(x, y) <= p.candidate_range]
+
+    def look_at_candidates(self, now: float) -> bool:
+        """Look in turn where the teammate's ball would be from either twin, ``candidate_dwell`` s each, then
+        sweep for as long before looking again; whether the head is doing so."""
+        p, request = self.parameters, self.head_motion_request
+        places = self.candidates()
+        if not places:
+            self.candidates_since = None
+            return False
+        if self.candidates_since is None:
+            self.candidates_since = now
+        phase = int((now - self.candidates_since) / p.candidate_dwell) % (2 * len(places))
+        if phase >= len(places):
+            return False  # the sweep's turn: the ball may lie elsewhere, and the field round helps the particles
+        x, y = places[phase]
+        request.yaw = math.atan2(y, x)
+        request.pitch = math.atan2(p.camera_height, math.hypot(x, y)) - p.camera_tilt
+        request.max_speed = p.track_speed
+        self.search_start = None  # the sweep starts from where the head looked
+        return True
 
     def glance(self, now: float, ball_distance: float) -> bool:
         """Glance round if it is time (or go on with a glance begun); whether the head is glancing."""

@@ -9,7 +9,7 @@ from tafel.core import Module, provides, requires, uses
 from tafel.debug import ModifyParameters
 from tafel.representations.geometry import Pose2D
 from tafel.representations.infrastructure import FrameInfo
-from tafel.representations.modeling import BallModel
+from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import Odometry
 from tafel.representations.perception import BallPercept
 
@@ -57,7 +57,7 @@ class AxisFilter:
 
 
 @requires(BallPercept, FrameInfo)
-@uses(Odometry)
+@uses(Odometry, RobotPose)
 @provides(BallModel)
 class KalmanBallModeler(Module):
     """A constant-velocity Kalman filter with rolling friction over the state (x, y, vx, vy), in the
@@ -68,11 +68,14 @@ class KalmanBallModeler(Module):
     - Measurement noise grows with distance, because the ground position of a far ball is less certain.
     - A percept far outside the predicted uncertainty is an outlier and ignored; only several in a row
       that agree with each other (the ball was really moved) restart the filter there.
+    - While the robot's pose is lost (``RobotPose.lost``: it may have been carried, which odometry does
+      not see) an unseen ball is forgotten sooner, so the robot turns to look for it.
     """
 
     ball_percept: BallPercept
     frame_info: FrameInfo
     odometry: Odometry
+    robot_pose: RobotPose
     ball_model: BallModel
 
     tuning = ModifyParameters(TUNED, "tried live: modify:set KalmanBallModeler:NAME")
@@ -96,7 +99,9 @@ class KalmanBallModeler(Module):
         outlier_agreement: float = 400.0
         """mm"""
         forget_after: float = 3.0
-        """s without a percept after which the model is no longer valid"""
+        """s without a percept after which the model is no longer valid ..."""
+        forget_after_lost: float = 1.0
+        """... and while the robot's pose is lost"""
         nominal_dt: float = 1.0 / 30.0
         """s, step used when the frame clock does not advance"""
 
@@ -178,4 +183,5 @@ class KalmanBallModeler(Module):
         model.x, model.y, model.vx, model.vy = ax.p, ay.p, ax.v, ay.v
         model.position_std = math.sqrt(max(0.0, (ax.pp + ay.pp) / 2))
         model.time_since_seen = max(0.0, (now_ns - self.last_seen_ns) * 1e-9)
-        model.valid = model.time_since_seen <= self.tuned.forget_after
+        forget = self.tuned.forget_after_lost if self.robot_pose.lost else self.tuned.forget_after
+        model.valid = model.time_since_seen <= forget

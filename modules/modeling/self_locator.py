@@ -10,7 +10,7 @@ import numpy as np
 from tafel.core import Module, bounded, provides, requires, uses
 from tafel.debug import Canvas, DebugRequest, Plot
 from tafel.modules.modeling.field_model import FIELD_MODEL, OWN_HALF
-from tafel.modules.modeling.mirror_hypotheses import SideBelief, fold, freshest_team_ball, twin
+from tafel.modules.modeling.mirror_hypotheses import SideBelief, fold, freshest_team_ball, pose_distance, twin
 from tafel.representations import field
 from tafel.representations.game import GameState
 from tafel.representations.geometry import Pose2D
@@ -121,7 +121,18 @@ class SelfLocator(Module):
         continuity_rotation: float = bounded(0.0, 3.2, 0.6)
         """... rad"""
         search_share: float = bounded(0.0, 1.0, 0.05)
-        """share made anew per frame before the first fix"""
+        """share made anew per frame while the pose is not valid ..."""
+        watch_share: float = bounded(0.0, 1.0, 0.02)
+        """... and while it is (mixture MCL): poses that explain this frame's percepts compete with the
+        estimate, so a robot carried elsewhere is noticed (its new place grows among them) even where
+        the percepts still half fit the old one. Only from a seen post, circle or line, never anywhere"""
+        jump: float = bounded(0.0, 5000.0, 500.0)
+        """mm (a radian counting 1000 mm): the estimate moved this far from the last one (moved by
+        odometry) in a frame, the particles found another place: the pose is confirmed anew"""
+        keep_share: float = bounded(0.0, 1.0, 0.7)
+        """once gathered, the particles count as gathered while this share of ``valid_share`` stays near
+        the estimate (and its spread within 1 / ``keep_share`` of ``valid_deviation``): a frame that saw
+        little does not undo the confirmation"""
         outside_std: float = bounded(10.0, 5000.0, 300.0)
         """mm beyond the field's lines at which a pose is one standard deviation unlikely"""
         valid_deviation: float = bounded(10.0, 5000.0, 350.0)
@@ -284,13 +295,20 @@ class SelfLocator(Module):
         self.fast += p.alpha_fast * (fit - self.fast) if self.fast else fit
         self.fit.add(fit)
         lost = self.fast < p.lost_ratio * self.slow
-        if not lost and self.robot_pose.valid:
-            return
-        # until the pose is valid a few fresh particles a frame keep every pose that fits what is seen alive
-        count = int((p.reset_share if lost else p.search_share) * len(self.particles))
+        if not lost and not self.usable_percepts():
+            return  # guesses anywhere only while lost: elsewhere they spread a gathered cloud in frames that saw little
+        # a few fresh particles a frame keep every pose that fits what is seen alive, and while the pose is
+        # valid they watch for a carried robot: where they keep fitting better, they win the resampling
+        share = p.reset_share if lost else p.search_share if not self.robot_pose.valid else p.watch_share
+        count = int(share * len(self.particles))
         fresh = FIELD_MODEL.poses_from_percepts(self.rng, count, self.line_percept, self.goal_post_percept)
         fresh = fold(fresh, self.reference())
         self.particles[self.rng.choice(len(self.particles), len(fresh), replace=False)] = fresh
+
+    def usable_percepts(self) -> bool:
+        """Whether this frame saw something fresh poses can be made from: the circle, a post, a line segment."""
+        return bool(self.line_percept.circle_seen or self.goal_post_percept.posts
+                    or any(s.length >= 300.0 for s in self.line_percept.segments))
 
     # ---------------------------------------------------------------------------------- estimate
     def publish(self) -> None:
@@ -301,6 +319,7 @@ class SelfLocator(Module):
         centres = [c for c in (self.estimate, self.best) if c is not None] or [self.particles.mean(axis=0)]
         near = max((self.near(c) for c in centres), key=np.count_nonzero)
         cluster = self.particles[near] if near.sum() >= 3 else self.particles
+        previous = self.estimate
         pose.x, pose.y = float(cluster[:, 0].mean()), float(cluster[:, 1].mean())
         pose.rotation = float(math.atan2(np.sin(cluster[:, 2]).mean(), np.cos(cluster[:, 2]).mean()))
         spread = np.hypot(cluster[:, 0] - pose.x, cluster[:, 1] - pose.y)
@@ -309,7 +328,10 @@ class SelfLocator(Module):
         pose.rotation_deviation = float(math.sqrt(max(0.0, -2.0 * math.log(max(1e-9, math.hypot(np.sin(cluster[:, 2]).mean(), np.cos(cluster[:, 2]).mean()))))))
         lost = bool(self.slow and self.fast < p.lost_ratio * self.slow)
         now = self.frame_info.time_s
-        if not (near.mean() >= p.valid_share and pose.deviation <= p.valid_deviation and not lost):
+        gathered = self.concentrated_since is not None
+        keep = p.keep_share if gathered else 1.0  # gathered once, a frame that saw little does not undo it
+        jumped = previous is not None and float(pose_distance(self.estimate[None, :], previous)[0]) > p.jump
+        if jumped or not (near.mean() >= p.valid_share * keep and pose.deviation <= p.valid_deviation / keep and not lost):
             self.concentrated_since, self.evidence = None, set()
         elif self.concentrated_since is None:
             self.concentrated_since = now

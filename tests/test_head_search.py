@@ -1,0 +1,56 @@
+"""LookAtBallBehavior's search while the own pose is unsure: where a teammate's ball would be from either
+twin, through the mocked blackboard."""
+
+from __future__ import annotations
+
+import math
+
+from tafel.core.testing import ModuleHarness
+from tafel.modules.behavior.look_at_ball_behavior import LookAtBallBehavior
+from tafel.representations.behavior import HeadMotionRequest
+from tafel.representations.infrastructure import FrameInfo
+from tafel.representations.modeling import BallModel, RobotPose
+from tafel.representations.team import TeamMate, TeamMates, TeamMessage
+
+FRAME_NS = 33_333_333
+
+
+def requests(pose: RobotPose, team_ball: tuple[float, float] | None, seconds: float) -> list[tuple[float, float]]:
+    """(yaw, pitch) requested each frame for ``seconds`` with no ball of its own."""
+    mates = []
+    if team_ball is not None:
+        said = TeamMessage(team=1, player=3, sent_ms=0, pose_valid=True, ball_seen=True, ball_x=team_ball[0], ball_y=team_ball[1], ball_age=0.2)
+        mates = [TeamMate(message=said, age=0.3)]
+    harness = ModuleHarness(LookAtBallBehavior, BallModel(valid=False), pose, TeamMates(mates=mates))
+    out = []
+    for i in range(1, int(seconds * 30) + 1):
+        harness.set(FrameInfo(frame_number=i, time_ns=i * FRAME_NS))
+        request = harness.execute()[HeadMotionRequest]
+        out.append((request.yaw, request.pitch))
+    return out
+
+
+def test_an_unsure_robot_looks_where_the_teams_ball_would_be_from_either_twin() -> None:
+    """Gathered on a pose it cannot tell from its twin, the head looks first where the teammate's ball lies
+    seen from the estimate, then where it lies seen from the twin (both within reach), not a sweep."""
+    pose = RobotPose(valid=False, lost=True, x=1000.0, y=-500.0, rotation=2.0, deviation=120.0)
+    ball = (-500.0, 1000.0)
+    p = LookAtBallBehavior.Parameters()
+    seen = requests(pose, ball, 2 * p.candidate_dwell)
+    estimate = math.atan2(*reversed(pose.to_robot(*ball)))
+    twin = math.atan2(*reversed(pose.to_robot(-ball[0], -ball[1])))
+    dwell = int(p.candidate_dwell * 30)
+    assert abs(seen[dwell // 2][0] - estimate) < 1e-6 and abs(seen[dwell + dwell // 2][0] - twin) < 1e-6
+    distance = math.hypot(*pose.to_robot(*ball))
+    assert seen[dwell // 2][1] == math.atan2(p.camera_height, distance) - p.camera_tilt
+
+
+def test_without_a_teams_ball_or_gathered_particles_it_sweeps() -> None:
+    """No teammate's ball, or particles spread all over: the sweep, as wide as the head reaches when unsure."""
+    p = LookAtBallBehavior.Parameters()
+    spread = RobotPose(valid=False, lost=True, x=1000.0, y=-500.0, rotation=2.0, deviation=2000.0)
+    for pose, ball in [(spread, (-500.0, 1000.0)), (RobotPose(valid=False, deviation=100.0), None)]:
+        yaws = [yaw for yaw, _ in requests(pose, ball, 6.0)]
+        assert max(yaws) > p.search_amplitude + 0.5 and min(yaws) < -p.search_amplitude - 0.5
+    sure = [yaw for yaw, _ in requests(RobotPose(valid=True, deviation=100.0), (-500.0, 1000.0), 6.0)]
+    assert max(map(abs, sure)) <= p.search_amplitude + 1e-9
