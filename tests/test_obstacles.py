@@ -13,7 +13,7 @@ from tafel.modules.behavior.paths import blocking, outside, waypoint
 from tafel.modules.modeling.obstacle_modeler import GOAL_POSTS, ObstacleModeler
 from tafel.modules.motion.sonar_filter import SonarFilter
 from tafel.representations.modeling import RobotPose
-from tafel.representations.motion_control import FallPhase, FallState
+from tafel.representations.motion_control import FallPhase, FallState, Odometry
 from tafel.representations.obstacles import ROBOT_RADIUS, ObstacleKind, Obstacles, RobotsPercept, SeenRobot
 from tafel.representations.sonar import SONAR_ANGLE, SonarData, SonarEcho, SonarPercept
 from tafel.representations.team import TeamMate, TeamMates, TeamMessage
@@ -119,3 +119,15 @@ def test_a_robot_seen_at_a_goal_post_is_the_post() -> None:
     seen = RobotsPercept(robots=[SeenRobot(1000.0, 0.0), SeenRobot(1000.0, 600.0)])
     found = ModuleHarness(ObstacleModeler, pose, seen).execute()[Obstacles].obstacles
     assert [(round(o.x), round(o.y)) for o in found] == [(1000, 600)]
+
+
+def test_without_a_pose_a_robot_seen_now_and_then_stays_where_odometry_puts_it() -> None:
+    """The localization is not sure yet (after a kick-off, a fall) and the robot is seen only in some
+    frames: it must not vanish in between while this robot walks towards it."""
+    harness = ModuleHarness(ObstacleModeler, RobotPose(valid=False), Odometry(), RobotsPercept(robots=[SeenRobot(800.0, 0.0)]))
+    harness.execute()
+    harness.set(RobotsPercept(robots=[]), Odometry(x=300.0, rotation=math.pi / 2))  # walked 300 mm ahead, turned left
+    held = harness.execute()[Obstacles].obstacles
+    assert len(held) == 1 and (held[0].x, held[0].y) == pytest.approx((0.0, -500.0), abs=1e-6)
+    harness.execute(70)  # > 2 s later
+    assert harness.blackboard[Obstacles].obstacles == []

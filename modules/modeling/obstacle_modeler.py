@@ -9,6 +9,7 @@ from tafel.core import Module, bounded, provides, requires, uses
 from tafel.representations.field import GOAL_INNER_WIDTH, GOAL_POST_DIAMETER, LENGTH
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import RobotPose
+from tafel.representations.motion_control import Odometry
 from tafel.representations.obstacles import ROBOT_RADIUS, Obstacle, ObstacleKind, Obstacles, RobotsPercept
 from tafel.representations.sonar import SonarPercept
 from tafel.representations.team import TeamMates
@@ -18,7 +19,7 @@ GOAL_POSTS = [(sx * LENGTH / 2, sy * (GOAL_INNER_WIDTH + GOAL_POST_DIAMETER) / 2
 
 
 @requires(FrameInfo)
-@uses(RobotsPercept, SonarPercept, TeamMates, RobotPose)
+@uses(RobotsPercept, SonarPercept, TeamMates, RobotPose, Odometry)
 @provides(Obstacles)
 class ObstacleModeler(Module):
     """Keeps the robots seen (``RobotsPercept``: in the images or, in ``--cameras off`` matches, from
@@ -28,13 +29,15 @@ class ObstacleModeler(Module):
     A teammate's radius grows with the age of its message (``mate_spread`` mm/s: it may have walked
     meanwhile); a seen robot within ``same_robot`` mm of a teammate is that teammate, and one seen
     again within two robot radii of where it was remembered replaces that memory. Something seen within
-    ``post_radius`` mm of a goal post (where the pose puts them) is that post, not a robot."""
+    ``post_radius`` mm of a goal post (where the pose puts them) is that post, not a robot. While the
+    pose is not valid, seen robots are remembered as long where ``Odometry`` puts them (no teammates then)."""
 
     frame_info: FrameInfo
     robots_percept: RobotsPercept
     sonar_percept: SonarPercept
     team_mates: TeamMates
     robot_pose: RobotPose
+    odometry: Odometry
     obstacles: Obstacles
 
     @dataclass
@@ -57,6 +60,7 @@ class ObstacleModeler(Module):
 
     def __init__(self) -> None:
         self.seen: list[tuple[float, float, float]] = []  # field mm, mm, and when (s)
+        self.unplaced: list[tuple[float, float, float]] = []  # while the pose is not valid: odometry's frame (mm), and when (s)
 
     def execute(self) -> None:
         p, pose, now, out = self.parameters, self.robot_pose, self.frame_info.time_s, self.obstacles
@@ -77,9 +81,18 @@ class ObstacleModeler(Module):
                     continue
                 x, y = pose.to_robot(fx, fy)
                 obstacles.append(Obstacle(x, y, ROBOT_RADIUS, ObstacleKind.robot, now - when))
-        else:  # without a pose: what is seen now, in the robot frame
+        else:  # without a pose: remembered where odometry puts them (robots seen now and then while it walks)
             self.seen = []
-            obstacles = [Obstacle(x, y, ROBOT_RADIUS, ObstacleKind.robot, 0.0) for x, y in seen]
+            odometry = self.odometry.as_pose2d()
+            fresh = [(*odometry.to_global(x, y), now) for x, y in seen]
+            kept = [(x, y, t) for x, y, t in self.unplaced
+                    if now - t <= p.memory_s and all(math.hypot(x - fx, y - fy) > 2 * ROBOT_RADIUS for fx, fy, _ in fresh)]
+            self.unplaced = fresh + kept
+            for ox, oy, when in self.unplaced:
+                x, y = odometry.to_local(ox, oy)
+                obstacles.append(Obstacle(x, y, ROBOT_RADIUS, ObstacleKind.robot, now - when))
+        if pose.valid:
+            self.unplaced = []
         obstacles = sorted((o for o in obstacles if math.hypot(o.x, o.y) <= p.max_distance), key=lambda o: math.hypot(o.x, o.y))
         out.obstacles = obstacles
         out.clearance = max(0.0, min((math.hypot(o.x, o.y) - o.radius for o in obstacles), default=0.0))
