@@ -100,6 +100,10 @@ def test_a_two_against_two_match_ends_cleanly_with_readable_logs(tmp_path: Path)
     for team in result["teams"]:
         assert 0 < team["team_messages"] and team["message_budget_left"] == 1200 - team["team_messages"]
     assert result["bytes_per_team_message"] == 30.0
+    # completed passes (tools/simulation/passes.py, from ground truth): each team's count, each pass between teammates
+    for number, team in zip((1, 2), result["teams"]):
+        assert team["passes"] == sum(p["team"] == number for p in result["passes"]) and team["own_goals"] >= 0
+    assert all(p["kicker"] != p["receiver"] and p["distance_mm"] >= 1000 for p in result["passes"]), result["passes"]
 
 
 def test_the_same_seed_plays_the_same_match(tmp_path: Path) -> None:
