@@ -17,7 +17,7 @@ import numpy as np
 
 from tafel.core import Module, bounded, provides, requires
 from tafel.debug import Canvas, DebugRequest, ModifyParameters, Plot
-from tafel.modules.motion.inverse_kinematics import apply_leg_angles, leg_angles, pose
+from tafel.modules.motion.inverse_kinematics import apply_leg_angles, leg_angles, pose, rot_x, rot_y
 from tafel.modules.motion.stand_motion import stand_pose
 from tafel.modules.motion.walk_kicks import KickStep, kick_swing, load_walk_kicks
 from tafel.representations.geometry import Pose2D
@@ -115,6 +115,11 @@ class WalkingEngine(Module):
         """mm the swing foot may step further sideways than planned (never across the other foot)"""
         adjust_until: float = bounded(0.1, 1.0, 0.6)
         """share of a step after which its landing place stays as it is"""
+        level_swing: float = bounded(0.0, 1.5, 0.5)
+        """share of the torso's backward tilt (beyond ``level_deadband``) the swing foot is turned back by, about the
+        torso: tipped onto its heels, the robot lands the foot flatter and further back, not where the tilted leg points"""
+        level_deadband: float = bounded(0.0, 0.3, 0.05)
+        """rad of backward tilt the walk's own rocking makes: only the tilt beyond it turns the swing foot"""
         hurry: float = bounded(0.0, 0.05, 0.01)
         """per mm of capture-point error beyond the deadband, how much faster the step goes (it lands sooner)"""
         max_hurry: float = bounded(1.0, 3.0, 1.6)
@@ -151,6 +156,9 @@ class WalkingEngine(Module):
         self.adjust = np.zeros(2)  # mm forward, left the swing foot steps beyond the plan, to catch the body
         self.reference = np.zeros(2)  # the torso's roll and pitch (rad) while walking undisturbed, a slow mean
         self.rates = np.zeros(2)  # roll and pitch rate (rad/s), lightly filtered
+        self.support_level = np.zeros(2)  # roll, pitch (rad) the support foot landed turned back by
+        self.tilt = np.zeros(2)  # the torso's roll and pitch (rad) beyond the reference
+        self.levelled = {Foot.left: np.zeros(2), Foot.right: np.zeros(2)}  # roll, pitch (rad) each foot is turned back by
         self.kicks: dict[WalkKick, KickStep] = load_walk_kicks()
         self.kick: KickStep | None = None  # the current step's kick
         self.kick_direction = 0.0  # rad, robot frame, of the current step's kick
@@ -218,7 +226,7 @@ class WalkingEngine(Module):
         angles = np.asarray(imu.angles[:2], dtype=float)
         self.rates = 0.5 * self.rates + 0.5 * np.asarray(imu.gyroscope[:2], dtype=float)
         self.reference += (angles - self.reference) * min(1.0, dt / 2.0)  # 2 s: a push does not move it
-        tilt = angles - self.reference
+        tilt = self.tilt = angles - self.reference
         settle = math.sqrt(p.com_height / 9810.0)  # s: the pendulum's time constant
         roll, pitch = tilt + settle * self.rates  # the tilt turns the stiff leg, and the landing place with it
         return np.array([p.com_height * pitch, -p.com_height * roll])  # leaning right: the body goes right
@@ -320,6 +328,7 @@ class WalkingEngine(Module):
         self.started = True
         self.phase_s = 0.0
         self.adjust = np.zeros(2)  # the foot that now swings starts with its own plan
+        self.support_level = self.levelled[self.support].copy()  # landed turned back: it rights the torso over this step
         self.start = {foot: offset.copy() for foot, offset in self.now.items()}
         swing = Foot.right if self.support is Foot.left else Foot.left
         limit = np.array([p.max_acceleration, p.max_acceleration, p.max_turn_acceleration]) * p.step_duration
@@ -361,10 +370,14 @@ class WalkingEngine(Module):
         p, out = self.tuned, self.walking_engine_output
         height = p.hip_height + HIP_OFFSET_Z
         soles = {}
+        back = min(float(self.tilt[1]) + p.level_deadband, 0.0)  # tipped back onto the heels, beyond the walk's own rocking
+        self.levelled[swing] = np.array([0.0, p.level_swing * back])
+        self.levelled[self.support] = self.support_level * (1.0 - phase)  # the torso rises back over the step
         for foot, side in ((Foot.left, 1.0), (Foot.right, -1.0)):
             x, y, yaw = self.now[foot]
             z = -height + (lift if foot is swing else 0.0)
-            soles[foot] = pose(x - p.torso_offset_x, side * 50.0 + y - sway, z, pitch=toe if foot is swing else 0.0, yaw=yaw)
+            soles[foot] = level(pose(x - p.torso_offset_x, side * 50.0 + y - sway, z, pitch=toe if foot is swing else 0.0, yaw=yaw),
+                                self.levelled[foot])
         angles = leg_angles(soles[Foot.left], soles[Foot.right])
         # gyroscope feedback on the support ankle: lean against the torso's rotation
         self.gyro = 0.7 * self.gyro + 0.3 * np.asarray(self.inertial_sensor_data.gyroscope[:2], dtype=float)
@@ -400,6 +413,18 @@ class WalkingEngine(Module):
         # step adjustment a stale tilt or rate (it lunged the first step after a get-up)
         self.reference = np.asarray(self.inertial_sensor_data.angles[:2], dtype=float).copy()
         self.rates = np.zeros(2)
+        self.tilt = np.zeros(2)
+        self.support_level = np.zeros(2)
         self.kick = None
         self.set_joints(Foot.right, 0.0, 0.0, 0.0)
         out.standing, out.step_phase, out.kicking = True, 0.0, False
+
+
+def level(sole: np.ndarray, tilt: np.ndarray) -> np.ndarray:
+    """``sole`` (torso frame) turned back by the torso's ``tilt`` (roll, pitch rad) about the torso: the pose
+    it has in the upright torso frame, now in the tilted one."""
+    if not np.any(tilt):
+        return sole
+    turn = np.eye(4)
+    turn[:3, :3] = (rot_y(float(tilt[1])) @ rot_x(float(tilt[0]))).T
+    return turn @ sole
