@@ -54,3 +54,22 @@ def test_without_a_teams_ball_or_gathered_particles_it_sweeps() -> None:
         assert max(yaws) > p.search_amplitude + 0.5 and min(yaws) < -p.search_amplitude - 0.5
     sure = [yaw for yaw, _ in requests(RobotPose(valid=True, deviation=100.0), (-500.0, 1000.0), 6.0)]
     assert max(map(abs, sure)) <= p.search_amplitude + 1e-9
+
+
+def test_a_ball_found_by_searching_is_looked_at_before_the_next_glance() -> None:
+    """Found after a search, the ball stays in view for a glance interval (an unsure robot decides its
+    side by it) rather than being looked away from at once because a glance was due."""
+    p = LookAtBallBehavior.Parameters()
+    harness = ModuleHarness(LookAtBallBehavior, BallModel(valid=False), RobotPose(valid=False, lost=True), TeamMates(mates=[]))
+    frame = 0
+    for _ in range(4 * 30):  # 4 s of searching: a glance is long due
+        frame += 1
+        harness.set(FrameInfo(frame_number=frame, time_ns=frame * FRAME_NS))
+        harness.execute()
+    harness.set(BallModel(valid=True, seen=True, x=2000.0, y=500.0))
+    yaws = []
+    for _ in range(int(p.glance_interval_lost * 30) - 2):
+        frame += 1
+        harness.set(FrameInfo(frame_number=frame, time_ns=frame * FRAME_NS))
+        yaws.append(harness.execute()[HeadMotionRequest].yaw)
+    assert all(abs(yaw - math.atan2(500.0, 2000.0)) < 1e-9 for yaw in yaws)

@@ -166,6 +166,26 @@ def test_a_robot_carried_a_little_way_is_unsure_at_once(start: tuple, carried: t
     assert states[-1].valid and error(states[-1], carried)[0] < 150.0 and error(states[-1], carried)[1] < 10.0
 
 
+def test_found_again_as_the_twin_of_where_it_was_decided_it_takes_the_decided_side() -> None:
+    """The side was decided at a place; the particles scatter (a frame that saw little) and gather again
+    folded onto the twin of that place: the belief is about the place, so the pose is found there again,
+    not valid at the twin (the belief was flipped with the turn, and the twin taken)."""
+    from tafel.modules.modeling.mirror_hypotheses import twin
+
+    run = Run()
+    truth = (1400.0, -1200.0, -3.0)
+    run.harness.set(KnownPose(serial=1, x=truth[0], y=truth[1], rotation=truth[2]))
+    for _ in range(30):
+        pose = run.step(truth)
+    assert pose.valid and error(pose, truth)[0] < 150.0
+    locator = run.harness.module
+    locator.particles, locator.estimate = twin(locator.particles), twin(locator.estimate)
+    locator.concentrated_since = None
+    states = [run.step(truth) for _ in range(60)]
+    assert not [p for p in states if mirrored(p, truth)]
+    assert states[-1].valid and error(states[-1], truth)[0] < 150.0
+
+
 def test_seeing_nothing_keeps_the_pose() -> None:
     run = Run()
     truth = (-1000.0, 1500.0, -0.5)

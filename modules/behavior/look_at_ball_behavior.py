@@ -100,6 +100,7 @@ class LookAtBallBehavior(Module):
         self.search_start: tuple[float, float, float] | None = None  # (time s, yaw rad, direction)
         self.last_glance = 0.0  # s when the last glance started
         self.candidates_since: float | None = None  # s since when the search has had a teammate's ball to look at
+        self.searching = False  # whether the last frame searched: a ball found is looked at a while before a glance
 
     def execute(self) -> None:
         p, ball, request = self.parameters, self.ball_model, self.head_motion_request
@@ -109,6 +110,8 @@ class LookAtBallBehavior(Module):
             return
         if ball.valid and ball.time_since_seen <= p.lost_after:
             self.search_start = None
+            if self.searching:  # just found: the next glance only after an interval (an unsure pose needs the ball)
+                self.searching, self.last_glance = False, now - p.glance_duration
             if self.glance(now, math.hypot(ball.x, ball.y)):
                 return
             distance = max(math.hypot(ball.x, ball.y), 1.0)
@@ -116,6 +119,7 @@ class LookAtBallBehavior(Module):
             request.pitch = math.atan2(p.camera_height, distance) - p.camera_tilt
             request.max_speed = p.track_speed
             return
+        self.searching = True
         if self.look_at_candidates(now):
             return
         amplitude = p.search_amplitude if self.robot_pose.valid else p.search_amplitude_lost

@@ -365,9 +365,8 @@ class SelfLocator(Module):
             if stayed is None:
                 side.carried(placed_since=self.trusted is None)
                 self.anchor = None
-            elif stayed == "twin":  # the old side, as the particles were folded the other way
-                self.turn_to_twin(pose)
-                side.flip()
+            elif stayed == "twin":  # the old place, the particles folded the other way: the belief is about the
+                self.turn_to_twin(pose)  # old place (the anchor), which is tracked again; it must not flip
         odometry = (self.odometry.x, self.odometry.y, self.odometry.rotation)
         side.add_placement(self.estimate, odometry, p.placement_cap, p.placement_rate * p.placement_cap, p.side_cap)
         team, ball = freshest_team_ball(self.team_mates, p.team_ball_max_age), self.ball_percept
@@ -377,6 +376,8 @@ class SelfLocator(Module):
         if side.odds < 0.0:
             self.turn_to_twin(pose)
             side.flip()
+            if self.anchor is not None:  # the belief follows the turn, and so does the place it is about
+                self.anchor = twin(self.anchor)
         if side.odds >= p.side_decided:  # a decided side is about this estimate from now on
             self.anchor = self.estimate.copy()
 
