@@ -106,7 +106,7 @@ class Match:
         self.referee = Referee(self.world, TEAM_NUMBERS, self.players, args.seconds / args.halves, self.ports["game_controller_port"],
                                self.ports["return_port"], self.team_ports, ready_s=args.ready_seconds,
                                goals_to_end=args.goals, halves=args.halves, shoot_out=args.shoot_out, penalty_shots=args.penalty_shots,
-                               sudden_death_shots=max(0, args.sudden_death_shots),
+                               sudden_death_shots=max(0, args.sudden_death_shots), seed=int(args.seed),
                                calls=[Call(seconds, SetPlay[name], team) for seconds, name, team in args.calls])
         self.key = secrets.token_hex(16)
         self.listener = Listener(("127.0.0.1", 0), backlog=2 * MAX_PLAYERS_PER_TEAM, authkey=self.key.encode())  # all join at once
