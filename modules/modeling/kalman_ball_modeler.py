@@ -99,9 +99,9 @@ class KalmanBallModeler(Module):
         outlier_agreement: float = 400.0
         """mm"""
         forget_after: float = 3.0
-        """s without a percept after which the model is no longer valid ..."""
+        """s without a percept after which the model is no longer valid"""
         forget_after_lost: float = 1.0
-        """... and while the robot's pose is lost"""
+        """s without a percept after which the model is no longer valid while the robot's pose is lost"""
         nominal_dt: float = 1.0 / 30.0
         """s, step used when the frame clock does not advance"""
 
