@@ -14,7 +14,7 @@ from tafel.modules.motion.motion_combinator import MotionCombinator
 from tafel.modules.motion.stand_motion import StandMotion, stand_pose
 from tafel.representations.behavior import HeadMotionRequest
 from tafel.representations.infrastructure import CognitionStatus, FrameInfo
-from tafel.representations.modeling import BallModel
+from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion import (
     HEAD_PITCH,
     HEAD_YAW,
@@ -39,13 +39,17 @@ def test_look_at_a_valid_ball() -> None:
     assert 0.0 < request.pitch < math.radians(29.5)
 
 
-def test_search_sweeps_while_the_ball_is_unknown() -> None:
-    harness = ModuleHarness(LookAtBallBehavior, BallModel(valid=False))
+@pytest.mark.parametrize("pose_valid", [True, False])
+def test_search_sweeps_while_the_ball_is_unknown(pose_valid: bool) -> None:
+    """The sweep reaches ``search_amplitude``; while the pose is not valid, ``search_amplitude_lost`` (wider, to
+    show the field round the robot), which the head's yaw limit (2.0857 rad) allows."""
+    harness = ModuleHarness(LookAtBallBehavior, BallModel(valid=False), RobotPose(valid=pose_valid))
     yaws = []
-    for i in range(0, 600, 10):
+    for i in range(0, 900, 10):
         harness.set(FrameInfo(frame_number=i, time_ns=i * TICK_NS))
         yaws.append(harness.execute()[HeadMotionRequest].yaw)
-    amplitude = harness.module.parameters.search_amplitude
+    p = harness.module.parameters
+    amplitude = p.search_amplitude if pose_valid else p.search_amplitude_lost
     assert max(yaws) == pytest.approx(amplitude, abs=0.05) and min(yaws) == pytest.approx(-amplitude, abs=0.05)
 
 

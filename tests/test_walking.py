@@ -140,7 +140,9 @@ def test_getting_up_from_lying(robot: Robot, side: str) -> None:
 @pytest.mark.alone
 @pytest.mark.slow
 def test_a_push_that_topples_the_robot_is_detected_as_a_fall_and_it_gets_up(robot: Robot) -> None:
-    robot.ask("sim:push -x 500")  # the most sim:push gives: at 400 N PyBullet's robot caught itself in 2 of 3 runs
+    # 100 N for 0.1 s (1.9 m/s) topples it forwards on both engines; 400 to 500 N flung PyBullet's robot
+    # through a somersault onto its feet, where no lying phase is seen
+    robot.ask("sim:push -x 100")
     phases, postures = set(), set()
     deadline = robot.status()["time"] + 6.0  # simulated s: a loaded machine samples the phases less often
     while robot.status()["time"] < deadline:

@@ -94,7 +94,7 @@ class Scenario:
     robot_start: tuple[float, float, float]
     ball: tuple[float, float]
     success: tuple[Condition, ...]
-    #: the localization is told the start pose (``KnownPose``), as a team tells a robot it placed by hand
+    #: the localization is told the start pose (the known pose), as a team tells a robot it placed by hand
     #: for a drill; without it a start the rules never give (the opponent half in PLAYING) is taken for its twin
     told_pose: bool = False
     description: str = ""

@@ -149,7 +149,7 @@ def play(scenario: Scenario, seed: int, record: Path | None = None) -> dict[str,
     start = perturbed_start(scenario, seed)
     began = time.perf_counter()
     program = SteppedProgram(scenario.platform, _options(scenario, start, seed), scenario.overrides, record=record)
-    program.platform.tell_pose = scenario.told_pose  # KnownPose at the first cognition frame, as sim:move_robot -reset on
+    program.platform.tell_pose = scenario.told_pose  # told at the first cognition frame, as sim:move_robot -reset on tells it
     world, judge = _Truth(program), _Judge(scenario)
     pushes = sorted(scenario.events, key=lambda e: e.at_s)
     push = program.platform.commands()["sim:push"][1]
