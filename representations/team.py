@@ -8,6 +8,7 @@ bytes of a Tafel message (its layout, ``pack_message``, ``unpack_message``) are
 from __future__ import annotations
 
 import enum
+import math
 from dataclasses import dataclass, field
 
 from tafel.core import representation
@@ -85,6 +86,17 @@ class TeamMate:
     age: float = 0.0
 
 
+@dataclass
+class TeamBall:
+    """The ball a teammate reported: on the field (mm, moved on by its velocity), how old (s), and which
+    message it came in (player, sender's clock in ms)."""
+
+    x: float
+    y: float
+    age: float
+    message: tuple[int, int]
+
+
 @representation
 class TeamMates:
     """Every teammate heard, by player number order; ``malformed`` counts messages ignored as not ours
@@ -95,6 +107,18 @@ class TeamMates:
     received: int = counter()
     malformed: int = counter()
     spoofed: int = counter()
+
+    def freshest_ball(self, max_age: float) -> TeamBall | None:
+        """The freshest ball reported by a teammate with a valid pose, upright and playing, within ``max_age``
+        s; None if there is none."""
+        heard = [(mate.age + mate.message.ball_age, mate.message) for mate in self.mates
+                 if mate.message.ball_seen and mate.message.pose_valid and not (mate.message.fallen or mate.message.penalized)
+                 and mate.message.ball_age >= 0.0]
+        heard = [(age, m) for age, m in heard if math.isfinite(age) and age <= max_age]
+        if not heard:
+            return None
+        age, m = min(heard, key=lambda h: h[0])
+        return TeamBall(m.ball_x + m.ball_vx * age, m.ball_y + m.ball_vy * age, age, (m.player, m.sent_ms))
 
     def fresh(self, max_age: float) -> list[TeamMate]:
         """The teammates heard within ``max_age`` s."""

@@ -8,7 +8,6 @@ import math
 from dataclasses import dataclass
 
 from tafel.core import Module, provides, requires, uses
-from tafel.modules.modeling.mirror_hypotheses import freshest_team_ball
 from tafel.representations.behavior import HOLD_SPEED, HeadMotionRequest
 from tafel.representations.game import GameState
 from tafel.representations.infrastructure import FrameInfo
@@ -137,7 +136,7 @@ class LookAtBallBehavior(Module):
         p, pose = self.parameters, self.robot_pose
         if pose.valid or pose.deviation > p.candidate_deviation:
             return []
-        team = freshest_team_ball(self.team_mates, p.team_ball_age)
+        team = self.team_mates.freshest_ball(p.team_ball_age)
         if team is None:
             return []
         # seen from the twin (turned by 180 degrees about the centre spot), a point lies where its mirror

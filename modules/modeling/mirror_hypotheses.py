@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tafel.representations.geometry import Pose2D
-from tafel.representations.team import TeamMates
+from tafel.representations.team import TeamBall
 
 ROTATION_MM = 1000.0  # mm a radian of heading counts as when poses are compared
 
@@ -54,30 +54,6 @@ def robust(normalized: float) -> float:
     """Log-likelihood of a normalized error, flat beyond 2.5 standard deviations (one wrong report cannot
     decide alone)."""
     return -0.5 * min(normalized, 2.5) ** 2
-
-
-@dataclass
-class TeamBall:
-    """The ball a teammate reported: on the field (mm, moved on by its velocity), how old (s), and which
-    message it came in (player, sender's clock in ms)."""
-
-    x: float
-    y: float
-    age: float
-    message: tuple[int, int]
-
-
-def freshest_team_ball(team_mates: TeamMates, max_age: float) -> TeamBall | None:
-    """The freshest ball reported by a teammate with a valid pose, upright and playing, within ``max_age``
-    s; None if there is none."""
-    heard = [(mate.age + mate.message.ball_age, mate.message) for mate in team_mates.mates
-             if mate.message.ball_seen and mate.message.pose_valid and not (mate.message.fallen or mate.message.penalized)
-             and mate.message.ball_age >= 0.0]
-    heard = [(age, m) for age, m in heard if math.isfinite(age) and age <= max_age]
-    if not heard:
-        return None
-    age, m = min(heard, key=lambda h: h[0])
-    return TeamBall(m.ball_x + m.ball_vx * age, m.ball_y + m.ball_vy * age, age, (m.player, m.sent_ms))
 
 
 @dataclass

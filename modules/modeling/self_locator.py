@@ -10,7 +10,7 @@ import numpy as np
 from tafel.core import Module, bounded, provides, requires, uses
 from tafel.debug import Canvas, DebugRequest, Plot
 from tafel.modules.modeling.field_model import FIELD_MODEL, OWN_HALF
-from tafel.modules.modeling.mirror_hypotheses import SideBelief, fold, freshest_team_ball, pose_distance, twin
+from tafel.modules.modeling.mirror_hypotheses import SideBelief, fold, pose_distance, twin
 from tafel.representations import field
 from tafel.representations.game import GameState
 from tafel.representations.geometry import Pose2D
@@ -371,7 +371,7 @@ class SelfLocator(Module):
                 self.turn_to_twin(pose)  # old place (the anchor), which is tracked again; it must not flip
         odometry = (self.odometry.x, self.odometry.y, self.odometry.rotation)
         side.add_placement(self.estimate, odometry, p.placement_cap, p.placement_rate * p.placement_cap, p.side_cap)
-        team, ball = freshest_team_ball(self.team_mates, p.team_ball_max_age), self.ball_percept
+        team, ball = self.team_mates.freshest_ball(p.team_ball_max_age), self.ball_percept
         if team is not None and ball.seen and math.isfinite(ball.x) and math.isfinite(ball.y):
             std = p.team_ball_std + p.team_ball_std_per_m * math.hypot(ball.x, ball.y) / 1000.0 + p.team_ball_std_per_s * team.age
             side.add_team_ball(self.estimate, (ball.x, ball.y), team, std, p.team_ball_rate, p.team_message_cap, p.side_cap)
