@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import math
 from pathlib import Path
 from types import ModuleType
@@ -12,16 +11,11 @@ import numpy as np
 import pytest
 
 from tafel.platforms.images import standing_camera
-
-REPO = Path(__file__).resolve().parent.parent
+from tests.support.benchmarks import load_benchmark
 
 
 def benchmark() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("cognition_budget_benchmark", REPO / "benchmarks" / "cognition_budget.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_benchmark("cognition_budget")
 
 
 @pytest.mark.slow

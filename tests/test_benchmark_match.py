@@ -2,21 +2,15 @@
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
 from types import ModuleType
 
 import pytest
 
-REPO = Path(__file__).resolve().parent.parent
+from tests.support.benchmarks import load_benchmark
 
 
 def benchmark() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("match_benchmark", REPO / "benchmarks" / "match.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_benchmark("match")
 
 
 def test_playing_time_runs_on_through_penalties_and_free_kicks_and_fouls_count_per_minute_of_it() -> None:

@@ -2,10 +2,8 @@
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import os
-from pathlib import Path
 from types import ModuleType
 
 import cv2
@@ -18,8 +16,8 @@ from tafel.modules.perception.robot_detector import RobotDetector
 from tafel.representations.motion import CameraMatrix, CameraMatrixBuffer
 from tafel.representations.obstacles import RobotsPercept
 from tafel.representations.perception import CameraImageBottom, CameraImageTop, FieldBoundary, FieldColor, SegmentedImage
+from tests.support.benchmarks import load_benchmark
 
-REPO = Path(__file__).resolve().parent.parent
 WIDTH, HEIGHT = 640, 480
 FOV = (math.radians(56.3), math.radians(43.7))
 GREEN, WHITE, GREY = (40, 140, 40), (235, 235, 235), (110, 110, 110)
@@ -120,11 +118,7 @@ def test_two_robots_side_by_side_are_two() -> None:
 
 
 def benchmark() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("robots_benchmark", REPO / "benchmarks" / "robots.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_benchmark("robots")
 
 
 @pytest.mark.slow
