@@ -95,3 +95,25 @@ def test_the_goalkeeper_clearing_passes_out_to_an_open_striker_ahead() -> None:
     out = keeper([TeamMessage(team=1, player=2, pose_valid=True, x=-2200.0, y=-1500.0)])
     aim = math.atan2(-1500.0, -2200.0 + 3700.0)  # from the ball at (-3700, 0) to the striker: about -0.79 rad
     assert out.motion is MotionType.walk_to and out.target_rotation == pytest.approx(aim, abs=0.15)
+
+
+def supporter(opponents: list[Obstacle]) -> tuple[float, float]:
+    """Where the supporter at (-1000, 0) walks (field mm) with the ball at the centre spot."""
+    team = TeamInfo(team_number=1, players=[RobotInfo() for _ in range(20)])
+    state = GameState(state=State.playing, teams=[team, TeamInfo(team_number=2)], team_number=1, player_number=2, kicking_team=1)
+    pose = RobotPose(valid=True, x=-1000.0, y=0.0)
+    harness = ModuleHarness(SoccerBehavior, state, PlayerRole(role=Role.supporter), pose, BallModel(valid=True, seen=True, x=1000.0, y=0.0),
+                            TeamMates(), MotionInfo(), Obstacles(obstacles=opponents))
+    out = harness.execute()[MotionRequest]
+    assert out.motion is MotionType.walk_to
+    return pose.to_field(out.target_x, out.target_y)
+
+
+def test_the_supporter_waits_ahead_and_beside_the_ball_on_the_side_open_to_a_pass() -> None:
+    free = supporter([])
+    assert free == pytest.approx((1500.0, 1000.0), abs=1.0)  # supporter_offset ahead, beside
+    assert choose_pass((0.0, 0.0), [free], [], P) is not None  # a place the pass rule passes to
+    marked = supporter([Obstacle(x=2600.0, y=1100.0, kind=ObstacleKind.robot)])  # an opponent at (1600, 1100)
+    assert marked == pytest.approx((1500.0, -1000.0), abs=1.0)
+    both = supporter([Obstacle(x=2600.0, y=1100.0, kind=ObstacleKind.robot), Obstacle(x=2600.0, y=-1100.0, kind=ObstacleKind.robot)])
+    assert both[0] > 1000.0 and both[1] > 500.0  # neither open: the usual side (stopping short of the robot standing there)

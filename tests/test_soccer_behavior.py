@@ -86,13 +86,13 @@ def test_the_goalkeeper_stays_between_ball_and_goal_and_clears_a_near_ball_in_it
     assert near.motion is MotionType.walk_to and near.target_x > 300.0  # goes for it
 
 
-def test_supporters_and_defenders_keep_their_distance_from_the_ball() -> None:
+def test_supporters_wait_ahead_of_the_ball_for_a_pass_and_defenders_behind_it_both_at_a_distance() -> None:
     pose = RobotPose(valid=True, x=-1000.0, y=0.0)
     ball = BallModel(valid=True, x=2000.0, y=1500.0)  # on the field: (1000, 1500)
-    for role in (Role.supporter, Role.defender):
+    for role, ahead in ((Role.supporter, True), (Role.defender, False)):
         out = request(State.playing, role, pose=pose, ball=ball)
         x, y = pose.to_field(out.target_x, out.target_y)
-        assert out.motion is MotionType.walk_to and math.hypot(x - 1000.0, y - 1500.0) > 1000.0 and x < 1000.0, role
+        assert out.motion is MotionType.walk_to and math.hypot(x - 1000.0, y - 1500.0) > 1000.0 and (x > 1000.0) is ahead, role
 
 
 # ------------------------------------------------------------------------------ the rules' set plays

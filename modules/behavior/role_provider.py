@@ -7,13 +7,13 @@ from dataclasses import dataclass
 
 from tafel.core import Module, bounded, provides, requires, uses
 from tafel.representations.game import GameState, Penalty, State
-from tafel.representations.modeling import BallModel
+from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import FallState
 from tafel.representations.team import Intention, PlayerRole, Role, TeamMates
 
 
 @requires(GameState, TeamMates)
-@uses(BallModel, FallState)
+@uses(BallModel, FallState, RobotPose)
 @provides(PlayerRole)
 class RoleProvider(Module):
     """Every robot computes the same assignment from what the team said, so exactly one field player goes
@@ -31,6 +31,12 @@ class RoleProvider(Module):
       does not flicker between two robots at about the same distance. A robot that does not know where
       the ball is has no time; if nobody knows, the last striker stays, or the lowest player number.
     - The next quickest is the supporter; the others defend.
+    - A team of two on the field (the GameController's players not penalized, or without it, one teammate
+      heard) is a goalkeeper and a striker, and nobody to pass to. So there the goalkeeper leaves its goal
+      while the ball is in attack: once the ball (its own sighting, else a teammate's) is beyond
+      ``keeper_out_x``, it takes part as a field player (usually the supporter, waiting ahead of the ball
+      for a pass), and it goes back to its goal when the ball is behind ``keeper_back_x`` again or nobody
+      knows where it is. Its teammate counts it as a field player while its messages say so.
 
     Teammates heard within ``mate_timeout`` s that are neither penalized nor fallen take part.
     """
@@ -39,6 +45,7 @@ class RoleProvider(Module):
     team_mates: TeamMates
     ball_model: BallModel
     fall_state: FallState
+    robot_pose: RobotPose
     player_role: PlayerRole
 
     @dataclass
@@ -51,28 +58,41 @@ class RoleProvider(Module):
         """s the current striker counts quicker"""
         mate_timeout: float = bounded(0.5, 30.0, 4.0)
         """s after a teammate's last message that it still takes part"""
+        keeper_out_x: float = bounded(-4500.0, 4500.0, 500.0)
+        """field mm: in a team of two on the field, the goalkeeper plays as a field player once the ball is beyond this"""
+        keeper_back_x: float = bounded(-4500.0, 4500.0, -1000.0)
+        """field mm: ... and keeps its goal again once the ball is behind this"""
+        team_ball_age: float = bounded(0.0, 30.0, 3.0)
+        """s: a teammate's ball older than this does not count for where the ball is"""
 
     parameters: Parameters
+
+    def __init__(self) -> None:
+        self.keeper_out = False
+        """the goalkeeper of a team of two plays as a field player (the ball is in attack)"""
 
     def execute(self) -> None:
         game, out = self.game_state, self.player_role
         out.time_to_ball = self.time_to_ball()
         if game.penalized or game.state in (State.initial, State.finished):
-            out.role, out.intention = Role.none, Intention.none
+            out.role, out.intention, self.keeper_out = Role.none, Intention.none, False
             return
         team = game.own_team()
         keeper = team.goalkeeper if team is not None and team.goalkeeper else 1
         mates = [m.message for m in self.team_mates.fresh(self.parameters.mate_timeout) if not (m.message.penalized or m.message.fallen)]
         on_field = self.on_field()
         alone = not mates if on_field is None else on_field == [game.player_number]
-        if game.player_number == keeper and not alone:
+        pair = len(mates) == 1 if on_field is None else len(on_field) == 2
+        self.keeper_out = game.player_number == keeper and pair and game.state is State.playing and self.ball_in_attack()
+        if game.player_number == keeper and not alone and not self.keeper_out:
             out.role, out.intention = Role.goalkeeper, Intention.keep_goal
             return
         if on_field is not None and game.state in (State.ready, State.set):  # nobody talks: by the numbers
             place = [n for n in on_field if n != keeper or alone].index(game.player_number)
         else:
             me = (game.player_number, out.time_to_ball, out.role is Role.striker)
-            field_players = [me, *((m.player, m.time_to_ball, m.role is Role.striker) for m in mates if m.player != keeper)]
+            field_players = [me, *((m.player, m.time_to_ball, m.role is Role.striker) for m in mates
+                                   if m.player != keeper or m.role in (Role.striker, Role.supporter))]  # a keeper out of its goal plays
             order = sorted(field_players, key=lambda player: self.rank(*player))
             place = [player for player, _, _ in order].index(game.player_number)
         out.role = Role.striker if place == 0 else Role.supporter if place == 1 else Role.defender
@@ -86,6 +106,19 @@ class RoleProvider(Module):
             return None
         numbers = [n for n, robot in enumerate(team.players[: game.players_per_team], start=1) if robot.penalty is Penalty.none]
         return numbers if game.player_number in numbers else None
+
+    def ball_in_attack(self) -> bool:
+        """Whether the ball is far enough in attack for a goalkeeper of a team of two to leave its goal: beyond
+        ``keeper_out_x``, or, once out, not yet behind ``keeper_back_x`` (field mm; own sighting, else a teammate's)."""
+        ball, pose, p = self.ball_model, self.robot_pose, self.parameters
+        if ball.valid and pose.valid:
+            x, _ = ball.field_position(pose)
+        else:
+            heard = self.team_mates.freshest_ball(p.team_ball_age)
+            if heard is None:
+                return False
+            x = heard.x
+        return x > (p.keeper_back_x if self.keeper_out else p.keeper_out_x)
 
     def rank(self, player: int, time_to_ball: float, striker: bool) -> tuple[float, int, int]:
         """Sort key: time to the ball (unknown last), the striker's bonus, then the last striker, then the number."""

@@ -100,8 +100,9 @@ class SoccerBehavior(Module):
         """mm from a position that counts as there (then the robot stands)"""
         team_ball_age: float = bounded(0.0, 30.0, 3.0)
         """s: a teammate's ball older than this is not used"""
-        supporter_offset: list[float] = field(default_factory=lambda: [-1200.0, 900.0])
-        """mm behind and beside the ball (beside: towards the field's centre line)"""
+        supporter_offset: list[float] = field(default_factory=lambda: [1500.0, 1000.0])
+        """mm ahead of (towards the opponent goal; negative: behind) and beside the ball (beside: towards the
+        field's long axis), where the supporter waits for a pass"""
         keeper_clear_distance: float = bounded(0.0, 3000.0, 1200.0)
         """mm: a ball this near the goalkeeper, in its penalty area, is cleared"""
         keep_out_margin: float = bounded(0.0, 1000.0, 300.0)

@@ -15,10 +15,12 @@ from typing import TYPE_CHECKING
 
 from tafel.modules.behavior.kicking import approach_and_kick, goal_direction
 from tafel.modules.behavior.options.framework import Next, Option, common, state
+from tafel.modules.behavior.passing import lane_clearance
 from tafel.modules.behavior.paths import outside
 from tafel.representations import field as pitch
 from tafel.representations.game import GamePhase, SetPlay, State
 from tafel.representations.motion_control import MotionType, WalkKick
+from tafel.representations.obstacles import ObstacleKind
 from tafel.representations.team import Role
 
 if TYPE_CHECKING:
@@ -36,6 +38,8 @@ LOST_TURN = 0.3  # rad/s: turning (the head looks around) while the robot does n
 #: least CROSS_BESIDE mm beside the centre, where the other team's kick-off places stand: in SET a robot in the
 #: other half is penalized
 CROSSED, CROSS_BESIDE = 250.0, pitch.CENTER_CIRCLE_DIAMETER / 2 + 500.0
+#: mm the supporter waits at least in front of the opponent goal line (out of the keeper's way) and inside the touchlines
+SUPPORT_GOAL_GAP, SUPPORT_TOUCHLINE_GAP = 1200.0, 400.0
 
 
 class GoTo(Option["SoccerBehavior"]):
@@ -194,16 +198,32 @@ class Goalkeeper(Option["SoccerBehavior"]):
 
 
 class Supporter(Option["SoccerBehavior"]):
-    """Wait behind and beside the ball (beside: towards the field's long axis)."""
+    """Wait ahead of and beside the ball, open to a pass: the striker passes by the pass rule
+    (``passing.py``) to a teammate nearer the opponent goal, and the receiver, then the nearest to the
+    ball, becomes the striker."""
 
     calls = (GoTo,)
 
     @state(initial=True)
     def support(self, b: SoccerBehavior) -> None:
-        """``supporter_offset`` behind and beside the ball, at least a metre in front of the own goal."""
-        bx, by = b.ball_on_field() or (0.0, 0.0)
-        back, beside = b.parameters.supporter_offset
-        x, y = max(OWN_GOAL_X + 1000.0, bx + back), by - math.copysign(beside, by) if abs(by) > 100.0 else by + beside
+        """``supporter_offset`` ahead of and beside the ball (beside: towards the field's long axis, or the
+        other side when an opponent stands within ``pass_open`` of that spot or ``lane_width`` of the ball's
+        way to it and not of the other), at least a metre in front of the own goal and ``SUPPORT_GOAL_GAP``
+        in front of the opponent goal line, ``SUPPORT_TOUCHLINE_GAP`` inside the touchlines; facing the ball."""
+        ball = b.ball_on_field() or (0.0, 0.0)
+        ahead, beside = b.parameters.supporter_offset
+        x = min(max(OWN_GOAL_X + 1000.0, ball[0] + ahead), pitch.LENGTH / 2 - SUPPORT_GOAL_GAP)
+        inward = -math.copysign(1.0, ball[1]) if abs(ball[1]) > 100.0 else 1.0
+        limit = pitch.WIDTH / 2 - SUPPORT_TOUCHLINE_GAP
+        spots = [(x, max(-limit, min(limit, ball[1] + side * beside))) for side in (inward, -inward)]
+        pose, p = b.robot_pose, b.parameters
+        opponents = [pose.to_field(o.x, o.y) for o in b.obstacles.obstacles if o.kind is ObstacleKind.robot] if pose.valid else []
+
+        def open_to_pass(spot: tuple[float, float]) -> bool:
+            return (all(math.dist(spot, o) >= p.pass_open for o in opponents)
+                    and lane_clearance(ball, spot, opponents) >= p.lane_width)
+
+        x, y = spots[0] if open_to_pass(spots[0]) or not open_to_pass(spots[1]) else spots[1]
         self.call(GoTo, x=x, y=y, rotation=b.facing_ball(x, y))
 
 
