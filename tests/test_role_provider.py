@@ -57,11 +57,12 @@ def test_by_a_teammates_ball_the_keeper_goes_out_and_without_any_ball_it_goes_ba
     assert harness.execute()[PlayerRole].role is Role.goalkeeper
 
 
-def test_the_teammate_counts_the_keeper_as_a_field_player_while_it_says_it_is_out() -> None:
-    def role_of_player_two(keeper_role: Role) -> Role:
+def test_the_teammate_counts_the_keeper_as_a_field_player_while_it_says_it_is_out_and_the_ball_is_in_attack() -> None:
+    def role_of_player_two(keeper_role: Role, ball_x: float) -> Role:
         harness = ModuleHarness(RoleProvider, game(2, 2), TeamMates(mates=[said(1, 2.0, keeper_role)]), RobotPose(valid=True),
-                                BallModel(valid=True, x=3000.0), PlayerRole())  # 15 s away: the keeper is quicker
+                                BallModel(valid=True, x=ball_x), PlayerRole())  # 15 s away: the keeper is quicker
         return harness.execute()[PlayerRole].role
 
-    assert role_of_player_two(Role.goalkeeper) is Role.striker
-    assert role_of_player_two(Role.striker) is Role.supporter
+    assert role_of_player_two(Role.goalkeeper, 3000.0) is Role.striker
+    assert role_of_player_two(Role.striker, 3000.0) is Role.supporter
+    assert role_of_player_two(Role.striker, -3000.0) is Role.striker  # the ball is back: the keeper is too, whatever it said last

@@ -36,7 +36,8 @@ class RoleProvider(Module):
       while the ball is in attack: once the ball (its own sighting, else a teammate's) is beyond
       ``keeper_out_x``, it takes part as a field player (usually the supporter, waiting ahead of the ball
       for a pass), and it goes back to its goal when the ball is behind ``keeper_back_x`` again or nobody
-      knows where it is. Its teammate counts it as a field player while its messages say so.
+      knows where it is. Its teammate counts it as a field player while its messages say so and the ball
+      (as the teammate knows it) is beyond ``keeper_back_x``: a keeper gone back is not waited for.
 
     Teammates heard within ``mate_timeout`` s that are neither penalized nor fallen take part.
     """
@@ -83,7 +84,10 @@ class RoleProvider(Module):
         on_field = self.on_field()
         alone = not mates if on_field is None else on_field == [game.player_number]
         pair = len(mates) == 1 if on_field is None else len(on_field) == 2
-        self.keeper_out = game.player_number == keeper and pair and game.state is State.playing and self.ball_in_attack()
+        ball_x = self.ball_x() if pair and game.state is State.playing else None
+        p = self.parameters
+        self.keeper_out = game.player_number == keeper and ball_x is not None and ball_x > (p.keeper_back_x if self.keeper_out else p.keeper_out_x)
+        keeper_may_play = ball_x is not None and ball_x > p.keeper_back_x  # a teammate's view: its keeper may be out
         if game.player_number == keeper and not alone and not self.keeper_out:
             out.role, out.intention = Role.goalkeeper, Intention.keep_goal
             return
@@ -92,7 +96,7 @@ class RoleProvider(Module):
         else:
             me = (game.player_number, out.time_to_ball, out.role is Role.striker)
             field_players = [me, *((m.player, m.time_to_ball, m.role is Role.striker) for m in mates
-                                   if m.player != keeper or m.role in (Role.striker, Role.supporter))]  # a keeper out of its goal plays
+                                   if m.player != keeper or (keeper_may_play and m.role in (Role.striker, Role.supporter)))]
             order = sorted(field_players, key=lambda player: self.rank(*player))
             place = [player for player, _, _ in order].index(game.player_number)
         out.role = Role.striker if place == 0 else Role.supporter if place == 1 else Role.defender
@@ -107,18 +111,14 @@ class RoleProvider(Module):
         numbers = [n for n, robot in enumerate(team.players[: game.players_per_team], start=1) if robot.penalty is Penalty.none]
         return numbers if game.player_number in numbers else None
 
-    def ball_in_attack(self) -> bool:
-        """Whether the ball is far enough in attack for a goalkeeper of a team of two to leave its goal: beyond
-        ``keeper_out_x``, or, once out, not yet behind ``keeper_back_x`` (field mm; own sighting, else a teammate's)."""
-        ball, pose, p = self.ball_model, self.robot_pose, self.parameters
+    def ball_x(self) -> float | None:
+        """Where the ball is along the field (mm, the opponent goal at +x): the own sighting, else a teammate's;
+        None when nobody knows."""
+        ball, pose = self.ball_model, self.robot_pose
         if ball.valid and pose.valid:
-            x, _ = ball.field_position(pose)
-        else:
-            heard = self.team_mates.freshest_ball(p.team_ball_age)
-            if heard is None:
-                return False
-            x = heard.x
-        return x > (p.keeper_back_x if self.keeper_out else p.keeper_out_x)
+            return ball.field_position(pose)[0]
+        heard = self.team_mates.freshest_ball(self.parameters.team_ball_age)
+        return None if heard is None else heard.x
 
     def rank(self, player: int, time_to_ball: float, striker: bool) -> tuple[float, int, int]:
         """Sort key: time to the ball (unknown last), the striker's bonus, then the last striker, then the number."""
