@@ -6,7 +6,8 @@ Everything in the robot frame (mm): the robot at the origin. A disc is (x, y, ra
 The way round a disc follows the tangent from the robot to the disc grown by a margin, on the side the
 straight line passes it (a disc dead ahead: the side asked for, else the right, so that two robots
 walking at each other both step aside the same way round). A robot already within the grown disc and
-heading further in steps out sideways instead of walking on.
+heading further in steps out sideways instead of walking on, even when its target lies in that disc too
+(two robots' discs overlap, and moving the target out of one put it into the other).
 """
 
 from __future__ import annotations
@@ -20,19 +21,25 @@ MIN_STEP = 300.0  # mm: a detour's waypoint is at least this far, so that the wa
 TANGENT_SLACK = 0.05  # rad beyond the exact tangent: the way to the waypoint clears the grown disc
 DEAD_AHEAD = 0.3  # share of the grown radius: a disc whose centre lies this near the way is "ahead" (the side asked for)
 RIGHT, LEFT = -1, 1
+OUTSIDE_PASSES = 4  # rounds of ``outside`` over the discs: one moved out of a disc into an overlapping one is moved again
 
 
 def outside(x: float, y: float, discs: Sequence[Disc], margin: float = 0.0) -> tuple[float, float]:
     """(x, y) moved radially out of every disc it lies in (each grown by ``margin``): where a target in a
-    forbidden area goes instead. Discs are handled in turn; two overlapping ones may need a second call."""
-    for cx, cy, radius in discs:
-        reach = radius + margin
-        dx, dy = x - cx, y - cy
-        distance = math.hypot(dx, dy)
-        if distance < reach:
-            if distance < 1e-6:  # at the centre: out towards the robot (or backwards, if it is there too)
-                dx, dy, distance = (-cx, -cy, math.hypot(cx, cy)) if math.hypot(cx, cy) > 1e-6 else (-1.0, 0.0, 1.0)
-            x, y = cx + dx / distance * reach, cy + dy / distance * reach
+    forbidden area goes instead. Discs are handled in turn, and again while a move put it into another
+    (at most ``OUTSIDE_PASSES`` rounds: closed in by discs, it stays where the last round put it)."""
+    for _ in range(OUTSIDE_PASSES):
+        moved = False
+        for cx, cy, radius in discs:
+            reach = radius + margin
+            dx, dy = x - cx, y - cy
+            distance = math.hypot(dx, dy)
+            if distance < reach - 1e-6:
+                if distance < 1e-6:  # at the centre: out towards the robot (or backwards, if it is there too)
+                    dx, dy, distance = (-cx, -cy, math.hypot(cx, cy)) if math.hypot(cx, cy) > 1e-6 else (-1.0, 0.0, 1.0)
+                x, y, moved = cx + dx / distance * reach, cy + dy / distance * reach, True
+        if not moved:
+            break
     return x, y
 
 
@@ -48,8 +55,8 @@ def hit(x: float, y: float, cx: float, cy: float, reach: float) -> float | None:
 
 def blocking(x: float, y: float, discs: Sequence[Disc], margin: float = 0.0) -> tuple[float, Disc] | None:
     """The first disc (grown by ``margin``) the straight walk from the origin to (x, y) runs into, and how
-    far along (0..1). A disc that holds the target is left out (the robot has to go in); one that holds
-    the robot blocks at 0 when the way leads further in, and is left out when it leads out."""
+    far along (0..1). A disc that holds the target but not the robot is left out (the robot has to go in);
+    one that holds the robot blocks at 0 when the way leads further in, and is left out when it leads out."""
     length_sq = x * x + y * y
     first: tuple[float, Disc] | None = None
     if length_sq < 1e-9:
@@ -57,7 +64,7 @@ def blocking(x: float, y: float, discs: Sequence[Disc], margin: float = 0.0) -> 
     for disc in discs:
         cx, cy, radius = disc
         reach = radius + margin
-        if math.hypot(x - cx, y - cy) < reach:
+        if math.hypot(x - cx, y - cy) < reach and math.hypot(cx, cy) >= reach:
             continue
         t = hit(x, y, cx, cy, reach)
         if t is not None and (first is None or t < first[0]):
