@@ -14,6 +14,7 @@ import pytest
 from tafel.platforms.match_world import MatchWorld, Side
 from tafel.platforms.network import listening_socket
 from tafel.representations.game import Penalty, SetPlay, State
+from tafel.representations.motion import JOINT_NAMES
 from tafel.tools.simulation.match import free_udp_port
 from tafel.tools.simulation.officiating import Player
 from tafel.tools.simulation.referee import Referee
@@ -128,6 +129,116 @@ def test_walking_into_an_opponent_away_from_the_ball_is_pushing(referee: Referee
     run(referee, TICK)
     foul = referee.fouls[-1]
     assert (foul.team, foul.player, foul.penalty) == (1, 1, Penalty.player_pushing) and "walked into team 2 player 1" in foul.reason
+
+
+# ------------------------------------------------------------------------------- fallen, inactive, motion in SET
+def lay(ref: Referee, index: int, x: float, y: float, how: str = "back") -> None:
+    """Put a robot down as a fall leaves it (``back``: its torso 60 mm up, tilted 90 degrees) or sitting up
+    (``sitting``: upright, 130 mm up), as a get-up passes through."""
+    half = math.pi / 4
+    height, quaternion = (0.06, [math.cos(half), 0.0, -math.sin(half), 0.0]) if how == "back" else (0.13, [1.0, 0.0, 0.0, 0.0])
+    ref.world.robots[index].place(ref.world.data, np.array([x / 1000.0, y / 1000.0, height]), np.array(quaternion))
+    mujoco.mj_forward(ref.world.model, ref.world.data)
+
+
+def bend(ref: Referee, index: int, joint: str, angle: float) -> None:
+    """Turn one of a robot's joints (rad), as its program would."""
+    robot = ref.world.robots[index]
+    ref.world.data.qpos[robot.joint_qpos[JOINT_NAMES.index(joint)]] = angle
+    mujoco.mj_forward(ref.world.model, ref.world.data)
+
+
+def attempt(ref: Referee, index: int, number: int) -> None:
+    """One get-up that fails: the legs move, the robot sits up, then falls back and lies still for 1 s."""
+    bend(ref, index, "LKneePitch", 0.5 * number)
+    lay(ref, index, -2000.0, 0.0, "sitting")
+    run(ref, 0.5)
+    lay(ref, index, -2000.0, 0.0)
+    run(ref, 1.0)
+
+
+def test_a_fallen_robot_that_does_not_begin_to_get_up_within_5_s_is_penalized_45_s_not_incrementally(referee: Referee) -> None:
+    until(referee, State.playing)
+    lay(referee, 0, -2000.0, 0.0)
+    run(referee, 4.9)
+    assert referee.fouls == []
+    run(referee, 0.2)
+    foul = referee.fouls[-1]
+    assert (foul.team, foul.player, foul.penalty, foul.reason) == (1, 1, Penalty.inactive_player, "fallen robot: no get-up within 5 s")
+    assert referee.game.teams[0].players[0].secs_till_unpenalised == 45 and referee.incremental == [0, 0]
+    assert referee.world.robot_pose(0)[1] < -3000.0  # removed: off the carpet
+
+
+@pytest.mark.parametrize("disturbed", [False, True])
+def test_a_fallen_robot_not_up_after_two_attempts_or_three_when_disturbed_is_penalized(referee: Referee, disturbed: bool) -> None:
+    until(referee, State.playing)
+    if disturbed:  # an opponent beside it
+        referee.world.move_robot(1, -2000.0, 300.0, math.pi)
+    lay(referee, 0, -2000.0, 0.0)
+    run(referee, 1.0)
+    attempt(referee, 0, 1)
+    assert referee.fouls == [] and referee.fall_watches[0].failed == 1
+    attempt(referee, 0, 2)
+    if disturbed:
+        assert referee.fouls == []
+        attempt(referee, 0, 3)
+    foul = referee.fouls[-1]
+    assert (foul.player, foul.penalty, foul.reason) == (1, Penalty.inactive_player, f"fallen robot: not up after {3 if disturbed else 2} attempts")
+
+
+def test_a_robot_that_gets_up_in_time_is_not_called_and_its_next_fall_counts_afresh(referee: Referee) -> None:
+    until(referee, State.playing)
+    for _ in range(3):
+        lay(referee, 0, -2000.0, 0.0)
+        run(referee, 3.0)
+        attempt(referee, 0, 1)  # the first attempt fails; the second gets it up
+        bend(referee, 0, "LKneePitch", 0.0)
+        referee.world.move_robot(0, -2000.0, 0.0, 0.0)
+        run(referee, 1.5)
+        assert 0 not in referee.fall_watches
+    assert referee.fouls == []
+
+
+def test_a_robot_that_ceased_activity_for_10_s_is_inactive_moving_its_head_or_seeing_the_ball_is_active(referee: Referee) -> None:
+    until(referee, State.playing)
+    referee.world.move_robot(0, -2000.0, 0.0, math.pi)  # its back to the ball
+    for step in range(1, 5):  # searching for the ball: the head turns now and then
+        bend(referee, 0, "HeadYaw", 0.3 * (-1) ** step)
+        run(referee, 5.0)
+    assert referee.fouls == []  # and team 2's robot, standing still, looks at the ball all along
+    run(referee, 5.0)
+    assert referee.fouls == []
+    run(referee, 0.1)  # 10 s since its head last moved
+    foul = referee.fouls[-1]
+    assert (foul.team, foul.player, foul.penalty, foul.reason) == (1, 1, Penalty.inactive_player, "inactive robot: no activity for 10 s")
+    assert referee.incremental == [0, 0]
+
+
+@pytest.mark.parametrize("how", ["walked", "turned"])
+def test_a_robot_that_walks_in_set_is_penalized_15_s_in_place_head_motion_sway_and_getting_up_are_allowed(
+        referee: Referee, how: str) -> None:
+    until(referee, State.set)
+    run(referee, referee.set_grace_s + 0.05)  # the places are taken
+    bend(referee, 0, "HeadYaw", 0.8)  # looking round
+    referee.world.move_robot(0, -1950.0, 30.0, 0.1)  # swaying
+    lay(referee, 1, 2000.0, 0.0)  # team 2's robot falls and gets up 0.3 m away
+    run(referee, 0.3)
+    referee.world.move_robot(1, 2300.0, 0.0, math.pi)
+    run(referee, 1.2)
+    assert referee.fouls == [] and referee.game.state is State.set
+    referee.world.move_robot(0, -1800.0, 0.0, 0.0) if how == "walked" else referee.world.move_robot(0, -2000.0, 0.0, 0.5)
+    run(referee, TICK)
+    foul = referee.fouls[-1]
+    assert (foul.team, foul.player, foul.penalty, foul.reason) == (1, 1, Penalty.illegal_motion_in_set, "walked in SET")
+    robot = referee.game.teams[0].players[0]
+    assert (robot.penalty, robot.secs_till_unpenalised) == (Penalty.illegal_motion_in_set, 15) and referee.incremental == [0, 0]
+    assert referee.world.robot_pose(0) == pytest.approx((-2000.0, 0.0, 0.0), abs=1.0)  # put back where it stood in SET, on the field
+    until(referee, State.playing)
+    run(referee, 14.9)
+    assert robot.penalty is Penalty.illegal_motion_in_set  # counted in PLAYING only
+    run(referee, 0.2)
+    assert robot.penalty is Penalty.none and referee.world.robot_pose(0)[:2] == pytest.approx((-2000.0, 0.0), abs=1.0)  # where it stood
+    assert len(referee.fouls) == 1
 
 
 # ------------------------------------------------------------------------------- penalty shoot-out

@@ -6,13 +6,21 @@ penalties they bring.
   kick-off (a defender in the centre circle before the ball moved or 10 s passed), and the free-kick
   distance (an opponent within 0.75 m of the ball after ``free_kick_grace_s``): ``set_plays.py`` says
   when these hold;
-- leaving the field, inactive player (fallen for 10 s), local game stuck (nobody touched the ball for
-  30 s with robots beside it).
+- motion in SET (the rules' "Forbidden Motion in Set"): a robot whose torso walked ``MOTION_IN_SET`` or
+  turned ``MOTION_IN_SET_TURN`` from where it stood once SET settled (head and arm motion, standing sway
+  and getting up are allowed); GameController3's motionInSet, 15 s, penalized in place: the robot is put
+  back where it stood and stays there, and the penalty ends by itself;
+- fallen or inactive robot (the rules' "Fallen or Inactive Robots", GameController3's fallenInactive,
+  45 s, not incremental), in READY, SET and PLAYING: a fallen robot that does not begin to get up within
+  5 s (its body's joints still, ``GET_UP_S``), or that is not up after 2 attempts (3 when another robot
+  came near it meanwhile: disturbed); an upright robot that ceased activity for 10 s (``INACTIVE_S``: it
+  neither walked nor turned, its head did not move, and the ball was in neither camera's view);
+- leaving the field, local game stuck (nobody touched the ball for 30 s with robots beside it).
 
 Penalties last the rules' times (``PENALTY_S``: 45 s, 15 s in SET; the incremental ones 10 s longer for
 each incremental penalty the team had before), counted in READY and PLAYING; a penalized robot is taken
 off the carpet, then put back on the touchline of its own half, on the side away from the ball, facing
-the field. Every foul is a ``Foul`` (time, team, player, penalty, why).
+the field (motion in SET aside: in place). Every foul is a ``Foul`` (time, team, player, penalty, why).
 """
 
 from __future__ import annotations
@@ -20,8 +28,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from tafel.representations import field as pitch
 from tafel.representations.game import GamePhase, Penalty, State
+from tafel.representations.motion import JOINT_NAMES
+from tafel.representations.nao import CAMERAS, HORIZONTAL_FOV, VERTICAL_FOV
 from tafel.tools.simulation.officiating import HALF_LINE_X, HALF_LINE_Y, Event, Officiating, Player
 
 #: GameController3's penalty durations (s, its champions_cup parameters); the incremental ones grow
@@ -34,7 +46,53 @@ CENTRE_CIRCLE_R, FREE_KICK_DISTANCE = pitch.CENTER_CIRCLE_DIAMETER / 2, 750.0  #
 CONTACT = 330.0  # mm between two torsos: the robots touch
 PUSH_SPEED = 80.0  # mm/s towards the other robot: walking into it
 FALLEN_HEIGHT = 0.2  # m: a torso lower than this has fallen
-INACTIVE_S, STUCK_S = 10.0, 30.0  # s fallen; s without a touch with robots beside the ball
+LYING_UP = 0.5  # the torso's up axis, vertical part: below it (tilted over 60 degrees) the robot lies
+SITTING_UP = 0.7  # ... above it the torso is upright (sitting, kneeling or standing)
+STOOD_HEIGHT, STOOD_S = 0.25, 1.0  # m a torso upright above this for s: the robot stood up, its fall is over
+GET_UP_S = 5.0  # s (the rules): a fallen robot begins to get up within this
+GET_UP_ATTEMPTS, GET_UP_ATTEMPTS_DISTURBED = 2, 3  # the rules: attempts to stand up, more when disturbed
+RISEN = 0.06  # m the torso rose above its lowest since the fall: an attempt got it up (or it sat up)
+ATTEMPT_FAILED_S = 0.3  # s lying still again after it had risen: the attempt failed
+DISTURBED = 400.0  # mm between torsos: another robot disturbs the get-up
+JOINT_MOVED = 0.1  # rad a body joint (the head's and hands' aside) turned: the robot moves its body
+BODY_JOINTS = np.array([k for k, name in enumerate(JOINT_NAMES) if not name.startswith("Head") and not name.endswith("Hand")])
+HEAD_JOINTS = np.array([JOINT_NAMES.index("HeadYaw"), JOINT_NAMES.index("HeadPitch")])
+#: activity (the rules: it walks or turns, it searches for or looks at the ball): mm walked, rad turned, rad of head motion
+ACTIVE_WALK, ACTIVE_TURN, ACTIVE_HEAD = 50.0, 0.2, 0.1
+INACTIVE_S, STUCK_S = 10.0, 30.0  # s without activity (the rules); s without a touch with robots beside the ball
+#: mm a robot's torso moved, and rad it turned, from where it stood in SET: it walked (motion in SET)
+MOTION_IN_SET, MOTION_IN_SET_TURN = 150.0, 0.35
+
+
+@dataclass
+class FallWatch:
+    """A fallen robot, watched until it stood up again: since when (s), its body's joints (rad) when they
+    last moved and when (s), its torso's lowest height (m) while lying since the fall or the last failed
+    attempt, whether it has risen from there, the failed attempts, whether another robot came near, and since when
+    it has stood (s)."""
+
+    since_s: float
+    joints: np.ndarray
+    moved_s: float
+    lowest: float = math.inf
+    lain: bool = False
+    """it has lain (its torso tilted over 60 degrees) since the fall or the last failed attempt"""
+    risen: bool = False
+    failed: int = 0
+    disturbed: bool = False
+    stood_s: float | None = None
+
+
+@dataclass
+class ActivityWatch:
+    """An upright robot's last activity: when (s), where its torso stood then (world mm, mm, rad) and its
+    head's yaw and pitch (rad)."""
+
+    active_s: float
+    x: float
+    y: float
+    heading: float
+    head: np.ndarray
 
 
 @dataclass
@@ -54,10 +112,22 @@ class Fouls(Officiating):
     fouls: list[Foul]
     incremental: list[int]
     """incremental penalties per team so far"""
-    fallen_since: dict[int, float]
+    fall_watches: dict[int, FallWatch]
+    """the fallen robots (by index)"""
+    activity: dict[int, ActivityWatch]
+    """the robots' last activity (by index)"""
+    placed: dict[int, tuple[float, float, float]]
+    """world mm, mm, rad: where each robot stood once SET settled (by index), for motion in SET"""
     set_judged: bool
     last_touch_s: float
     """s: the ball's last touch (or the last call of a local game stuck)"""
+
+    def enter(self, state: State, now: float) -> None:
+        """A new state: activity and falls are watched afresh (they are judged in READY, SET and PLAYING only)."""
+        super().enter(state, now)
+        self.activity.clear()
+        self.fall_watches.clear()
+        self.placed.clear()
 
     def judge_set(self, now: float) -> None:
         """In SET every robot stands in its own half, the defenders outside the centre circle."""
@@ -69,6 +139,22 @@ class Fouls(Officiating):
                 self.penalize(player, Penalty.illegal_position_in_set, now, "in the opponent half in SET")
             elif player.team != kicking and math.hypot(x, y) < CENTRE_CIRCLE_R and kicking is not None:
                 self.penalize(player, Penalty.illegal_position_in_set, now, "in the centre circle at the opponents' kick-off")
+
+    def judge_motion_in_set(self, players: list[Player], now: float, reason: str = "walked in SET") -> None:
+        """SET: the ``players`` may move their heads and arms, sway and get up, but not walk: where each stands
+        (upright, not fallen) is its place; its torso ``MOTION_IN_SET`` from it, or turned ``MOTION_IN_SET_TURN``,
+        is the rules' motion in SET (GameController3's motionInSet, 15 s, in place)."""
+        for player in players:
+            if player.penalized_until_s >= 0:
+                continue
+            x, y, heading = self.world.robot_pose(player.index)
+            position, rotation = self.world.robots[player.index].torso_pose(self.world.data)
+            if float(position[2]) < FALLEN_HEIGHT or float(rotation[2, 2]) < LYING_UP or player.index in self.fall_watches:
+                self.placed.pop(player.index, None)  # getting up is allowed: its place is where it stands up
+                continue
+            px, py, ph = self.placed.setdefault(player.index, (x, y, heading))
+            if math.hypot(x - px, y - py) > MOTION_IN_SET or abs(math.remainder(heading - ph, math.tau)) > MOTION_IN_SET_TURN:
+                self.penalize(player, Penalty.illegal_motion_in_set, now, reason)
 
     def judge_play(self, now: float, kick_off_defender: int | None, free_kick: bool) -> None:
         """The fouls of PLAYING, from where the robots are and how they move; team index ``kick_off_defender``
@@ -84,8 +170,6 @@ class Fouls(Officiating):
             elif free_kick and player.team != kicking and math.hypot(x - bx, y - by) < FREE_KICK_DISTANCE - 50.0:
                 self.penalize(player, Penalty.illegal_position, now,
                               f"within 0.75 m of the ball at the opponents' {self.game.set_play.name}")
-            elif self.inactive(player, now):
-                self.penalize(player, Penalty.inactive_player, now, f"fallen for {INACTIVE_S:g} s")
         self.judge_pushing(now, bx, by)
         if now - self.last_touch_s >= STUCK_S:
             near = sorted((math.hypot(bx - x, by - y), p.index) for p in self.on_field() for x, y, _ in [self.world.robot_pose(p.index)])
@@ -116,14 +200,84 @@ class Fouls(Officiating):
                                   f"{(b if pusher is a else a).number}")
                     return
 
-    def inactive(self, player: Player, now: float) -> bool:
-        """Fallen for ``INACTIVE_S`` s (the torso low all that time)."""
-        position, _ = self.world.robots[player.index].torso_pose(self.world.data)
-        if float(position[2]) >= FALLEN_HEIGHT:
-            self.fallen_since.pop(player.index, None)
-            return False
-        since = self.fallen_since.setdefault(player.index, now)
-        return now - since >= INACTIVE_S
+    def judge_activity(self, now: float, spared: Player | None = None) -> None:
+        """The rules' fallen or inactive robot, for every robot on the field but ``spared``: GameController3's
+        fallenInactive (45 s, not incremental)."""
+        for player in self.on_field():
+            if player is not spared and player.penalized_until_s < 0:
+                why = self.fallen(player, now) or self.inactive(player, now)
+                if why:
+                    self.penalize(player, Penalty.inactive_player, now, why)
+
+    def fallen(self, player: Player, now: float) -> str:
+        """Why a fallen robot is called (else ""): it did not begin to get up within ``GET_UP_S`` (its body's
+        joints still that long while it is down), or it is not up after ``GET_UP_ATTEMPTS`` attempts
+        (``GET_UP_ATTEMPTS_DISTURBED`` when another robot came near). An attempt failed when the robot, having
+        risen (sat up, or its torso ``RISEN`` above its lowest), lies still again."""
+        robot, index = self.world.robots[player.index], player.index
+        position, rotation = robot.torso_pose(self.world.data)
+        height, up = float(position[2]), float(rotation[2, 2])
+        joints = robot.joint_angles(self.world.data)[BODY_JOINTS]
+        watch = self.fall_watches.get(index)
+        lying = height < FALLEN_HEIGHT or up < LYING_UP
+        if watch is None:
+            if not lying:
+                return ""
+            watch = self.fall_watches[index] = FallWatch(now, joints, now)
+        if height >= STOOD_HEIGHT and up >= SITTING_UP:
+            watch.stood_s = now if watch.stood_s is None else watch.stood_s
+            if now - watch.stood_s >= STOOD_S:
+                del self.fall_watches[index]
+                return ""
+        else:
+            watch.stood_s = None
+        if float(np.max(np.abs(joints - watch.joints))) > JOINT_MOVED:
+            watch.joints, watch.moved_s = joints, now
+        if up < LYING_UP and not watch.risen:
+            watch.lain, watch.lowest = True, min(watch.lowest, height)
+        if watch.lain and not watch.risen:
+            watch.risen = up >= SITTING_UP or height > watch.lowest + RISEN
+        elif watch.risen and up < LYING_UP and now - watch.moved_s >= ATTEMPT_FAILED_S:  # lies still again
+            watch.failed, watch.risen, watch.lowest = watch.failed + 1, False, height
+        x, y, _ = self.world.robot_pose(index)
+        watch.disturbed = watch.disturbed or any(
+            math.hypot(ox - x, oy - y) < DISTURBED for other in self.on_field() if other is not player
+            for ox, oy, _ in [self.world.robot_pose(other.index)])
+        attempts = GET_UP_ATTEMPTS_DISTURBED if watch.disturbed else GET_UP_ATTEMPTS
+        if watch.failed >= attempts:
+            return f"fallen robot: not up after {watch.failed} attempts"
+        if now - watch.moved_s >= GET_UP_S:
+            return f"fallen robot: no get-up within {GET_UP_S:g} s"
+        return ""
+
+    def inactive(self, player: Player, now: float) -> str:
+        """Why an inactive robot is called (else ""): it ceased activity for ``INACTIVE_S``. Active is (the
+        rules) walking or turning (``ACTIVE_WALK``, ``ACTIVE_TURN`` from where it last was active), searching
+        for the ball (the head moved ``ACTIVE_HEAD``) or looking at it (the ball in a camera's view)."""
+        x, y, heading = self.world.robot_pose(player.index)
+        head = self.world.robots[player.index].joint_angles(self.world.data)[HEAD_JOINTS]
+        watch = self.activity.get(player.index)
+        if (watch is None or math.hypot(x - watch.x, y - watch.y) > ACTIVE_WALK
+                or abs(math.remainder(heading - watch.heading, math.tau)) > ACTIVE_TURN
+                or float(np.max(np.abs(head - watch.head))) > ACTIVE_HEAD or self.sees_ball(player)):
+            self.activity[player.index] = ActivityWatch(now, x, y, heading, head)
+            return ""
+        if now - watch.active_s >= INACTIVE_S:
+            return f"inactive robot: no activity for {INACTIVE_S:g} s"
+        return ""
+
+    def sees_ball(self, player: Player) -> bool:
+        """The ball's centre in the top or bottom camera's field of view (ground truth)."""
+        robot, data = self.world.robots[player.index], self.world.data
+        ball = data.xpos[self.world.ball.body]
+        for camera in CAMERAS:
+            forward, left, up = robot.camera_rotation(data, camera.name).T
+            direction = ball - data.cam_xpos[robot.model.camera(robot.camera(camera.name)).id]
+            ahead = float(direction @ forward)
+            if (ahead > 0.0 and abs(math.atan2(float(direction @ left), ahead)) <= HORIZONTAL_FOV / 2
+                    and abs(math.atan2(float(direction @ up), ahead)) <= VERTICAL_FOV / 2):
+                return True
+        return False
 
     def penalize(self, player: Player, penalty: Penalty, now: float, reason: str = "") -> None:
         robot = self.game.teams[player.team].players[player.number - 1]
@@ -132,8 +286,13 @@ class Fouls(Officiating):
             seconds += PENALTY_INCREMENT_S * self.incremental[player.team]
             self.incremental[player.team] += 1
         robot.penalty, player.penalized_until_s, player.penalty_left_s = penalty, now + seconds, seconds
-        self.fallen_since.pop(player.index, None)
-        self.off_the_carpet(player)  # while it waits
+        self.fall_watches.pop(player.index, None)
+        self.activity.pop(player.index, None)
+        if penalty is Penalty.illegal_motion_in_set:  # the rules: penalized in place, put back where it stood
+            x, y, heading = self.placed.pop(player.index, self.world.robot_pose(player.index))
+            self.world.move_robot(player.index, x, y, heading)
+        else:
+            self.off_the_carpet(player)  # while it waits
         team = self.team_numbers[player.team]
         self.events.append(Event(now, f"PENALTY {penalty.name} team {team} player {player.number}"))
         self.fouls.append(Foul(now, team, player.number, penalty, reason))
@@ -150,8 +309,9 @@ class Fouls(Officiating):
                 player.penalty_left_s -= dt
             robot.secs_till_unpenalised = max(0, int(math.ceil(player.penalty_left_s - 1e-6)))
             if player.penalty_left_s <= 1e-9 and counting:
-                bx, by, _ = player.side.to_team(*self.world.ball_position())
-                side = -1.0 if by > 0 else 1.0  # the touchline farther from the ball
-                x, y, heading = player.side.to_world(-1500.0, side * HALF_LINE_Y, -side * math.pi / 2)
-                self.world.move_robot(player.index, x, y, heading)
+                if robot.penalty is not Penalty.illegal_motion_in_set:  # that one ends where the robot stands
+                    bx, by, _ = player.side.to_team(*self.world.ball_position())
+                    side = -1.0 if by > 0 else 1.0  # the touchline farther from the ball
+                    x, y, heading = player.side.to_world(-1500.0, side * HALF_LINE_Y, -side * math.pi / 2)
+                    self.world.move_robot(player.index, x, y, heading)
                 robot.penalty, robot.secs_till_unpenalised, player.penalized_until_s = Penalty.none, 0, -1.0

@@ -109,7 +109,8 @@ class Referee(ShootOut, SetPlays):
         self.over = False
         self.ending = False  # the game ends at the next FINISHED, whichever half it is
         # the fouls' state (fouls.py)
-        self.incremental, self.fallen_since, self.set_judged, self.last_touch_s = [0, 0], {}, False, 0.0
+        self.incremental, self.set_judged, self.last_touch_s = [0, 0], False, 0.0
+        self.fall_watches, self.activity, self.placed = {}, {}, {}
         # the set plays' state (set_plays.py)
         self.calls = sorted(self.calls, key=lambda call: call.time_s)
         self.restriction = None
@@ -119,7 +120,7 @@ class Referee(ShootOut, SetPlays):
         # the shoot-out's state (shoot_out.py)
         self.shoot_out_goals, self.winner, self.shot = [0, 0], None, None
         self.mark, self.kicked, self.keeper_touched, self.ball_track = (0.0, 0.0), False, False, []
-        self.post_hit, self.striker_released, self.placed = False, False, {}
+        self.post_hit, self.striker_released = False, False
         self.shoot_out_initial_s = self.initial_s
         if self.shoot_out == "only":
             self.start_shoot_out(0.0)
@@ -137,6 +138,7 @@ class Referee(ShootOut, SetPlays):
         elif state is State.standby and now - self.phase_since >= self.standby_s:
             self.enter(State.ready, now)
         elif state is State.ready:
+            self.judge_activity(now)
             self.game.secondary_time = max(0, int(math.ceil(self.ready_s - (now - self.phase_since) - 1e-6)))
             if now - self.phase_since >= self.ready_s or self.all_still(now):
                 self.enter(State.set, now)
@@ -145,6 +147,9 @@ class Referee(ShootOut, SetPlays):
         elif state is State.set:
             if not self.set_judged and now - self.phase_since >= self.set_grace_s:
                 self.judge_set(now)
+            self.judge_activity(now)
+            if self.set_judged:
+                self.judge_motion_in_set(self.players, now)
             if now - self.phase_since >= self.set_s:
                 self.enter(State.playing, now)
                 self.start_kick_off(now)
@@ -201,6 +206,7 @@ class Referee(ShootOut, SetPlays):
             self.take_call(bx, by, now)
         self.watch_restriction(now)
         self.judge_play(now, self.kick_off_defender, self.free_kick_kept(now))
+        self.judge_activity(now)
 
     def all_still(self, now: float) -> bool:
         """Every robot has stood still for 2 s (after at least 5 s of READY): all are in position."""

@@ -17,9 +17,9 @@ GameController3's StartPenaltyShootout). A shot ends (the rules' penalty kick):
   penalized before its kick (``foul``).
 
 Then FINISHED, and the other team kicks. Fouls called in the shoot-out (GameController3 allows these
-there): motion in SET (a robot walked from where it was placed; 15 s), and in PLAYING pushing, leaving
-the field and the striker's inactivity (the rules spare the keeper); a robot penalized in the shoot-out
-stays off until the shot ends. ``penalty_shots`` each (the rules: three), then sudden death, at most
+there): motion in SET (a robot walked from where it was placed; 15 s, in place), and in PLAYING pushing,
+leaving the field and a fallen or inactive striker (the rules spare the keeper: it may dive and lie); a
+robot penalized in the shoot-out stays penalized until the shot ends. ``penalty_shots`` each (the rules: three), then sudden death, at most
 ``sudden_death_shots`` each: GameController3 stops the regular shots once a team can no longer draw
 level, and in sudden death the rules rank each pair of shots (goal, saved, post, wide, any other kick, no
 kick) and the better one wins; still level after all of them, a coin toss (seeded, ``seed``) decides.
@@ -58,7 +58,6 @@ STRIKER_TOUCH, STRIKER_RELEASE = 220.0, 400.0
 KEEPER_LINE_FRONT, KEEPER_LINE_BEHIND = 250.0, 100.0
 SHOT_OVERTIME_S = 15.0  # s after the shot's time a ball kicked in time may still roll: then the shot ends whatever it does
 POST_HIT = pitch.BALL_RADIUS + pitch.GOAL_POST_DIAMETER / 2 + 10.0  # mm from a post's centre to the ball's: it hit the post
-MOTION_IN_SET = 150.0  # mm a robot's torso moved from where it was placed in SET: it walked (GameController3's motion in Set)
 #: the rules' ranking of a sudden-death shot (0 best: goal, saved, post, wide, any other kick, no kick); the better of a pair wins
 RANK = {"goal": 0, "saved": 1, "post": 2, "wide": 3, "missed": 4, "second touch": 4, "time": 5, "foul": 5}
 
@@ -110,8 +109,6 @@ class ShootOut(Fouls):
     post_hit: bool
     striker_released: bool
     """the striker's torso got ``STRIKER_RELEASE`` from the ball after the kick"""
-    placed: dict[int, tuple[float, float]]
-    """world mm: where each robot of the shot stood when SET was judged (by index)"""
 
     def shoot_out_follows(self) -> bool:
         """Whether a shoot-out follows the game that just ended (``shoot_out`` always, or tie and a tie)."""
@@ -199,8 +196,7 @@ class ShootOut(Fouls):
         self.shot = Shot(now, game.kicking_team, striker.number if striker else 0, keeper.number if keeper else 0,
                          sudden_death=team.penalty_shot > self.penalty_shots)
         self.clock = PENALTY_SHOT_S
-        self.placed = {}
-        self.enter(State.set, now)
+        self.enter(State.set, now)  # where the robots stand once SET settled is their place (``placed``)
 
     def shot_player(self, striker: bool) -> Player | None:
         """The shot's striker (or keeper) while it is on the field."""
@@ -213,16 +209,9 @@ class ShootOut(Fouls):
     def judge_shot_set(self, now: float, since: float) -> None:
         """SET of a penalty shot: neither robot may walk (the rules; GameController3's motion in Set, 15 s).
         Where each stands once it settled (``set_grace_s``) is its place; walking from it is the foul."""
-        if since < self.set_grace_s:
-            return
-        for player in (self.shot_player(True), self.shot_player(False)):
-            if player is None:
-                continue
-            x, y, _ = self.world.robot_pose(player.index)
-            px, py = self.placed.setdefault(player.index, (x, y))
-            upright = float(self.world.robots[player.index].torso_pose(self.world.data)[0][2]) >= FALLEN_HEIGHT
-            if upright and math.hypot(x - px, y - py) > MOTION_IN_SET:
-                self.penalize(player, Penalty.illegal_motion_in_set, now, "walked in SET of a penalty shot")
+        if since >= self.set_grace_s:
+            players = [p for p in (self.shot_player(True), self.shot_player(False)) if p is not None]
+            self.judge_motion_in_set(players, now, "walked in SET of a penalty shot")
 
     def judge_shot(self, now: float, dt: float) -> None:
         """A penalty shot in PLAYING, from the ground truth: the keeper's line before the kick, the fouls, the
@@ -281,16 +270,15 @@ class ShootOut(Fouls):
         return True
 
     def judge_shot_fouls(self, now: float, bx: float, by: float) -> None:
-        """The fouls GameController3 allows in a penalty shot's PLAYING: leaving the field, pushing, and an
-        inactive striker (the rules spare the keeper)."""
+        """The fouls GameController3 allows in a penalty shot's PLAYING: leaving the field, pushing, and a
+        fallen or inactive striker (the rules spare the keeper)."""
         keeper = self.shot_player(False)
         for player in self.on_field():
             x, y, _ = self.world.robot_pose(player.index)
             if abs(x) > HALF_LINE_X + 300.0 or abs(y) > HALF_LINE_Y + 300.0:
                 self.penalize(player, Penalty.leaving_the_field, now, "left the field in a penalty shot")
-            elif player is not keeper and self.inactive(player, now):
-                self.penalize(player, Penalty.inactive_player, now, "fallen for 10 s in a penalty shot")
         self.judge_pushing(now, bx, by)
+        self.judge_activity(now, spared=keeper)
 
     def second_touch(self, striker: Player | None, bx: float, by: float) -> bool:
         """The rules: the striker may not play the ball again once it clearly moved. After the kick, its torso
