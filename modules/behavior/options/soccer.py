@@ -38,6 +38,8 @@ LOST_TURN = 0.3  # rad/s: turning (the head looks around) while the robot does n
 #: least CROSS_BESIDE mm beside the centre, where the other team's kick-off places stand: in SET a robot in the
 #: other half is penalized
 CROSSED, CROSS_BESIDE = 250.0, pitch.CENTER_CIRCLE_DIAMETER / 2 + 500.0
+#: s the shoot-out striker stands after its kick before it judges it; mm from its feet a ball that did not go lies
+SHOT_SETTLE_S, SHOT_MISSED = 1.0, 300.0
 #: mm the supporter waits at least in front of the opponent goal line (out of the keeper's way) and inside the touchlines
 SUPPORT_GOAL_GAP, SUPPORT_TOUCHLINE_GAP = 1200.0, 400.0
 
@@ -342,8 +344,9 @@ class ReadyPosition(Option["SoccerBehavior"]):
 
 
 class ShootOut(Option["SoccerBehavior"]):
-    """A penalty shoot-out in PLAYING: the kicking team's robot kicks at a goal corner, the other keeps
-    its goal line."""
+    """A penalty shoot-out in PLAYING: the kicking team's robot kicks at a goal corner once and then stands
+    (the rules: the striker may not play the ball again once it clearly moved), the other keeps its goal
+    line."""
 
     calls = (GoTo,)
 
@@ -352,6 +355,8 @@ class ShootOut(Option["SoccerBehavior"]):
         game = b.game_state
         if game.kicking_team != game.team_number:
             return "keep_line"
+        if self.state in ("kicking", "settle", "kicked"):
+            return None  # the shot is one touch
         return "shoot" if b.ball_model.valid else "search"
 
     @state(initial=True)
@@ -359,9 +364,11 @@ class ShootOut(Option["SoccerBehavior"]):
         """The kicker without a ball: turn on the spot."""
         b.turn(b.parameters.search_turn)
 
-    @state
-    def shoot(self, b: SoccerBehavior) -> None:
+    @state(to=("kicking",))
+    def shoot(self, b: SoccerBehavior) -> Next:
         """Kick at the goal's corner on the side away from the keeper's (``shootout_aim`` mm beside the centre)."""
+        if b.motion_info.motion is MotionType.kick:
+            return "kicking"
         ball, pose, p = b.ball_model, b.robot_pose, b.parameters
         if pose.valid:
             gx, gy = pose.to_robot(pitch.LENGTH / 2, p.shootout_aim if pose.y <= 0 else -p.shootout_aim)
@@ -369,6 +376,30 @@ class ShootOut(Option["SoccerBehavior"]):
         else:
             direction = goal_direction(ball, pose, b.odometry)
         approach_and_kick(ball, direction, b.kick_tuning.apply(p), b.motion_request)
+        return None
+
+    @state(to=("settle",))
+    def kicking(self, b: SoccerBehavior) -> Next:
+        """The kick plays to its end (motion holds its request while busy)."""
+        if not b.motion_info.busy and b.motion_info.motion is not MotionType.kick:
+            return "settle"
+        b.stand()
+        return None
+
+    @state(to=("shoot", "kicked"))
+    def settle(self, b: SoccerBehavior) -> Next:
+        """Stand ``SHOT_SETTLE_S`` after the kick; a ball then still at the feet (``SHOT_MISSED`` mm) did not go:
+        the kick missed it, kick again. Else the shot is taken."""
+        if self.time_in_state >= SHOT_SETTLE_S:
+            ball = b.ball_model
+            return "shoot" if ball.valid and math.hypot(ball.x, ball.y) < SHOT_MISSED else "kicked"
+        b.stand()
+        return None
+
+    @state
+    def kicked(self, b: SoccerBehavior) -> None:
+        """The shot is taken: stand (the head follows the ball) until the referee ends it."""
+        b.stand()
 
     @state
     def keep_line(self, b: SoccerBehavior) -> None:
