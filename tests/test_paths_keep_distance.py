@@ -11,10 +11,11 @@ from hypothesis import strategies as st
 from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.paths import detour, outside
 from tafel.modules.behavior.soccer_behavior import SoccerBehavior
+from tafel.modules.modeling.obstacle_modeler import ObstacleModeler
 from tafel.representations.game import GameState, RobotInfo, State, TeamInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType
-from tafel.representations.obstacles import Obstacle, ObstacleKind, Obstacles
+from tafel.representations.obstacles import Obstacle, ObstacleKind, Obstacles, RobotsPercept, SeenRobot
 from tafel.representations.team import PlayerRole, Role, TeamMates
 
 GROWN = 550.0  # mm: a robot's disc as SoccerBehavior grows it (150 + 150 + obstacle_margin 250)
@@ -67,3 +68,19 @@ def test_the_striker_holding_back_beside_an_opponent_steps_away_from_it() -> Non
     assert out.motion in (MotionType.walk_to, MotionType.stand)
     if out.motion is MotionType.walk_to:
         assert not further_in((out.target_x, out.target_y), (opponent.x, opponent.y))
+
+
+def test_a_robot_left_behind_is_remembered_longer_than_one_in_view_that_is_no_longer_seen() -> None:
+    """A robot that turned away from another (now behind it, where nothing is seen) keeps it for
+    ``unseen_memory_s``: walking backwards it would walk into it. One still in view but no longer seen
+    there has gone, and is forgotten after ``memory_s`` (before: both after 2 s)."""
+    p = ObstacleModeler.Parameters()
+    harnesses = {}
+    for turned, kept in ((math.pi, True), (math.pi / 2, False)):  # behind it, or beside it within the view (100 degrees)
+        harness = harnesses[turned] = ModuleHarness(ObstacleModeler, RobotPose(valid=True), RobotsPercept(robots=[SeenRobot(600.0, 0.0)]))
+        harness.execute()
+        harness.set(RobotsPercept(robots=[]), RobotPose(valid=True, rotation=turned))
+        harness.advance(p.memory_s + 1.0)
+        assert (len(harness[Obstacles].obstacles) == 1) is kept, turned
+    harnesses[math.pi].advance(p.unseen_memory_s)  # and then forgotten too
+    assert harnesses[math.pi][Obstacles].obstacles == []

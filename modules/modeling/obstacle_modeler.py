@@ -24,7 +24,9 @@ GOAL_POSTS = [(sx * LENGTH / 2, sy * (GOAL_INNER_WIDTH + GOAL_POST_DIAMETER) / 2
 class ObstacleModeler(Module):
     """Keeps the robots seen (``RobotsPercept``: in the images or, in ``--cameras off`` matches, from
     ground truth) and heard (``SonarPercept``'s echoes) for ``memory_s`` s, on the field while the pose is
-    valid (so that they stay put while this robot turns and walks), and adds every teammate that said
+    valid (so that they stay put while this robot turns and walks); one remembered beyond ``view_angle`` of
+    the heading (beside or behind, where it cannot be seen again) for ``unseen_memory_s`` s, so that a robot
+    walking backwards or sideways still keeps clear of it. It adds every teammate that said
     where it is within ``mate_timeout`` s and is not penalized (a penalized robot is off the field).
     A teammate's radius grows with the age of its message (``mate_spread`` mm/s: it may have walked
     meanwhile); a seen robot within ``same_robot`` mm of a teammate is that teammate, and one seen
@@ -45,6 +47,11 @@ class ObstacleModeler(Module):
         memory_s: float = bounded(0.0, 10.0, 2.0)
         """s a seen robot is remembered after it was last seen (robots out of view while this one walks
         sideways or backwards are still walked round)"""
+        view_angle: float = bounded(0.0, math.pi, 1.75)
+        """rad either side of the heading within which robots are seen (``tafel match --cameras off``: 100
+        degrees); one remembered beyond it is not looked for"""
+        unseen_memory_s: float = bounded(0.0, 30.0, 5.0)
+        """s a robot remembered beyond ``view_angle`` is kept after it was last seen"""
         mate_timeout: float = bounded(0.0, 30.0, 6.0)
         """s after a teammate's message that its position is still used"""
         mate_spread: float = bounded(0.0, 500.0, 60.0)
@@ -70,7 +77,7 @@ class ObstacleModeler(Module):
             fresh = [(*pose.to_field(x, y), now) for x, y in seen]
             fresh = [(x, y, t) for x, y, t in fresh if all(math.hypot(x - px, y - py) > p.post_radius for px, py in GOAL_POSTS)]
             kept = [(x, y, t) for x, y, t in self.seen
-                    if now - t <= p.memory_s and all(math.hypot(x - fx, y - fy) > 2 * ROBOT_RADIUS for fx, fy, _ in fresh)]
+                    if now - t <= self.memory(*pose.to_robot(x, y)) and all(math.hypot(x - fx, y - fy) > 2 * ROBOT_RADIUS for fx, fy, _ in fresh)]
             self.seen = fresh + kept  # a robot seen again replaces its memory
             mates = [m for m in self.team_mates.fresh(p.mate_timeout) if m.message.pose_valid and not m.message.penalized]
             for mate in mates:
@@ -86,7 +93,7 @@ class ObstacleModeler(Module):
             odometry = self.odometry.as_pose2d()
             fresh = [(*odometry.to_global(x, y), now) for x, y in seen]
             kept = [(x, y, t) for x, y, t in self.unplaced
-                    if now - t <= p.memory_s and all(math.hypot(x - fx, y - fy) > 2 * ROBOT_RADIUS for fx, fy, _ in fresh)]
+                    if now - t <= self.memory(*odometry.to_local(x, y)) and all(math.hypot(x - fx, y - fy) > 2 * ROBOT_RADIUS for fx, fy, _ in fresh)]
             self.unplaced = fresh + kept
             for ox, oy, when in self.unplaced:
                 x, y = odometry.to_local(ox, oy)
@@ -96,3 +103,8 @@ class ObstacleModeler(Module):
         obstacles = sorted((o for o in obstacles if math.hypot(o.x, o.y) <= p.max_distance), key=lambda o: math.hypot(o.x, o.y))
         out.obstacles = obstacles
         out.clearance = max(0.0, min((math.hypot(o.x, o.y) - o.radius for o in obstacles), default=0.0))
+
+    def memory(self, x: float, y: float) -> float:
+        """s a robot remembered at (x, y) (robot frame mm) is kept: longer beyond ``view_angle``, where it is not looked for."""
+        p = self.parameters
+        return p.memory_s if abs(math.atan2(y, x)) <= p.view_angle else max(p.memory_s, p.unseen_memory_s)
