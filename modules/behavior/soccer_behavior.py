@@ -154,6 +154,8 @@ class SoccerBehavior(Module):
         self.aim: tuple[float, float] | None = None
         self.aim_is_pass, self.aim_s = False, -math.inf
         """where the ball is played (field mm: a pass's target or the shot's point), whether it is a pass, and when chosen (s)"""
+        self.last_ball: tuple[float, float] | None = None
+        """field mm: where the ball was last known (own sighting or a teammate's)"""
 
     def execute(self) -> None:
         out = self.motion_request
@@ -162,6 +164,7 @@ class SoccerBehavior(Module):
             self.option_graph.root, self.option_graph.options = graph.root, graph.options
         busy = {info.name: getattr(out, info.name) for info in fields_of(MotionRequest)} if self.motion_info.busy else None
         self.keep_out, self.indirect = [], False
+        self.last_ball = self.ball_on_field() or self.last_ball
         out.motion, out.walk_kick = MotionType.stand, WalkKick.none  # each frame's request starts afresh
         self.options.run(self, self.frame_info.time_s, self.activation_graph)
         self.stay_on_field()
@@ -216,6 +219,13 @@ class SoccerBehavior(Module):
         """The ball in field mm: the own sighting, else a teammate's; None when nobody knows."""
         ball, pose = self.ball_model, self.robot_pose
         return ball.field_position(pose) if ball.valid and pose.valid else self.team_ball()
+
+    def set_play_ball(self) -> tuple[float, float] | None:
+        """The ball to keep away from (field mm): where it is known; at the opponents' set play, else where it
+        was last known (a ball that went out is put back about where it left the field, beside the robot
+        that chased it there, which may not see it then)."""
+        known = self.ball_on_field()
+        return known if known is not None or not self.opponents_set_play() else self.last_ball
 
     def facing_ball(self, x: float, y: float) -> float:
         """rad (field) from (x, y) towards the ball (the centre spot when nobody knows where it is)."""

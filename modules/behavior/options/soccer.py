@@ -108,7 +108,7 @@ class Striker(Option["SoccerBehavior"]):
     @common(to=("wait_outside", "kick", "hold_back", "challenge", "to_teammates_ball", "search"))
     def what_is_known(self, b: SoccerBehavior) -> Next:
         ball, p = b.ball_on_field(), b.parameters
-        if b.keep_out and ball is not None:
+        if b.keep_out and b.set_play_ball() is not None:
             return "wait_outside"
         if b.ball_model.valid:
             if self.state == "challenge" and self.time_in_state < p.challenge_s:
@@ -165,8 +165,9 @@ class Striker(Option["SoccerBehavior"]):
 
     @state
     def wait_outside(self, b: SoccerBehavior) -> None:
-        """The rules keep the team away from the ball: stand between it and the own goal, just outside."""
-        bx, by = b.ball_on_field() or (0.0, 0.0)
+        """The rules keep the team away from the ball (where it was last known, if nobody knows where it is
+        now): stand between it and the own goal, just outside."""
+        bx, by = b.set_play_ball() or (0.0, 0.0)
         dx, dy = OWN_GOAL_X - bx, -by
         distance = max(math.hypot(dx, dy), 1.0)
         reach = max((radius for cx, cy, radius in b.keep_out if math.hypot(bx - cx, by - cy) < radius), default=0.0)
@@ -269,12 +270,13 @@ class Play(Option["SoccerBehavior"]):
 
     @state(to=("play", "set_play_over"))
     def opponents_set_play(self, b: SoccerBehavior) -> Next:
-        """The opponents' free kick or penalty kick: keep 0.75 m (and ``keep_out_margin``) from the ball."""
+        """The opponents' free kick or penalty kick: keep 0.75 m (and ``keep_out_margin``) from the ball, or
+        from where it was last known while nobody knows where it is."""
         if not b.opponents_set_play():
             return "play"
         if self.time_in_state >= FREE_KICK_S:
             return "set_play_over"
-        ball = b.ball_on_field()
+        ball = b.set_play_ball()
         if ball is not None:
             b.keep_out.append((*ball, FREE_KICK_DISTANCE + b.parameters.keep_out_margin))
         self.call(ROLES[self.args.role])
