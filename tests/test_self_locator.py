@@ -18,8 +18,9 @@ from tafel.representations.game import GameState, Penalty, RobotInfo, TeamInfo
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import KnownPose, RobotPose
 from tafel.representations.motion_control import FallDirection, FallPhase, FallState, Odometry
-from tafel.representations.perception import BallPercept, GoalPostPercept, LinePercept
+from tafel.representations.perception import BallPercept, GoalPost, GoalPostPercept, LinePercept
 from tafel.representations.team import TeamMate, TeamMates, TeamMessage
+from tests.support import field_views
 from tests.support.field_views import line_percept, post_percept
 
 FRAME_NS = 33_333_333
@@ -156,16 +157,41 @@ def test_a_robot_carried_a_little_way_is_unsure_at_once(start: tuple, carried: t
     """Carried about a metre and turned, where what it sees still half fits the old pose (so the measurements'
     fit hardly drops): poses made from the percepts that fit better win, and the pose is not valid within
     a third of a second (it was for one to two seconds, valid and wrong, before they competed while valid);
-    never the mirror, and found again by the team's ball. The watch is off by default (``watch_share`` 0:
-    at 0.02 it took the validity of accurate poses in a default run), so it is switched on here."""
+    never the mirror, and found again by the team's ball. The watch (``watch_share``) is on by default: it
+    starts only once the percepts have contradicted the estimate for ``watch_after`` frames."""
     run = Run()
-    run.harness.module.parameters.watch_share = 0.02
     for _ in range(120):
         assert not mirrored(run.step(start), start)
     states = [run.step(carried, ball=ball, team_ball=ball) for _ in range(180)]
     assert next(i for i, p in enumerate(states) if not p.valid) <= 10
     assert not [p for p in states if mirrored(p, carried)]
     assert states[-1].valid and error(states[-1], carried)[0] < 150.0 and error(states[-1], carried)[1] < 10.0
+
+
+def test_the_watch_for_a_carry_starts_only_on_contradictions_in_frames_in_a_row(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A post seen where none stands (a robot's leg taken for one) in fewer than ``watch_after`` frames in a row
+    does not start the watch: an accurate pose stays valid, and no fresh particles compete with it. The same
+    post in ``watch_after`` frames in a row does start it."""
+    run = Run()
+    truth = (-1500.0, 500.0, 0.2)
+    for _ in range(120):
+        assert run.step(truth).valid or run.frame < 60
+    after = run.harness.module.parameters.watch_after
+    false_post = GoalPostPercept(posts=[GoalPost(1500.0, -300.0, "top")])  # 1.5 m ahead: no post stands there
+    for _ in range(10):
+        monkeypatch.setitem(globals(), "post_percept", lambda pose, head=0.0: false_post)
+        for _ in range(after - 1):
+            pose = run.step(truth)
+            assert pose.valid and 0 < run.harness.module.contradicted < after
+        monkeypatch.setitem(globals(), "post_percept", field_views.post_percept)
+        for _ in range(3):  # the lines agree: the count starts anew
+            pose = run.step(truth)
+        assert run.harness.module.contradicted == 0
+    assert pose.valid and error(pose, truth)[0] < 150.0
+    monkeypatch.setitem(globals(), "post_percept", lambda pose, head=0.0: false_post)
+    for _ in range(after):
+        run.step(truth)
+    assert run.harness.module.contradicted >= after
 
 
 def test_found_again_as_the_twin_of_where_it_was_decided_it_takes_the_decided_side() -> None:

@@ -21,6 +21,9 @@ from tafel.representations.perception import BallPercept, GoalPostPercept, LineP
 from tafel.representations.team import TeamMates
 
 KNOWN_POSE_STD, KNOWN_ROTATION_STD = 30.0, 0.03  # mm and rad: the particles' spread round a pose told (KnownPose)
+WATCH_MIN_POINTS = 10  # line points a frame needs to say whether the lines fit the estimate ...
+WATCH_LINES_OFF = 0.2  # ... the share of them beyond 2.5 standard deviations that contradicts it (a robot carried where
+WATCH_LINES_ON = 0.1  # the old pose half fits: about a quarter), and the share at most that agrees (an accurate pose: 0)
 
 
 @requires(Odometry, LinePercept, GoalPostPercept, FrameInfo)
@@ -122,12 +125,16 @@ class SelfLocator(Module):
         """... rad"""
         search_share: float = bounded(0.0, 1.0, 0.05)
         """share made anew per frame while the pose is not valid ..."""
-        watch_share: float = bounded(0.0, 1.0, 0.0)
-        """... and while it is (mixture MCL): poses that explain this frame's percepts compete with the
-        estimate, so a robot carried elsewhere is noticed (its new place grows among them) even where
-        the percepts still half fit the old one. Only from a seen post, circle or line, never anywhere.
-        Off by default: at 0.02 an accurate pose (50 mm) lost its validity for 3 s in a default run
-        (seeds 0 and 1, at 6.7 s)"""
+        watch_share: float = bounded(0.0, 1.0, 0.1)
+        """... and while it is (mixture MCL), once the circle, a post or many line points have contradicted the
+        estimate (beyond 2.5 standard deviations) in ``watch_after`` frames in a row: poses that explain this frame's percepts
+        compete with the estimate, so a robot carried elsewhere is noticed (its new place grows among them)
+        even where the other percepts still half fit the old one. Only from a seen post, circle or line, never
+        anywhere. Not while nothing contradicts: at 0.02 in every frame an accurate pose (50 mm) lost its
+        validity for 3 s in a default run (seeds 0 and 1, at 6.7 s)"""
+        watch_after: int = bounded(1, 1000, 5)
+        """frames in a row whose circle, posts or lines contradict the estimate before the watch starts (frames
+        that see none of them count neither way, one that agrees starts the count anew)"""
         jump: float = bounded(0.0, 5000.0, 500.0)
         """mm (a radian counting 1000 mm): the estimate moved this far from the last one (moved by
         odometry) in a frame, the particles found another place: the pose is confirmed anew"""
@@ -167,6 +174,7 @@ class SelfLocator(Module):
         self.side = SideBelief()
         self.anchor: np.ndarray | None = None  # the estimate the side belief is about, moved by odometry: carried since?
         self.fell_at = -math.inf  # s of the last fall: after one the heading may be anything, the place not
+        self.contradicted = 0  # frames in a row whose circle or posts disagreed with the estimate
 
     def execute(self) -> None:
         odometry = (self.odometry.x, self.odometry.y, self.odometry.rotation)
@@ -185,6 +193,7 @@ class SelfLocator(Module):
             self.start_at(self.known_pose)
         upright = self.fall_state.upright
         if upright and self.was_upright:  # percepts of a lying robot come through a wrong camera matrix
+            self.count_contradictions()
             fits = self.weigh()
             if fits is not None:
                 self.reset_if_lost(fits)
@@ -301,11 +310,42 @@ class SelfLocator(Module):
             return  # guesses anywhere only while lost: elsewhere they spread a gathered cloud in frames that saw little
         # a few fresh particles a frame keep every pose that fits what is seen alive, and while the pose is
         # valid they watch for a carried robot: where they keep fitting better, they win the resampling
-        share = p.reset_share if lost else p.search_share if not self.robot_pose.valid else p.watch_share
+        watching = self.contradicted >= p.watch_after
+        share = p.reset_share if lost else p.search_share if not self.robot_pose.valid else p.watch_share if watching else 0.0
         count = int(share * len(self.particles))
         fresh = FIELD_MODEL.poses_from_percepts(self.rng, count, self.line_percept, self.goal_post_percept)
         fresh = fold(fresh, self.reference())
         self.particles[self.rng.choice(len(self.particles), len(fresh), replace=False)] = fresh
+
+    def count_contradictions(self) -> None:
+        """Count the frames in a row in which the centre circle or a goal post, seen from the estimate (moved by
+        odometry), lies beyond 2.5 standard deviations of the circle's or the nearest post's place, or many line
+        points (``WATCH_LINES_OFF``) lie that far off every line: the robot may have been carried where the
+        particles still half fit. A frame that sees none of them leaves the count; one in which all agree
+        starts it anew."""
+        p = self.parameters
+        if self.estimate is None:
+            return
+        pose, verdicts = Pose2D(*self.estimate), []
+        lines = self.line_percept
+        if lines.circle_seen and math.isfinite(lines.circle_x) and math.isfinite(lines.circle_y):
+            verdicts.append(math.hypot(*pose.to_global(lines.circle_x, lines.circle_y)) / p.circle_std >= 2.5)
+        for post in self.goal_post_percept.posts:
+            if math.isfinite(post.x) and math.isfinite(post.y):
+                std = p.post_std + p.post_std_per_m * math.hypot(post.x, post.y) / 1000.0
+                place = np.array([pose.to_global(post.x, post.y)])
+                verdicts.append(float(FIELD_MODEL.post_distance(place)[0]) / std >= 2.5)
+        points = np.asarray(lines.points, dtype=float).reshape(-1, 2)
+        points = points[np.isfinite(points).all(axis=1) & (np.abs(points) < 20000.0).all(axis=1)]
+        if len(points) >= WATCH_MIN_POINTS:
+            c, s = math.cos(pose.rotation), math.sin(pose.rotation)
+            seen = np.column_stack([pose.x + c * points[:, 0] - s * points[:, 1], pose.y + s * points[:, 0] + c * points[:, 1]])
+            std = p.point_std + p.point_std_per_m * np.linalg.norm(points, axis=1) / 1000.0
+            off = float(np.mean(FIELD_MODEL.line_distance(seen[None, :, :])[0] / std >= 2.5))
+            if off >= WATCH_LINES_OFF or off <= WATCH_LINES_ON:  # in between, lines say nothing either way
+                verdicts.append(off >= WATCH_LINES_OFF)
+        if verdicts:
+            self.contradicted = self.contradicted + 1 if any(verdicts) else 0
 
     def usable_percepts(self) -> bool:
         """Whether this frame saw something fresh poses can be made from: the circle, a post, a line segment."""
