@@ -12,7 +12,7 @@ from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.paths import detour, outside
 from tafel.modules.behavior.soccer_behavior import SoccerBehavior
 from tafel.modules.modeling.obstacle_modeler import ObstacleModeler
-from tafel.representations.game import GameState, RobotInfo, State, TeamInfo
+from tafel.representations.game import GameState, RobotInfo, SetPlay, State, TeamInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType
 from tafel.representations.obstacles import Obstacle, ObstacleKind, Obstacles, RobotsPercept, SeenRobot
@@ -84,3 +84,24 @@ def test_a_robot_left_behind_is_remembered_longer_than_one_in_view_that_is_no_lo
         assert (len(harness[Obstacles].obstacles) == 1) is kept, turned
     harnesses[math.pi].advance(p.unseen_memory_s)  # and then forgotten too
     assert harnesses[math.pi][Obstacles].obstacles == []
+
+
+def test_a_way_brought_back_onto_the_field_does_not_lead_into_the_opponent_beside_the_robot() -> None:
+    """Recorded in a 2v2 (seed 1, 541.8 s): at its own corner kick the striker stood just beyond the goal line,
+    an opponent 0.4 m to its left; the way round the opponent led further beyond the line, and bringing that
+    target back onto the field turned it into the opponent, which the referee called pushing."""
+    game = playing()
+    game.set_play = SetPlay.corner_kick
+    pose = RobotPose(valid=True, x=4661.0, y=1548.0, rotation=math.radians(23.0))
+    ball = BallModel(valid=True, seen=True, x=326.0, y=1353.0)
+    opponent = Obstacle(x=-121.0, y=397.0, kind=ObstacleKind.robot)
+    others = [Obstacle(x=-811.0, y=-725.0, kind=ObstacleKind.robot), Obstacle(x=-1516.0, y=689.0, radius=209.0, kind=ObstacleKind.teammate)]
+    harness = ModuleHarness(SoccerBehavior, game, PlayerRole(role=Role.striker), pose, ball, TeamMates(), MotionInfo(),
+                            Obstacles(obstacles=[opponent, *others]))
+    out = harness.execute()[MotionRequest]
+    if out.motion is MotionType.walk_to:
+        assert not further_in((out.target_x, out.target_y), (opponent.x, opponent.y))
+        x, y = pose.to_field(out.target_x, out.target_y)
+        assert x <= pose.x + 1e-6  # and no further beyond the goal line
+    else:
+        assert out.motion is MotionType.stand

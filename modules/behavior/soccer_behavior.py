@@ -14,7 +14,7 @@ from tafel.modules.behavior.kicking import KickParameters, goal_direction, kick_
 from tafel.modules.behavior.options import OptionRunner
 from tafel.modules.behavior.options.soccer import FREE_KICKS, OWN_GOAL_X, PlaySoccer
 from tafel.modules.behavior.passing import PassParameters, best_shot, choose_pass, pass_kick
-from tafel.modules.behavior.paths import Disc, detour, outside
+from tafel.modules.behavior.paths import Disc, clear, detour, free_direction, outside
 from tafel.representations import field as pitch
 from tafel.representations.behavior import ActivationGraph, OptionGraph
 from tafel.representations.game import GameState, SetPlay
@@ -174,15 +174,27 @@ class SoccerBehavior(Module):
 
     def stay_on_field(self) -> None:
         """A walk's target beyond the lines by more than ``field_margin`` comes back to it: leaving the field
-        is a foul (the referee calls it 0.3 m beyond a line)."""
+        is a foul (the referee calls it 0.3 m beyond a line). When the way back runs into a robot's disc
+        (the way round it led beyond the line), the free direction nearest it that leads no further beyond
+        the lines than the robot is; the robot stands if there is none: pushing is a foul too."""
         out, pose, margin = self.motion_request, self.robot_pose, self.parameters.field_margin
         if out.motion is not MotionType.walk_to or not pose.valid:
             return
         x, y = pose.to_field(out.target_x, out.target_y)
         limit_x, limit_y = pitch.LENGTH / 2 + margin, pitch.WIDTH / 2 + margin
         inside = max(-limit_x, min(limit_x, x)), max(-limit_y, min(limit_y, y))
-        if inside != (x, y):
-            out.target_x, out.target_y = pose.to_robot(*inside)
+        if inside == (x, y):
+            return
+        target = pose.to_robot(*inside)
+        robots = self.robot_discs(self.parameters.obstacle_margin)
+        if not clear(*target, robots, 0.0):
+            way_x, way_y, _ = free_direction(*target, robots, 0.0)
+            fx, fy = pose.to_field(way_x, way_y)
+            if (way_x, way_y) == (0.0, 0.0) or abs(fx) > max(limit_x, abs(pose.x)) or abs(fy) > max(limit_y, abs(pose.y)):
+                out.motion, out.walk_kick = MotionType.stand, WalkKick.none
+                return
+            target = way_x, way_y
+        out.target_x, out.target_y = target
 
     # ------------------------------------------------------------------------ what the options do
     def stand(self) -> None:
