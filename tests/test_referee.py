@@ -169,6 +169,17 @@ def test_a_fallen_robot_that_does_not_begin_to_get_up_within_5_s_is_penalized_45
     assert referee.world.robot_pose(0)[1] < -3000.0  # removed: off the carpet
 
 
+def test_a_fall_is_watched_across_ready_set_and_playing(referee: Referee) -> None:
+    until(referee, State.ready)
+    run(referee, 2.0)
+    lay(referee, 0, -2000.0, 0.0)
+    until(referee, State.set)
+    run(referee, 2.9)
+    assert referee.fouls == []
+    run(referee, 0.2)  # 5 s since it fell, READY's 2 s and SET's 3 s
+    assert (referee.fouls[-1].penalty, referee.fouls[-1].reason) == (Penalty.inactive_player, "fallen robot: no get-up within 5 s")
+
+
 @pytest.mark.parametrize("disturbed", [False, True])
 def test_a_fallen_robot_not_up_after_two_attempts_or_three_when_disturbed_is_penalized(referee: Referee, disturbed: bool) -> None:
     until(referee, State.playing)

@@ -59,6 +59,7 @@ BODY_JOINTS = np.array([k for k, name in enumerate(JOINT_NAMES) if not name.star
 HEAD_JOINTS = np.array([JOINT_NAMES.index("HeadYaw"), JOINT_NAMES.index("HeadPitch")])
 #: activity (the rules: it walks or turns, it searches for or looks at the ball): mm walked, rad turned, rad of head motion
 ACTIVE_WALK, ACTIVE_TURN, ACTIVE_HEAD = 50.0, 0.2, 0.1
+JUDGED_STATES = (State.ready, State.set, State.playing)  # where GameController3 allows fallenInactive
 INACTIVE_S, STUCK_S = 10.0, 30.0  # s without activity (the rules); s without a touch with robots beside the ball
 #: mm a robot's torso moved, and rad it turned, from where it stood in SET: it walked (motion in SET)
 MOTION_IN_SET, MOTION_IN_SET_TURN = 150.0, 0.35
@@ -123,11 +124,13 @@ class Fouls(Officiating):
     """s: the ball's last touch (or the last call of a local game stuck)"""
 
     def enter(self, state: State, now: float) -> None:
-        """A new state: activity and falls are watched afresh (they are judged in READY, SET and PLAYING only)."""
+        """A new state: a SET's places are taken afresh; activity and falls, judged in READY, SET and PLAYING
+        only, are watched afresh after any other state."""
         super().enter(state, now)
-        self.activity.clear()
-        self.fall_watches.clear()
         self.placed.clear()
+        if state not in JUDGED_STATES:
+            self.activity.clear()
+            self.fall_watches.clear()
 
     def judge_set(self, now: float) -> None:
         """In SET every robot stands in its own half, the defenders outside the centre circle."""
