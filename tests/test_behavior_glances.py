@@ -42,7 +42,14 @@ def test_it_glances_round_now_and_then_and_more_often_when_the_pose_is_not_valid
     assert sum(abs(v) < 1e-9 for v in sure) > 0.6 * len(sure)  # most of the time: on the ball
 
 
-def test_it_never_looks_away_from_a_near_ball() -> None:
+def test_it_never_looks_away_from_a_near_ball_while_its_pose_is_valid() -> None:
+    """A near ball stays in view while the pose is valid; an unsure robot (carried next to the ball) glances
+    anyway: it must see the field before it kicks."""
     ball = BallModel(valid=True, seen=True, x=400.0, y=300.0)
-    values = yaws(ball, RobotPose(valid=False), 20.0)
+    values = yaws(ball, RobotPose(valid=True), 20.0)
     assert all(v == values[0] for v in values) and values[0] == math.atan2(300.0, 400.0)
+    p = LookAtBallBehavior.Parameters()
+    unsure = yaws(ball, RobotPose(valid=False, lost=True), 20.0)
+    right = [v < -0.5 for v in unsure]  # the ball is on the left: count the glances' swings to the right
+    swings = sum(1 for a, b in zip(right, right[1:]) if b and not a)
+    assert abs(swings - 20.0 / (p.glance_interval_lost + p.glance_duration)) <= 1.5

@@ -34,8 +34,8 @@ class LookAtBallBehavior(Module):
     towards the other side, where the ball most likely went out of view.
 
     A ball alone shows little of the field, so every ``glance_interval`` s (more often while the pose is
-    not valid) the head glances left and right for lines and goals, unless the ball is close: then the
-    striker needs it in view, and the ball model follows the robot's steps meanwhile anyway.
+    not valid) the head glances left and right for lines and goals, unless the ball is close and the pose
+    valid: then the striker needs it in view, and the ball model follows the robot's steps meanwhile anyway.
 
     While the pose is not valid (a robot carried elsewhere: the field cannot tell it from its twin, only
     the team's ball can) and the particles have gathered, the search looks first where a teammate's ball
@@ -78,7 +78,8 @@ class LookAtBallBehavior(Module):
         glance_amplitude: float = 1.0
         """rad of head yaw a glance reaches to either side"""
         glance_min_ball_distance: float = 900.0
-        """mm: nearer balls are never looked away from"""
+        """mm: nearer balls are never looked away from while the pose is valid (an unsure robot glances anyway:
+        next to the ball it would kick it the wrong way)"""
 
         search_amplitude_lost: float = 2.0
         """rad, largest head yaw while searching with the pose not valid"""
@@ -169,7 +170,8 @@ class LookAtBallBehavior(Module):
         """Glance round if it is time (or go on with a glance begun); whether the head is glancing."""
         p, request = self.parameters, self.head_motion_request
         interval = p.glance_interval if self.robot_pose.valid else p.glance_interval_lost
-        if now - self.last_glance >= p.glance_duration + interval and ball_distance >= p.glance_min_ball_distance:
+        near = ball_distance < p.glance_min_ball_distance and self.robot_pose.valid  # unsure, it must see the field
+        if now - self.last_glance >= p.glance_duration + interval and not near:
             self.last_glance = now
         elapsed = now - self.last_glance
         if elapsed >= p.glance_duration or self.last_glance == 0.0:

@@ -17,11 +17,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tafel.modules.behavior.ball_search import SearchTurn
 from tafel.modules.communication.team_message_codec import pack_message
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionRequest, MotionType
 from tafel.representations.perception import BallPercept
-from tafel.representations.team import Role, TeamMessage
+from tafel.representations.team import Role, TeamMates, TeamMessage
 from tests.support.simulation import PERCEPTION, Simulation
 
 WINDOW_S = 12.0  # s judged after each kidnapping
@@ -77,14 +78,21 @@ class KidnapRun:
         motion = self.sim.blackboard("motion")
         self.sim.runtime.runners["motion"].manager.before_frame.append(lambda: motion.set(self.request))
         self.heard_at = -math.inf
+        self.search = SearchTurn()
         self.sim.run(5.0, self.tick)
 
     def tick(self, sim: Simulation) -> None:
         if sim.time >= self.heard_at + 1.0:  # the teammate's message, once a second
             self.heard_at = sim.time
             sim.platform.network.echo.append(teammate_message(sim.platform.ball_position(), sim.time, self.rng))
-        searching = not sim.blackboard("cognition")[BallModel].valid
-        self.request = MotionRequest(motion=MotionType.walk, walk_rotation=SEARCH_TURN) if searching else MotionRequest(motion=MotionType.stand)
+        cognition = sim.blackboard("cognition")
+        ball = cognition[BallModel]
+        if ball.valid:
+            self.search.found()
+            self.request = MotionRequest(motion=MotionType.stand)
+            return
+        side = self.search.direction(ball, cognition[RobotPose], cognition[TeamMates].freshest_ball(3.0))
+        self.request = MotionRequest(motion=MotionType.walk, walk_rotation=side * SEARCH_TURN)
 
     def kidnap(self, to: tuple[tuple[float, float, float], tuple[float, float]] | None = None) -> Kidnapping:
         """Carry the robot to a random pose (or ``to``: pose and ball), the ball near it, and judge the
