@@ -14,8 +14,8 @@ from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType
 from tafel.representations.team import PlayerRole, Role, TeamMates
 
-#: the striker on the edge of the penalty area, the ball on the penalty mark 1.3 m ahead of it
-POSE, MARK = RobotPose(valid=True, x=1950.0, y=0.0), BallModel(valid=True, seen=True, x=1300.0, y=0.0)
+#: the striker on the edge of the penalty area, the ball on the penalty mark 0.35 m ahead of it
+POSE, MARK = RobotPose(valid=True, x=2850.0, y=0.0), BallModel(valid=True, seen=True, x=350.0, y=0.0)
 
 
 def shoot_out_playing() -> GameState:
@@ -58,3 +58,15 @@ def test_a_kick_that_missed_the_ball_is_taken_again() -> None:
     assert harness[MotionRequest].motion is MotionType.stand
     harness.advance(0.2)
     assert shoot_out_state(harness) == "shoot" and harness[MotionRequest].motion is not MotionType.stand
+
+
+def test_a_mirrored_pose_does_not_turn_the_shot_round_the_striker_kicks_where_it_was_placed_facing() -> None:
+    """The localization took the mirror image after the referee placed the robot (seen in a cameras-on shoot-out):
+    the pose says the robot stands in its own half facing its own goal. The rules placed it facing the ball and
+    the goal, so it walks up behind the ball and kicks ahead, at a corner, not round the ball and through it."""
+    mirrored = RobotPose(valid=True, x=-POSE.x, y=0.0, rotation=3.13)
+    for pose in (POSE, mirrored, RobotPose()):
+        harness = ModuleHarness(SoccerBehavior, shoot_out_playing(), PlayerRole(role=Role.striker), pose, MARK, TeamMates(), MotionInfo())
+        out = harness.execute()[MotionRequest]
+        assert out.motion is MotionType.walk_to and out.target_x < MARK.x - 100.0, (pose, out)  # behind the ball
+        assert 0.1 < abs(out.target_rotation) < 0.5, (pose, out)  # at a corner of the goal ahead

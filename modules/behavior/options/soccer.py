@@ -13,12 +13,13 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from tafel.modules.behavior.kicking import approach_and_kick, goal_direction
+from tafel.modules.behavior.kicking import approach_and_kick
 from tafel.modules.behavior.options.framework import Next, Option, common, state
 from tafel.modules.behavior.passing import lane_clearance
 from tafel.modules.behavior.paths import outside
 from tafel.representations import field as pitch
 from tafel.representations.game import GamePhase, SetPlay, State
+from tafel.representations.geometry import Pose2D
 from tafel.representations.motion_control import MotionType, WalkKick
 from tafel.representations.obstacles import ObstacleKind
 from tafel.representations.team import Role
@@ -40,6 +41,8 @@ LOST_TURN = 0.3  # rad/s: turning (the head looks around) while the robot does n
 CROSSED, CROSS_BESIDE = 250.0, pitch.CENTER_CIRCLE_DIAMETER / 2 + 500.0
 #: s the shoot-out striker stands after its kick before it judges it; mm from its feet a ball that did not go lies
 SHOT_SETTLE_S, SHOT_MISSED = 1.0, 300.0
+#: rad the shoot-out kick's direction by the pose may differ from the one by where the referee placed the striker
+SHOT_POSE_TRUST = 0.6
 #: mm the supporter waits at least in front of the opponent goal line (out of the keeper's way) and inside the touchlines
 SUPPORT_GOAL_GAP, SUPPORT_TOUCHLINE_GAP = 1200.0, 400.0
 
@@ -351,9 +354,14 @@ class ShootOut(Option["SoccerBehavior"]):
     line."""
 
     calls = (GoTo,)
+    placed: Pose2D | None = None
+    """the robot's odometry pose as the shot's PLAYING began: where the referee placed it (the rules: the
+    striker on the edge of the penalty area, facing the ball and the goal)"""
 
     @common(to=("search", "shoot", "keep_line"))
     def whose_kick(self, b: SoccerBehavior) -> Next:
+        if self.time_in_option <= 0.0 or self.placed is None:
+            self.placed = b.odometry.as_pose2d()
         game = b.game_state
         if game.kicking_team != game.team_number:
             return "keep_line"
@@ -368,15 +376,21 @@ class ShootOut(Option["SoccerBehavior"]):
 
     @state(to=("kicking",))
     def shoot(self, b: SoccerBehavior) -> Next:
-        """Kick at the goal's corner on the side away from the keeper's (``shootout_aim`` mm beside the centre)."""
+        """Kick at the goal's corner on the side away from the keeper's (``shootout_aim`` mm beside the centre).
+        Where the goal is: by the pose, unless it is not valid or puts the goal over ``SHOT_POSE_TRUST`` away
+        from where the placing puts it (straight ahead of where the robot stood, ``PENALTY_AREA_LENGTH`` away,
+        followed by odometry): a mirrored pose would walk the robot round the ball and through it."""
         if b.motion_info.motion is MotionType.kick:
             return "kicking"
         ball, pose, p = b.ball_model, b.robot_pose, b.parameters
+        aim = p.shootout_aim if not pose.valid or pose.y <= 0 else -p.shootout_aim
+        now = b.odometry.as_pose2d()
+        gx, gy = now.to_local(*(self.placed or now).to_global(pitch.PENALTY_AREA_LENGTH, aim))
+        direction = math.atan2(gy - ball.y, gx - ball.x)
         if pose.valid:
-            gx, gy = pose.to_robot(pitch.LENGTH / 2, p.shootout_aim if pose.y <= 0 else -p.shootout_aim)
-            direction = math.atan2(gy - ball.y, gx - ball.x)
-        else:
-            direction = goal_direction(ball, pose, b.odometry)
+            fx, fy = pose.to_robot(pitch.LENGTH / 2, aim)
+            by_pose = math.atan2(fy - ball.y, fx - ball.x)
+            direction = by_pose if abs(math.remainder(by_pose - direction, math.tau)) <= SHOT_POSE_TRUST else direction
         approach_and_kick(ball, direction, b.kick_tuning.apply(p), b.motion_request)
         return None
 
