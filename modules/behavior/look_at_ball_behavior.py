@@ -84,15 +84,16 @@ class LookAtBallBehavior(Module):
         search_amplitude_lost: float = 2.0
         """rad, largest head yaw while searching with the pose not valid"""
         candidate_dwell: float = 0.8
-        """s the head looks where a teammate's ball would be from one twin while the pose is not valid ..."""
+        """s the head looks where a teammate's ball would be from one twin while the pose is not valid (the
+        candidate places: below)"""
         candidate_deviation: float = 400.0
-        """mm: ... once the particles have gathered this close (RobotPose.deviation) ..."""
+        """mm: candidate places are looked at once the particles have gathered this close (RobotPose.deviation)"""
         candidate_range: float = 5000.0
-        """mm: ... for a place this near ..."""
+        """mm: candidate places this near are looked at"""
         candidate_reach: float = 2.4
-        """rad: ... this far to either side (the head turns to 2.09, the top camera sees 0.5 beyond) ..."""
+        """rad: candidate places this far to either side are looked at (the head turns to 2.09, the top camera sees 0.5 beyond)"""
         team_ball_age: float = 3.0
-        """s: ... reported this recently"""
+        """s: a teammate's ball reported this recently gives candidate places"""
 
     parameters: Parameters
 

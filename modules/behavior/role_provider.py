@@ -62,7 +62,7 @@ class RoleProvider(Module):
         keeper_out_x: float = bounded(-4500.0, 4500.0, 500.0)
         """field mm: in a team of two on the field, the goalkeeper plays as a field player once the ball is beyond this"""
         keeper_back_x: float = bounded(-4500.0, 4500.0, -1000.0)
-        """field mm: ... and keeps its goal again once the ball is behind this"""
+        """field mm: a goalkeeper playing as a field player keeps its goal again once the ball is behind this"""
         team_ball_age: float = bounded(0.0, 30.0, 3.0)
         """s: a teammate's ball older than this does not count for where the ball is"""
 

@@ -81,9 +81,9 @@ class SelfLocator(Module):
         fallen_rotation_noise: float = bounded(0.0, 3.0, 0.6)
         """rad of rotation noise added when the robot has fallen"""
         point_std: float = bounded(10.0, 1000.0, 80.0)
-        """mm: noise of a line point at the robot ..."""
+        """mm: noise of a line point at the robot (grows by ``point_std_per_m``)"""
         point_std_per_m: float = bounded(0.0, 500.0, 50.0)
-        """... plus this per metre of distance"""
+        """mm per metre of distance added to ``point_std``"""
         max_points: int = bounded(5, 500, 40)
         point_weight: float = bounded(0.01, 1.0, 0.12)
         """line points are not independent: each counts this much of a full measurement"""
@@ -102,31 +102,31 @@ class SelfLocator(Module):
         """largest log-odds the side belief holds: what evidence for the twin must overcome"""
         placement_cap: float = bounded(0.0, 50.0, 6.0)
         """log-odds against a twin that puts the robot's placement well beyond the halfway line (counted
-        once, not every frame) ..."""
+        once, not every frame; ``placement_rate`` of it a frame)"""
         placement_rate: float = bounded(0.0, 1.0, 0.2)
-        """... of which at most this share a frame"""
+        """share of ``placement_cap`` counted at most in one frame"""
         team_ball_std: float = bounded(10.0, 5000.0, 300.0)
-        """mm: the team's ball against the ball seen ..."""
+        """mm: the team's ball against the ball seen (grows with distance and age, below)"""
         team_ball_std_per_m: float = bounded(0.0, 1000.0, 100.0)
-        """... plus this per metre of the seen ball's distance ..."""
+        """mm per metre of the seen ball's distance added to ``team_ball_std``"""
         team_ball_std_per_s: float = bounded(0.0, 5000.0, 300.0)
-        """... plus this per second of the team ball's age"""
+        """mm per second of the team ball's age added to ``team_ball_std``"""
         team_ball_max_age: float = bounded(0.0, 30.0, 3.0)
         """s: older team balls are not used"""
         team_ball_rate: float = bounded(0.0, 1.0, 0.12)
-        """share of the team ball's log-likelihood ratio counted per frame (frames see the same ball) ..."""
+        """share of the team ball's log-likelihood ratio counted per frame (frames see the same ball)"""
         team_message_cap: float = bounded(0.0, 50.0, 4.0)
-        """... and at most this much log-odds from one teammate's message: a confident side turns only
+        """log-odds one teammate's message adds at most: a confident side turns only
         on several messages that keep saying so"""
         continuity_distance: float = bounded(0.0, 5000.0, 1000.0)
         """mm: relocalized this near where it was lost (and within ``continuity_rotation``, unless it
-        fell), the robot was not carried: the side belief carries on ..."""
+        fell), the robot was not carried: the side belief carries on"""
         continuity_rotation: float = bounded(0.0, 3.2, 0.6)
-        """... rad"""
+        """rad: relocalized this near the rotation where it was lost (with ``continuity_distance``), the side belief carries on"""
         search_share: float = bounded(0.0, 1.0, 0.05)
-        """share made anew per frame while the pose is not valid ..."""
+        """share of the particles made anew per frame while the pose is not valid"""
         watch_share: float = bounded(0.0, 1.0, 0.1)
-        """... and while it is (mixture MCL), once the circle, a post or many line points have contradicted the
+        """share of the particles made anew per frame while the pose is valid (mixture MCL), once the circle, a post or many line points have contradicted the
         estimate (beyond 2.5 standard deviations) in ``watch_after`` frames in a row: poses that explain this frame's percepts
         compete with the estimate, so a robot carried elsewhere is noticed (its new place grows among them)
         even where the other percepts still half fit the old one. Only from a seen post, circle or line, never
@@ -145,16 +145,16 @@ class SelfLocator(Module):
         outside_std: float = bounded(10.0, 5000.0, 300.0)
         """mm beyond the field's lines at which a pose is one standard deviation unlikely"""
         valid_deviation: float = bounded(10.0, 5000.0, 350.0)
-        """mm: the pose is valid while the particles around the estimate are this close together ..."""
+        """mm: the pose is valid while the particles around the estimate are this close together (with ``valid_share`` and ``confirm_after``)"""
         valid_share: float = bounded(0.1, 1.0, 0.7)
-        """... and hold this share of all particles ..."""
+        """share of all particles that must lie around the estimate for a valid pose"""
         confirm_after: float = bounded(0.0, 10.0, 1.0)
-        """... for this many seconds, in which the circle, a post, or lines both along and across the
+        """s the particles must stay gathered before the pose is valid, in which the circle, a post, or lines both along and across the
         field were seen (one straight line fits many places on the field)"""
         roughening: float = bounded(0.0, 200.0, 15.0)
-        """mm of noise added to resampled particles, against their collapse onto a few ..."""
+        """mm of noise added to resampled particles, against their collapse onto a few"""
         roughening_rotation: float = bounded(0.0, 1.0, 0.15)
-        """... and rad"""
+        """rad of noise added to resampled particles' rotation"""
 
     parameters: Parameters
 

@@ -115,9 +115,9 @@ class FieldBoundaryDetector(Module):
         max_gap: float = bounded(0.0, 0.5, 0.05)
         """the longest stretch of a column without field that the scan upwards crosses (share of the image height)"""
         outlier_window: float = bounded(0.01, 1.0, 0.2)
-        """share of the columns on either side whose median a column's field edge is compared with ..."""
+        """share of the columns on either side whose median a column's field edge is compared with"""
         outlier_rise: float = bounded(0.0, 1.0, 0.04)
-        """... and the share of the image height it may rise above that median"""
+        """share of the image height a column's field edge may rise above the median of its ``outlier_window``"""
         white_value: float = bounded(0.1, 1.0, 0.6)
         """white (a line the scan crosses): unsaturated and at least this share of the image's brightest value"""
         horizon_margin: float = bounded(0.0, 0.5, 0.03)

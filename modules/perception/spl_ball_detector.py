@@ -192,9 +192,9 @@ class SPLBallDetector(Module):
         above_boundary: float = bounded(0.0, 50.0, 8.0)
         """px above the field boundary still searched: a ball on the border strip reaches over it"""
         post_share: float = bounded(0.0, 1.0, 0.6)
-        """share of white pixels right above a spot that makes it the foot of a goal post ..."""
+        """share of white pixels right above a spot that makes it the foot of a goal post (white: ``post_white``)"""
         post_white: float = bounded(0.1, 1.0, 0.55)
-        """... white being at least this share of the image's brightest value (posts are shaded)"""
+        """share of the image's brightest value a pixel reaches to count as white for ``post_share`` (posts are shaded)"""
         strict_saturation: float = bounded(0.0, 1.0, 0.75)
         """share of the carpet's median saturation a pixel needs to hide a ball candidate as green"""
         black_contrast: float = bounded(0.1, 1.5, 0.85)
@@ -211,25 +211,25 @@ class SPLBallDetector(Module):
         """a candidate that fails the checks only by faint black patches or a little colour (a small ball blurred by the
         head's turn, in a colour cast) is a ball if it passes looser ones and the classifier is sure (``second_look_min``)"""
         second_dark_ratio: float = bounded(0.1, 1.0, 0.6)
-        """the looser checks: a pixel is dark below this share of the bright pixels' value ..."""
+        """the second look's looser check: a pixel is dark below this share of the bright pixels' value"""
         second_black_contrast: float = bounded(0.1, 1.5, 0.85)
-        """... the black patches darker than this share of the carpet's value ..."""
+        """the second look's looser check: the black patches darker than this share of the carpet's value"""
         second_saturation_max: float = bounded(0.0, 255.0, 90.0)
-        """... and this mean saturation inside at most"""
+        """the second look's looser check: the mean saturation inside at most this"""
         second_look_min: float = bounded(-5.0, 10.0, 3.0)
         """the classifier's score (a logit) a candidate that passed only the looser checks needs"""
         edge_search: bool = True
         """far balls on the field's edge: also look for ball-coloured blobs in a band round the field boundary"""
         edge_above: int = bounded(0, 60, 14)
-        """px above the field boundary the band reaches (a far ball lies on the edge and reaches over it) ..."""
+        """px above the field boundary the band reaches (a far ball lies on the edge and reaches over it)"""
         edge_below: int = bounded(0, 60, 20)
-        """... and px below it"""
+        """px below the field boundary the far-ball band reaches"""
         edge_max_radius: float = bounded(1.0, 30.0, 9.0)
         """px: the band looks only for balls at most this large (nearer ones stand out on the green)"""
         edge_white: float = bounded(0.5, 3.0, 1.1)
-        """in the band, ball white is brighter than this share of the carpet's value ..."""
+        """in the far-ball band, ball white is brighter than this share of the carpet's value"""
         edge_black: float = bounded(0.05, 1.0, 0.5)
-        """... and ball black darker than this share; between is the hall, which is no ball"""
+        """in the far-ball band, ball black is darker than this share of the carpet's value; between white and black is the hall, which is no ball"""
         edge_max_spots: int = bounded(0, 20, 6)
         """candidates from the band checked per image, beside ``max_spots``"""
         edge_green_below: float = bounded(0.0, 1.0, 0.6)
