@@ -121,14 +121,47 @@ def test_a_defender_in_the_centre_circle_at_the_kick_off_and_near_a_free_kick_is
     assert referee.game.teams[1].players[0].secs_till_unpenalised == 55  # incremental: its team's second
 
 
-def test_walking_into_an_opponent_away_from_the_ball_is_pushing(referee: Referee) -> None:
+def walk(ref: Referee, index: int, start: tuple[float, float], heading: float, velocity: tuple[float, float], seconds: float,
+         sway: float = 0.0) -> None:
+    """Move robot ``index`` from ``start`` (mm) at ``velocity`` (mm/s) for ``seconds``, facing ``heading``, its torso
+    swaying ``sway`` mm sideways at 2 Hz (a walk's steps), the referee ticking."""
+    for k in range(int(round(seconds / TICK)) + 1):
+        t = k * TICK
+        side = sway * math.sin(2 * math.pi * 2.0 * t)
+        ref.world.move_robot(index, start[0] + velocity[0] * t - side * math.sin(heading),
+                             start[1] + velocity[1] * t + side * math.cos(heading), heading)
+        run(ref, TICK)
+
+
+def test_walking_into_an_opponent_is_pushing_by_the_rule_book_even_in_a_duel_for_the_ball(referee: Referee) -> None:
     until(referee, State.playing)
-    referee.world.move_robot(0, -2000.0, 2000.0, 0.0)
-    referee.world.move_robot(1, -1750.0, 2000.0, math.pi)
-    referee.world.data.qvel[referee.world.robots[0].root_qvel] = 0.3  # team 1's robot walks into the other at 300 mm/s
-    run(referee, TICK)
+    referee.world.move_robot(1, -1700.0, 2000.0, math.pi / 2)  # team 2's robot stands, facing along the touchline
+    referee.world.move_ball(-1800.0, 2250.0)  # beside both: a duel near the ball no longer excuses a push
+    walk(referee, 0, (-2200.0, 2000.0), 0.0, (300.0, 0.0), 0.6)  # team 1's walks into its side at 300 mm/s
     foul = referee.fouls[-1]
     assert (foul.team, foul.player, foul.penalty) == (1, 1, Penalty.player_pushing) and "walked into team 2 player 1" in foul.reason
+
+
+@pytest.mark.parametrize("case", ["standing swaying", "front to front over the ball", "side on the way to the ball", "keeper in its area"])
+def test_the_rule_books_exceptions_to_pushing_are_no_foul(referee: Referee, case: str) -> None:
+    until(referee, State.playing)
+    if case == "standing swaying":  # a walk's sway touches at 250 mm/s for an instant; over a step it goes nowhere
+        referee.world.move_robot(1, -1700.0, 2000.0, math.pi)
+        referee.world.move_ball(-3000.0, 2000.0)  # behind it: it is not on its way to the ball
+        walk(referee, 0, (-1990.0, 2000.0), math.pi / 2, (0.0, 0.0), 2.0, sway=20.0)
+    elif case == "front to front over the ball":
+        referee.world.move_robot(1, -1700.0, 2000.0, math.pi)
+        referee.world.move_ball(-1850.0, 2030.0)
+        walk(referee, 0, (-2200.0, 2000.0), 0.0, (300.0, 0.0), 0.6)
+    elif case == "side on the way to the ball":  # walking to the ball ahead, its shoulder brushes a robot beside it
+        referee.world.move_robot(1, -1700.0, 2250.0, math.pi)
+        referee.world.move_ball(-1000.0, 1900.0)
+        walk(referee, 0, (-2200.0, 1950.0), 0.0, (300.0, 0.0), 2.0)
+    else:  # team 1's keeper (player 1) in its penalty area
+        referee.game.teams[0].goalkeeper = 1
+        referee.world.move_robot(1, -3700.0, 500.0, math.pi)
+        walk(referee, 0, (-4200.0, 500.0), 0.0, (300.0, 0.0), 0.6)
+    assert not [f for f in referee.fouls if f.penalty is Penalty.player_pushing], referee.fouls
 
 
 # ------------------------------------------------------------------------------- fallen, inactive, motion in SET

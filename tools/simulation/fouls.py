@@ -1,7 +1,8 @@
 """The fouls the simulated GameController (``referee.py``) calls from the world's ground truth, and the
 penalties they bring.
 
-- pushing: walking into an opponent away from the ball (a duel for the ball is no push);
+- pushing: walking into a touching opponent, with the rules' exceptions (standing, getting up, the keeper in
+  its penalty area, front to front with the ball between, a side touched on the way to the ball);
 - illegal position in SET (in the other half, or the defenders in the centre circle) and at the
   kick-off (a defender in the centre circle before the ball moved or 10 s passed), and the free-kick
   distance (an opponent within 0.75 m of the ball after ``free_kick_grace_s``): ``set_plays.py`` says
@@ -26,6 +27,7 @@ the field (motion in SET aside: in place). Every foul is a ``Foul`` (time, team,
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,7 +46,10 @@ INCREMENTAL = (Penalty.player_pushing, Penalty.illegal_position, Penalty.leaving
 PENALTY_INCREMENT_S = 10.0  # s longer for each incremental penalty of the team before
 CENTRE_CIRCLE_R, FREE_KICK_DISTANCE = pitch.CENTER_CIRCLE_DIAMETER / 2, 750.0  # mm
 CONTACT = 330.0  # mm between two torsos: the robots touch
-PUSH_SPEED = 80.0  # mm/s towards the other robot: walking into it
+PUSH_SPEED = 80.0  # mm/s towards the other robot over PUSH_WINDOW_S: walking into it
+PUSH_WINDOW_S = 0.5  # s: about a step, over which a robot's approach is measured
+PUSH_FRONT = math.radians(50.0)  # rad: contact within this of a robot's heading is at its front, beyond at its side
+BALL_BETWEEN = 150.0  # mm: the ball this near the line between two robots' torsos (and between them) is between them
 FALLEN_HEIGHT = 0.2  # m: a torso lower than this has fallen
 LYING_UP = 0.5  # the torso's up axis, vertical part: below it (tilted over 60 degrees) the robot lies
 SITTING_UP = 0.7  # ... above it the torso is upright (sitting, kneeling or standing)
@@ -122,6 +127,8 @@ class Fouls(Officiating):
     set_judged: bool
     last_touch_s: float
     """s: the ball's last touch (or the last call of a local game stuck)"""
+    tracks: dict[int, deque[tuple[float, float, float]]]
+    """per robot index: its torso's (s, x mm, y mm) over the last ``PUSH_WINDOW_S`` of PLAYING, for pushing"""
 
     def enter(self, state: State, now: float) -> None:
         """A new state: a SET's places are taken afresh; activity and falls, judged in READY, SET and PLAYING
@@ -181,27 +188,74 @@ class Fouls(Officiating):
             self.last_touch_s = now
 
     def judge_pushing(self, now: float, bx: float, by: float) -> None:
-        """An opponent walked into: the robot moving towards the other, away from the ball (a duel for the
-        ball is no push)."""
+        """The rules' pushing (forceful contact with an opponent): a robot whose torso approached a touching
+        (``CONTACT``) opponent faster than ``PUSH_SPEED`` over the last ``PUSH_WINDOW_S`` (a step: a walk's
+        sway alone reaches 250 mm/s for an instant) walked into it. Of two, only the one that approached
+        faster pushed. The rules' exceptions: a stationary robot (also one kicking: its torso stays), one
+        getting up (fallen), a goalkeeper in its own penalty area, front to front contact with the ball
+        between, and a robot proceeding to the ball that touches with its side."""
         field = self.on_field()
+        for index in set(self.tracks) - {player.index for player in field}:
+            del self.tracks[index]  # taken off the field: its way back is no walk
+        for player in field:
+            x, y, _ = self.world.robot_pose(player.index)
+            track = self.tracks.setdefault(player.index, deque())
+            if track and now - track[-1][0] > PUSH_WINDOW_S:
+                track.clear()  # PLAYING anew: the referee may have placed it meanwhile
+            track.append((now, x, y))
+            while len(track) > 2 and now - track[1][0] >= PUSH_WINDOW_S:
+                track.popleft()
         for k, a in enumerate(field):
             for b in field[k + 1:]:
                 if a.team == b.team:
                     continue
                 ax, ay, _ = self.world.robot_pose(a.index)
                 bx_, by_, _ = self.world.robot_pose(b.index)
-                distance = math.hypot(bx_ - ax, by_ - ay)
-                if distance >= CONTACT or min(math.hypot(bx - ax, by - ay), math.hypot(bx - bx_, by - by_)) < 400.0:
+                if math.hypot(bx_ - ax, by_ - ay) >= CONTACT:
                     continue
-                ux, uy = (bx_ - ax) / max(distance, 1.0), (by_ - ay) / max(distance, 1.0)
-                va, vb = self.world.robot_velocity(a.index), self.world.robot_velocity(b.index)
-                towards_b, towards_a = va[0] * ux + va[1] * uy, -(vb[0] * ux + vb[1] * uy)
-                if max(towards_b, towards_a) > PUSH_SPEED:
-                    pusher = a if towards_b >= towards_a else b
-                    self.penalize(pusher, Penalty.player_pushing, now,
-                                  f"walked into team {self.team_numbers[(b if pusher is a else a).team]} player "
-                                  f"{(b if pusher is a else a).number}")
-                    return
+                pushers = sorted(((self.approach(a, b), a, b), (self.approach(b, a), b, a)), key=lambda t: -t[0])
+                for speed, pusher, pushed in pushers:
+                    if speed > PUSH_SPEED and not self.may_touch(pusher, pushed, bx, by):
+                        self.penalize(pusher, Penalty.player_pushing, now,
+                                      f"walked into team {self.team_numbers[pushed.team]} player {pushed.number}")
+                        return
+                    if speed > PUSH_SPEED:
+                        break  # the faster one was excused; the other was pushed, not pushing
+
+    def approach(self, player: Player, other: Player) -> float:
+        """mm/s the robot's torso moved towards the other's over its track (``PUSH_WINDOW_S``)."""
+        track = self.tracks.get(player.index)
+        if not track or track[-1][0] - track[0][0] <= 0.0:
+            return 0.0
+        (t0, x0, y0), (t1, x1, y1) = track[0], track[-1]
+        ox, oy, _ = self.world.robot_pose(other.index)
+        distance = max(math.hypot(ox - x1, oy - y1), 1.0)
+        return ((x1 - x0) * (ox - x1) + (y1 - y0) * (oy - y1)) / distance / (t1 - t0)
+
+    def may_touch(self, player: Player, other: Player, bx: float, by: float) -> bool:
+        """The rules' exceptions to pushing for ``player`` touching ``other`` (the ball at ``bx``, ``by``)."""
+        if player.index in self.fall_watches:
+            return True  # getting up
+        x, y, heading = self.world.robot_pose(player.index)
+        tx, ty, _ = self.team_pose(player)
+        keeper = self.game.teams[player.team].goalkeeper == player.number
+        if keeper and tx < -HALF_LINE_X + pitch.PENALTY_AREA_LENGTH and abs(ty) < pitch.PENALTY_AREA_WIDTH / 2:
+            return True
+        ox, oy, other_heading = self.world.robot_pose(other.index)
+        to_other = math.atan2(oy - y, ox - x)
+        front = abs(math.remainder(to_other - heading, math.tau)) < PUSH_FRONT
+        other_front = abs(math.remainder(to_other + math.pi - other_heading, math.tau)) < PUSH_FRONT
+        distance = max(math.hypot(ox - x, oy - y), 1.0)
+        along = ((bx - x) * (ox - x) + (by - y) * (oy - y)) / distance
+        across = abs((bx - x) * (oy - y) - (by - y) * (ox - x)) / distance
+        if front and other_front and 0.0 < along < distance and across < BALL_BETWEEN:
+            return True
+        if not front:  # its side touches: excused while it proceeds to the ball
+            track = self.tracks[player.index]
+            (_, x0, y0), (_, x1, y1) = track[0], track[-1]
+            moved, ball = math.hypot(x1 - x0, y1 - y0), math.hypot(bx - x1, by - y1)
+            return moved > 0.0 and ((x1 - x0) * (bx - x1) + (y1 - y0) * (by - y1)) > 0.5 * moved * max(ball, 1.0)
+        return False
 
     def judge_activity(self, now: float, spared: Player | None = None) -> None:
         """The rules' fallen or inactive robot, for every robot on the field but ``spared``: GameController3's

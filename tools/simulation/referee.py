@@ -110,7 +110,7 @@ class Referee(ShootOut, SetPlays):
         self.ending = False  # the game ends at the next FINISHED, whichever half it is
         # the fouls' state (fouls.py)
         self.incremental, self.set_judged, self.last_touch_s = [0, 0], False, 0.0
-        self.fall_watches, self.activity, self.placed = {}, {}, {}
+        self.fall_watches, self.activity, self.placed, self.tracks = {}, {}, {}, {}
         # the set plays' state (set_plays.py)
         self.calls = sorted(self.calls, key=lambda call: call.time_s)
         self.restriction = None
