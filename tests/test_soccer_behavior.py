@@ -69,6 +69,17 @@ def test_the_striker_goes_for_the_ball_and_searches_by_turning_without_one() -> 
     assert search.motion is MotionType.walk and search.walk_rotation > 0
 
 
+def test_the_striker_searches_towards_the_side_it_last_saw_the_ball_on() -> None:
+    """Lost on its right, the ball is searched by turning right (and on its left, left), not always left."""
+    for y, sign in ((-900.0, -1.0), (900.0, 1.0)):
+        harness = ModuleHarness(SoccerBehavior, game(State.playing), PlayerRole(role=Role.striker), RobotPose(valid=True, x=-3000.0),
+                                BallModel(valid=True, seen=True, x=1500.0, y=y), TeamMates(), MotionInfo())
+        harness.execute()
+        harness.set(BallModel(valid=False, x=300.0, y=y, time_since_seen=2.0))
+        search = harness.execute()[MotionRequest]
+        assert search.motion is MotionType.walk and search.walk_x == 0.0 and math.copysign(1.0, search.walk_rotation) == sign
+
+
 def test_without_its_own_sighting_the_striker_goes_by_a_teammates_ball() -> None:
     said = TeamMessage(team=1, player=3, pose_valid=True, ball_seen=True, ball_x=500.0, ball_y=1000.0, ball_age=0.5)
     out = request(State.playing, pose=RobotPose(valid=True, x=-2000.0, y=0.0), mates=TeamMates(mates=[TeamMate(said, age=0.4)]))

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field, replace
 
 from tafel.core import Module, bounded, fields_of, provides, requires, uses
 from tafel.debug import Canvas, DebugRequest
+from tafel.modules.behavior.ball_search import SearchTurn
 from tafel.modules.behavior.kicking import KickParameters, goal_direction, kick_tuning
 from tafel.modules.behavior.options import OptionRunner
 from tafel.modules.behavior.options.soccer import FREE_KICKS, OWN_GOAL_X, PlaySoccer
@@ -156,6 +157,8 @@ class SoccerBehavior(Module):
         """where the ball is played (field mm: a pass's target or the shot's point), whether it is a pass, and when chosen (s)"""
         self.last_ball: tuple[float, float] | None = None
         """field mm: where the ball was last known (own sighting or a teammate's)"""
+        self.ball_search = SearchTurn()
+        """which way a search for the ball turns: towards the side it was last seen on"""
 
     def execute(self) -> None:
         out = self.motion_request
@@ -165,6 +168,8 @@ class SoccerBehavior(Module):
         busy = {info.name: getattr(out, info.name) for info in fields_of(MotionRequest)} if self.motion_info.busy else None
         self.keep_out, self.indirect = [], False
         self.last_ball = self.ball_on_field() or self.last_ball
+        if self.ball_model.valid:
+            self.ball_search.found()
         out.motion, out.walk_kick = MotionType.stand, WalkKick.none  # each frame's request starts afresh
         self.options.run(self, self.frame_info.time_s, self.activation_graph)
         self.stay_on_field()

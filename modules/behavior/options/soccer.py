@@ -125,8 +125,9 @@ class Striker(Option["SoccerBehavior"]):
 
     @state(initial=True)
     def search(self, b: SoccerBehavior) -> None:
-        """Nobody knows where the ball is: turn on the spot (the head searches)."""
-        b.turn(b.parameters.search_turn)
+        """Nobody knows where the ball is: turn on the spot (the head searches), towards the side the ball was
+        last seen on (``ball_search.SearchTurn``; a teammate's ball is gone to, not searched)."""
+        b.turn(b.ball_search.direction(b.ball_model, b.robot_pose, None) * b.parameters.search_turn)
 
     @state
     def kick(self, b: SoccerBehavior) -> None:
