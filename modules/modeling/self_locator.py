@@ -26,6 +26,14 @@ WATCH_LINES_OFF = 0.2  # ... the share of them beyond 2.5 standard deviations th
 WATCH_LINES_ON = 0.1  # the old pose half fits: about a quarter), and the share at most that agrees (an accurate pose: 0)
 
 
+def seen_from(poses: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Robot-frame points (M x 2, mm) as seen from each of the field poses (N x 3: mm, mm, rad): N x M x 2
+    field positions (mm)."""
+    x, y, heading = (poses[:, i : i + 1] for i in range(3))
+    c, s = np.cos(heading), np.sin(heading)
+    return np.stack([x + c * points[:, 0] - s * points[:, 1], y + s * points[:, 0] + c * points[:, 1]], axis=-1)
+
+
 @requires(Odometry, LinePercept, GoalPostPercept, FrameInfo)
 @uses(FallState, GameState, KnownPose, BallPercept, TeamMates)
 @provides(RobotPose)
@@ -246,21 +254,19 @@ class SelfLocator(Module):
         p = self.parameters
         log_weight = np.zeros(len(self.particles))
         measurements = 0.0
-        points = np.asarray(self.line_percept.points, dtype=float).reshape(-1, 2)
-        points = points[np.isfinite(points).all(axis=1) & (np.abs(points) < 20000.0).all(axis=1)]  # what no camera sees
+        points = self.line_points()
         if len(points):
             if len(points) > p.max_points:
                 points = points[np.linspace(0, len(points) - 1, p.max_points).astype(int)]
-            std = p.point_std + p.point_std_per_m * np.linalg.norm(points, axis=1) / 1000.0
+            std = self.point_std(points)
             distance = FIELD_MODEL.line_distance(self.to_field(points))
             log_weight += p.point_weight * robust(distance / std).sum(axis=1)
             measurements += p.point_weight * len(points)
         for post in self.goal_post_percept.posts:
             if not (math.isfinite(post.x) and math.isfinite(post.y)):
                 continue
-            std = p.post_std + p.post_std_per_m * math.hypot(post.x, post.y) / 1000.0
             distance = FIELD_MODEL.post_distance(self.to_field(np.array([[post.x, post.y]]))[:, 0])
-            log_weight += robust(distance / std)
+            log_weight += robust(distance / self.post_std(post.x, post.y))
             measurements += 1
         if self.line_percept.circle_seen and math.isfinite(self.line_percept.circle_x) and math.isfinite(self.line_percept.circle_y):
             centre = self.to_field(np.array([[self.line_percept.circle_x, self.line_percept.circle_y]]))[:, 0]
@@ -295,9 +301,20 @@ class SelfLocator(Module):
 
     def to_field(self, points: np.ndarray) -> np.ndarray:
         """Robot-frame points (M x 2) as seen from every particle: (N x M x 2) field positions."""
-        x, y, heading = (self.particles[:, i : i + 1] for i in range(3))
-        c, s = np.cos(heading), np.sin(heading)
-        return np.stack([x + c * points[:, 0] - s * points[:, 1], y + s * points[:, 0] + c * points[:, 1]], axis=-1)
+        return seen_from(self.particles, points)
+
+    def line_points(self) -> np.ndarray:
+        """This frame's line points (M x 2, robot mm), without the ones no camera sees (not finite, over 20 m)."""
+        points = np.asarray(self.line_percept.points, dtype=float).reshape(-1, 2)
+        return points[np.isfinite(points).all(axis=1) & (np.abs(points) < 20000.0).all(axis=1)]
+
+    def point_std(self, points: np.ndarray) -> np.ndarray:
+        """mm: each line point's noise, growing with its distance."""
+        return self.parameters.point_std + self.parameters.point_std_per_m * np.linalg.norm(points, axis=1) / 1000.0
+
+    def post_std(self, x: float, y: float) -> float:
+        """mm: a goal post's noise at (x, y) (robot mm), growing with its distance."""
+        return self.parameters.post_std + self.parameters.post_std_per_m * math.hypot(x, y) / 1000.0
 
     def reset_if_lost(self, fit: float) -> None:
         """Make part of the particles anew from the percepts while lost, or while the pose is not valid."""
@@ -332,16 +349,12 @@ class SelfLocator(Module):
             verdicts.append(math.hypot(*pose.to_global(lines.circle_x, lines.circle_y)) / p.circle_std >= 2.5)
         for post in self.goal_post_percept.posts:
             if math.isfinite(post.x) and math.isfinite(post.y):
-                std = p.post_std + p.post_std_per_m * math.hypot(post.x, post.y) / 1000.0
                 place = np.array([pose.to_global(post.x, post.y)])
-                verdicts.append(float(FIELD_MODEL.post_distance(place)[0]) / std >= 2.5)
-        points = np.asarray(lines.points, dtype=float).reshape(-1, 2)
-        points = points[np.isfinite(points).all(axis=1) & (np.abs(points) < 20000.0).all(axis=1)]
+                verdicts.append(float(FIELD_MODEL.post_distance(place)[0]) / self.post_std(post.x, post.y) >= 2.5)
+        points = self.line_points()
         if len(points) >= WATCH_MIN_POINTS:
-            c, s = math.cos(pose.rotation), math.sin(pose.rotation)
-            seen = np.column_stack([pose.x + c * points[:, 0] - s * points[:, 1], pose.y + s * points[:, 0] + c * points[:, 1]])
-            std = p.point_std + p.point_std_per_m * np.linalg.norm(points, axis=1) / 1000.0
-            off = float(np.mean(FIELD_MODEL.line_distance(seen[None, :, :])[0] / std >= 2.5))
+            seen = seen_from(np.array([self.estimate]), points)
+            off = float(np.mean(FIELD_MODEL.line_distance(seen)[0] / self.point_std(points) >= 2.5))
             if off >= WATCH_LINES_OFF or off <= WATCH_LINES_ON:  # in between, lines say nothing either way
                 verdicts.append(off >= WATCH_LINES_OFF)
         if verdicts:
