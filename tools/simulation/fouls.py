@@ -213,24 +213,28 @@ class Fouls(Officiating):
                 bx_, by_, _ = self.world.robot_pose(b.index)
                 if math.hypot(bx_ - ax, by_ - ay) >= CONTACT:
                     continue
-                pushers = sorted(((self.approach(a, b), a, b), (self.approach(b, a), b, a)), key=lambda t: -t[0])
-                for speed, pusher, pushed in pushers:
-                    if speed > PUSH_SPEED and not self.may_touch(pusher, pushed, bx, by):
-                        self.penalize(pusher, Penalty.player_pushing, now,
-                                      f"walked into team {self.team_numbers[pushed.team]} player {pushed.number}")
-                        return
-                    if speed > PUSH_SPEED:
-                        break  # the faster one was excused; the other was pushed, not pushing
+                # only the faster one can have pushed: excused, the other was pushed, not pushing
+                speed, pusher, pushed = max((self.approach(a, b), a, b), (self.approach(b, a), b, a), key=lambda t: t[0])
+                if speed > PUSH_SPEED and not self.may_touch(pusher, pushed, bx, by):
+                    self.penalize(pusher, Penalty.player_pushing, now, f"walked into team {self.team_numbers[pushed.team]} player {pushed.number}")
+                    return
+
+    def walked(self, player: Player) -> tuple[float, float, float]:
+        """mm, mm, s: how far the robot's torso moved over its track (``PUSH_WINDOW_S``), and in what time."""
+        track = self.tracks.get(player.index)
+        if not track:
+            return 0.0, 0.0, 0.0
+        (t0, x0, y0), (t1, x1, y1) = track[0], track[-1]
+        return x1 - x0, y1 - y0, t1 - t0
 
     def approach(self, player: Player, other: Player) -> float:
         """mm/s the robot's torso moved towards the other's over its track (``PUSH_WINDOW_S``)."""
-        track = self.tracks.get(player.index)
-        if not track or track[-1][0] - track[0][0] <= 0.0:
+        dx, dy, seconds = self.walked(player)
+        if seconds <= 0.0:
             return 0.0
-        (t0, x0, y0), (t1, x1, y1) = track[0], track[-1]
+        x, y, _ = self.world.robot_pose(player.index)
         ox, oy, _ = self.world.robot_pose(other.index)
-        distance = max(math.hypot(ox - x1, oy - y1), 1.0)
-        return ((x1 - x0) * (ox - x1) + (y1 - y0) * (oy - y1)) / distance / (t1 - t0)
+        return (dx * (ox - x) + dy * (oy - y)) / max(math.hypot(ox - x, oy - y), 1.0) / seconds
 
     def may_touch(self, player: Player, other: Player, bx: float, by: float) -> bool:
         """The rules' exceptions to pushing for ``player`` touching ``other`` (the ball at ``bx``, ``by``)."""
@@ -251,10 +255,9 @@ class Fouls(Officiating):
         if front and other_front and 0.0 < along < distance and across < BALL_BETWEEN:
             return True
         if not front:  # its side touches: excused while it proceeds to the ball
-            track = self.tracks[player.index]
-            (_, x0, y0), (_, x1, y1) = track[0], track[-1]
-            moved, ball = math.hypot(x1 - x0, y1 - y0), math.hypot(bx - x1, by - y1)
-            return moved > 0.0 and ((x1 - x0) * (bx - x1) + (y1 - y0) * (by - y1)) > 0.5 * moved * max(ball, 1.0)
+            dx, dy, _ = self.walked(player)
+            moved, ball = math.hypot(dx, dy), math.hypot(bx - x, by - y)
+            return moved > 0.0 and (dx * (bx - x) + dy * (by - y)) > 0.5 * moved * max(ball, 1.0)
         return False
 
     def judge_activity(self, now: float, spared: Player | None = None) -> None:
