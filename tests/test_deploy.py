@@ -102,12 +102,14 @@ def test_a_release_that_fails_to_start_leaves_the_robot_on_the_one_it_had(robot:
     before = (target / "current").resolve()
     broken = tmp_path / "broken"
     broken.mkdir()
-    (broken / "robots.toml").write_text((robot["config"] / "robots.toml").read_text())
+    # the program must report its start: no timer decides, however short (this one is shorter than Python's start)
+    (broken / "robots.toml").write_text(robots_toml(robot["server"], target, start_check_s=0.05))
     (broken / "general.toml").write_text("[runtime]\nmotion_hz = -5\n")  # the program refuses to start
     result = tafel("deploy", "robo", "--config", str(broken), "--ssh-config", str(robot["server"].config),
                    "--staging", str(tmp_path / "staging"))
     assert result.returncode == 1
     assert "failed to start; the robot runs" in result.stderr and "again" in result.stderr
+    assert "motion_hz" in result.stderr  # the program's own words on why
     assert (target / "current").resolve() == before
     running_pid(target)  # the old release runs again
 

@@ -106,6 +106,42 @@ def test_switching_a_debug_request_in_the_page_switches_it_in_the_program(page: 
         time.sleep(0.2)
 
 
+def test_a_list_asked_for_before_a_click_does_not_undo_the_click_on_the_page(page: Any, program: WebProgram) -> None:
+    """The requests view asks for the list every 3 s; an answer to a question asked before the user's
+    click arrives after it and must not show the box as it was (the user would switch it back)."""
+    box = "document.querySelector(\"[data-request='FieldBoundaryDetector:draw']\")"
+    page.evaluate("""() => {  // hold every answer to the list until the test lets it go
+      const connection = tafel.connection;
+      window.held = [];
+      window.realJson = connection.json;
+      connection.json = (line) => line.startsWith("debug_request:list")
+        ? window.realJson.call(connection, line).then((value) => new Promise((resolve) => window.held.push(() => resolve(value))))
+        : window.realJson.call(connection, line);
+    }""")
+    try:
+        wait_for(page, "window.held.length > 0")  # a list asked for with the box off
+        assert page.evaluate(f"{box}.checked") is False
+        page.locator("[data-request='FieldBoundaryDetector:draw']").check()
+        deadline = time.monotonic() + 10
+        while "on  FieldBoundaryDetector:draw" not in program.ask("debug_request:list"):
+            assert time.monotonic() < deadline, program.ask("debug_request:list")
+            time.sleep(0.2)
+        shown = page.evaluate(f"""async () => {{
+          tafel.connection.json = window.realJson;
+          window.held.forEach((release) => release());
+          await new Promise((resolve) => setTimeout(resolve, 300));
+          return {box}.checked;
+        }}""")
+        assert shown is True
+    finally:
+        page.evaluate("tafel.connection.json = window.realJson; window.held.forEach((release) => release())")
+    page.locator("[data-request='FieldBoundaryDetector:draw']").uncheck()
+    deadline = time.monotonic() + 10
+    while "off FieldBoundaryDetector:draw" not in program.ask("debug_request:list"):
+        assert time.monotonic() < deadline, program.ask("debug_request:list")
+        time.sleep(0.2)
+
+
 def test_editing_a_parameter_in_the_page_changes_the_module(page: Any, program: WebProgram) -> None:
     field = page.locator("[data-parameter='FieldColorProvider.smoothing']")
     field.wait_for()

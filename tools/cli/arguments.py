@@ -300,6 +300,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--status-interval", type=positive(float), default=2.0, metavar="S",
                      help="seconds between status lines (default: %(default)s)")
     run.add_argument("-v", "--verbose", action="store_true", help="log informational messages")
+    run.add_argument("--ready-file", type=Path, metavar="FILE",
+                     help="write FILE (the program's pid) once every context has run a frame, so that whoever started "
+                          "the program knows it runs (tafel deploy waits for it); under systemd READY=1 goes to $NOTIFY_SOCKET")
     run.add_argument("--record", type=Path, metavar="FILE.mcap", help="record representations into an MCAP log")
     run.add_argument("--record-dir", type=Path, default=Path("logs"), metavar="DIR",
                      help="the only folder debug clients may record into with log:start (default: %(default)s)")

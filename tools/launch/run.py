@@ -34,6 +34,7 @@ from tafel.debug.executors import (
 from tafel.debug.values import frame_number
 from tafel.tools.launch.errors import fail
 from tafel.tools.launch.program import prepare, report_pruned
+from tafel.tools.launch.readiness import Readiness
 from tafel.tools.launch.recording import (
     add_blackbox_commands,
     blackbox_triggers,
@@ -58,6 +59,7 @@ from tafel.tools.viewers.live_feed import forward
 
 
 def command_run(args: argparse.Namespace, extra: Sequence[str]) -> int:
+    Readiness(args.ready_file).clear()
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(name)s %(levelname)s: %(message)s")
     if args.foxglove is not None:
         foxglove_address(args.foxglove)  # a wrong address fails before anything starts
@@ -157,6 +159,9 @@ def run_lockstep(args: argparse.Namespace, platform: Platform, plans: dict[str, 
             status_print(line.format(rt.time_ns * 1e-9, stats, now, rt.runners, recording_notices(recorder)))
 
     runtime.after_tick.append(status)
+    readiness = Readiness(args.ready_file)
+    if readiness.wanted:
+        runtime.after_tick.append(lambda rt: readiness.reported or readiness.check({n: r.frames for n, r in rt.runners.items()}))
     try:
         stats = runtime.run(limits)
     finally:
@@ -211,6 +216,10 @@ def run_concurrent(args: argparse.Namespace, platform: Platform, options: dict[s
             status_print(line.format(now - started, rt.stats, now, None, [*rt.notices, *recording_notices(recorder)], rt.dead))
 
     runtime.on_report.append(on_report)
+    readiness = Readiness(args.ready_file)
+    if readiness.wanted:
+        runtime.on_report.append(lambda rt: readiness.check({name: rt.stats[name].frames if name in rt.stats and name not in rt.dead else 0
+                                                             for name, plan in plans.items() if plan.runs}))
     signals = install_signal_handlers(runtime.stop, on_force=lambda: [p.kill() for p in runtime.processes.values()],
                                       grace_s=shutdown_grace(config))
     if debug is not None:

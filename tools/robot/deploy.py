@@ -73,7 +73,10 @@ class Robot:
     service: str = "systemd"
     #: the program the service runs, as arguments of ``tafel``
     command: str = "run --platform nao"
-    #: s the program must live after its start to count as started
+    #: s a ``run`` program may take to report that each of its contexts ran a frame (``--ready-file``;
+    #: under systemd ``READY=1``) before its start counts as failed
+    start_timeout_s: float = 120.0
+    #: s the program must go on living after that report (other commands than ``run``: after their start)
     start_check_s: float = 3.0
     #: MB the robot must have free beyond what a release needs
     min_free_mb: int = 50
@@ -90,7 +93,8 @@ ROBOT_KEYS: dict[str, tuple[Any, Range | None, str | None]] = {
     "player": (int, Range(0, 20), "a player number from 1 to 20, or 0 for none"),
     "team": (int, Range(0, 254), "a team number from 1 to 254, or 0 for none"), "python": (str, None, None),
     "dependencies": (Literal["wheels", "robot"], None, None), "service": (Literal["systemd", "process"], None, None),
-    "command": (str, None, None), "start_check_s": (float, Range(0.0, low_open=True), None), "min_free_mb": (int, Range(0), None),
+    "command": (str, None, None), "start_timeout_s": (float, Range(0.0, low_open=True), None),
+    "start_check_s": (float, Range(0.0, low_open=True), None), "min_free_mb": (int, Range(0), None),
 }
 
 
@@ -271,7 +275,11 @@ def command_deploy(args: argparse.Namespace) -> int:
     for line in result.stdout.splitlines():
         print(f"{robot.name}: {line}")
     if result.returncode != 0:
-        print(f"tafel deploy: error: {robot.name}: {last_line(result.stderr)}", file=sys.stderr)
+        reason = last_line(result.stderr)
+        for line in result.stderr.strip().splitlines():  # what led there: the program's last lines, a failed install
+            if line.strip() and line != reason:
+                print(f"{robot.name}: {line}", file=sys.stderr)
+        print(f"tafel deploy: error: {robot.name}: {reason}", file=sys.stderr)
         return 1
     print(f"{robot.name}: release {release} runs ({len(copied)} files copied, {time.monotonic() - started:.1f} s)")
     return 0
@@ -280,7 +288,7 @@ def command_deploy(args: argparse.Namespace) -> int:
 def install_script(robot: Robot) -> str:
     """The command line that runs ``deploy_robot.sh`` on the robot with the robot's settings."""
     settings = {"TARGET": robot.target, "PYTHON": robot.python, "DEPENDENCIES": robot.dependencies, "SERVICE": robot.service,
-                "COMMAND": robot.command, "START_CHECK_S": f"{robot.start_check_s:g}", "MIN_FREE_MB": str(robot.min_free_mb)}
+                "COMMAND": robot.command, "START_TIMEOUT_S": f"{robot.start_timeout_s:g}", "START_CHECK_S": f"{robot.start_check_s:g}", "MIN_FREE_MB": str(robot.min_free_mb)}
     assignments = " ".join(f"{key}={shlex.quote(value)}" for key, value in settings.items())
     return f"{assignments} sh {shlex.quote(robot.target + '/stage/' + ROBOT_SCRIPT.name)}"
 

@@ -2,7 +2,10 @@
 # Runs on the robot, started by `tafel deploy` over SSH after it copied the release into $TARGET/stage.
 # Installs the release into its own virtual environment, checks that it imports, switches
 # $TARGET/current to it and (re)starts the program. Any failure leaves the robot on the release it had.
-# Settings come from the environment: TARGET PYTHON DEPENDENCIES SERVICE COMMAND START_CHECK_S MIN_FREE_MB.
+# Settings come from the environment: TARGET PYTHON DEPENDENCIES SERVICE COMMAND START_TIMEOUT_S
+# START_CHECK_S MIN_FREE_MB. A `run` program counts as started when it reports that each of its contexts
+# ran a frame (its --ready-file; under systemd READY=1), not after a fixed wait: on a slow robot a broken
+# release can take longer to fail than any timer.
 set -eu
 cd "$TARGET"
 RELEASE=$(cat stage/RELEASE)
@@ -55,25 +58,38 @@ stop_program() {
     fi
 }
 
-start_program() {  # $1: the release folder the program runs from, $2: tafel's arguments
+reports_ready() {  # $1: tafel's arguments; only `run` reports its start
+    case "$1" in run|run\ *) return 0 ;; *) return 1 ;; esac
+}
+
+start_program() {  # $1: the release folder the program runs from, $2: tafel's arguments, $3: "ready" to ask for the report
+    rm -f tafel.ready
+    ready_argument=""
+    [ "${3:-}" = ready ] && ready_argument="--ready-file $TARGET/tafel.ready"
     if [ "$SERVICE" = systemd ]; then
         mkdir -p "$HOME/.config/systemd/user"
+        service_type=simple
+        [ -n "$ready_argument" ] && service_type=notify
         cat >"$HOME/.config/systemd/user/tafel.service" <<UNIT
 [Unit]
 Description=Tafel robot control program
 
 [Service]
+Type=$service_type
+NotifyAccess=main
+TimeoutStartSec=$START_TIMEOUT_S
 WorkingDirectory=$TARGET
-ExecStart=$TARGET/current/bin/tafel $2 --config $TARGET/current/config
+ExecStart=$TARGET/current/bin/tafel $2 --config $TARGET/current/config $ready_argument
 Restart=on-failure
 
 [Install]
 WantedBy=default.target
 UNIT
-        systemctl --user daemon-reload && systemctl --user restart tafel.service
+        # with Type=notify this waits for READY=1; a failed start is judged below, not by set -e
+        systemctl --user daemon-reload && systemctl --user restart tafel.service || true
     else
         # shellcheck disable=SC2086 - the arguments are words
-        nohup "$TARGET/$1/bin/tafel" $2 --config "$TARGET/$1/config" >tafel.log 2>&1 </dev/null &
+        nohup "$TARGET/$1/bin/tafel" $2 --config "$TARGET/$1/config" $ready_argument >tafel.log 2>&1 </dev/null &
         echo $! >tafel.pid
     fi
 }
@@ -88,17 +104,34 @@ running() {
 
 switch_to() { ln -sfn "$1" current; }
 
+wait_until_ready() {  # until the program wrote tafel.ready, died, or START_TIMEOUT_S passed (systemctl waited already)
+    [ "$SERVICE" = systemd ] && return 0
+    deadline=$(( $(date +%s) + ${START_TIMEOUT_S%.*} + 1 ))
+    while [ ! -f tafel.ready ]; do
+        running || return 1
+        [ "$(date +%s)" -lt "$deadline" ] || { echo "release $RELEASE did not report its start within ${START_TIMEOUT_S} s" >&2; return 1; }
+        sleep 0.2
+    done
+}
+
 PREVIOUS_COMMAND=$(cat current.command 2>/dev/null || echo "$COMMAND")
 stop_program
 switch_to "$NEW"
-start_program "$NEW" "$COMMAND"
-sleep "$START_CHECK_S"
-if running; then
+if reports_ready "$COMMAND"; then
+    start_program "$NEW" "$COMMAND" ready
+    started=0
+    wait_until_ready && started=1
+else
+    start_program "$NEW" "$COMMAND"
+    started=1
+fi
+[ "$started" = 1 ] && sleep "$START_CHECK_S"
+if [ "$started" = 1 ] && running; then
     echo "$COMMAND" >current.command
     echo "running release $RELEASE (tafel $COMMAND)"
     exit 0
 fi
-echo "release $RELEASE did not keep running; its last lines:" >&2
+echo "release $RELEASE did not start or did not keep running; its last lines:" >&2
 tail -n 5 tafel.log >&2 2>/dev/null || true
 stop_program
 if [ -n "$PREVIOUS" ]; then

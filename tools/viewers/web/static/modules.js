@@ -4,7 +4,7 @@
 // module enables or disables it; providers are chosen above the picture.
 
 import { arg } from "./connection.js";
-import { el, every } from "./views.js";
+import { el, every, userChanges } from "./views.js";
 
 const SVG = "http://www.w3.org/2000/svg";
 const svg = (tag, attributes = {}) => {
@@ -44,8 +44,13 @@ export function modulesView(body, connection, state, panel) {
   fitButton.onclick = () => fit();
   actual.onclick = () => { view.fitted = false; zoomAt(1 / view.k, picture.clientWidth / 2, picture.clientHeight / 2); };
 
+  const clicks = userChanges();
   async function refresh() {
-    try { graphs = await connection.json("modules:list -format json"); } catch (error) { tell(error.message); return; }
+    const current = clicks.asked();
+    let answer;
+    try { answer = await connection.json("modules:list -format json"); } catch (error) { tell(error.message); return; }
+    if (!current()) return;
+    graphs = answer;
     state.modules.graphs = graphs;
     draw();
   }
@@ -61,7 +66,7 @@ export function modulesView(body, connection, state, panel) {
       .map(([rep, info]) => {
         const choice = el("select", { dataset: { representation: rep, context } },
           ...info.alternatives.map((m) => el("option", { value: m, textContent: m, selected: m === info.provider })));
-        choice.onchange = async () => { tell(await connection.ask(`modules:provider -representation ${rep} ${arg("module", choice.value)} -context ${context}`)); refresh(); };
+        choice.onchange = async () => { clicks.changed(); tell(await connection.ask(`modules:provider -representation ${rep} ${arg("module", choice.value)} -context ${context}`)); refresh(); };
         return el("label", { title: `which module provides ${rep} in ${context}` }, `${rep} (${context}) by `, choice);
       })));
     showDetail();
@@ -76,7 +81,7 @@ export function modulesView(body, connection, state, panel) {
     const module = graph?.modules?.find((m) => m.name === selected.name);
     if (!module) { detail.replaceChildren(el("span", { className: "muted", textContent: "click a module to enable or disable it" })); return; }
     const box = el("input", { type: "checkbox", checked: module.enabled });
-    box.onchange = async () => { tell(await connection.ask(`modules:set ${arg("module", module.name)} -enabled ${box.checked} -context ${selected.context}`)); refresh(); };
+    box.onchange = async () => { clicks.changed(); tell(await connection.ask(`modules:set ${arg("module", module.name)} -enabled ${box.checked} -context ${selected.context}`)); refresh(); };
     const time = module.mean_us != null ? `mean ${(module.mean_us / 1000).toFixed(2)} ms, max ${(module.max_us / 1000).toFixed(2)} ms` : "not running";
     detail.replaceChildren(el("strong", { textContent: `${module.name} (${selected.context})` }), el("label", {}, box, " enabled"),
       el("span", { className: module.errors ? "error" : "muted", textContent: `${time}${module.errors ? `, ${module.errors} errors: ${module.last_error}` : ""}` }));

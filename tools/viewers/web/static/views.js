@@ -20,6 +20,13 @@ export function every(seconds, panel, connection, task) {
   setInterval(run, seconds * 1000);
 }
 
+// A list asked for before the user's last change answers after it and would show the page as it was
+// before the click: such answers are dropped (the next refresh comes soon).
+export function userChanges() {
+  let changes = 0;
+  return { changed: () => { changes += 1; }, asked: () => { const at = changes; return () => at === changes; } };
+}
+
 function answerNote(node, answer) {
   node.textContent = answer;
   node.className = answer.startsWith("error:") ? "error" : "ok";
@@ -272,9 +279,12 @@ export function debugRequestsView(body, connection, state, panel) {
   const note = el("div");
   body.append(note, tree);
   const open = new Set();
+  const clicks = userChanges();
   async function refresh() {
+    const current = clicks.asked();
     let lists;
     try { lists = await connection.json("debug_request:list -format json"); } catch (error) { answerNote(note, error.message); return; }
+    if (!current()) return;
     state.debugRequests = lists;
     const root = {};
     for (const [context, requests] of Object.entries(lists)) {
@@ -293,6 +303,7 @@ export function debugRequestsView(body, connection, state, panel) {
       if (child.request) {
         const box = el("input", { type: "checkbox", checked: child.request.on, dataset: { request: child.request.name } });
         box.addEventListener("change", async () => {
+          clicks.changed();
           answerNote(note, await connection.ask(`debug_request:set ${arg("name", child.request.name)} -value ${box.checked ? "on" : "off"} -context ${child.context}`));
         });
         return el("div", { className: "leaf", title: child.request.description }, el("label", {}, box, ` ${name}`),
