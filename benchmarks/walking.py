@@ -14,6 +14,10 @@ cameras rendered. Only the get-ups: ``--parts getups``.
 
     python benchmarks/walking.py [--minutes 10] [--kicks 10] [--getups 10] [--push-seeds 5]
                                  [--engines mujoco,pybullet] [--parts speeds,random_walk,pushes,...]
+                                 [--set parameters.WalkingEngine.foot_lift=25 ...]
+
+``--set`` changes configuration values as ``tafel run --set`` does, for trying a parameter against
+ground truth before it goes into ``config/``; the JSON line names what was set.
 
 Prints one JSON line. Targets (MuJoCo, this 2-core machine): forward >= 200 mm/s, sideways >= 100 mm/s,
 turning >= 0.8 rad/s, 0 falls in 10 minutes, odometry error <= 10 %, kick >= 3 m, get-up 10/10 each within
@@ -36,6 +40,7 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 os.environ.setdefault("MUJOCO_GL", "egl")
 
+from tafel.core.framework.errors import TafelError  # noqa: E402
 from tafel.representations.motion_control import Foot, MotionRequest, MotionType, Odometry  # noqa: E402
 from tests.support.driven import PUSH_FROM, Driven  # noqa: E402
 from tests.support.getting_up import get_up, seeded_walk_s  # noqa: E402
@@ -45,7 +50,7 @@ def speeds(engine: str) -> dict[str, float]:
     """Ground-truth speed over 10 s at the largest request in each direction (from a standstill)."""
     result = {}
     for name, request in (("forward_mm_s", (1000.0, 0.0, 0.0)), ("sideways_mm_s", (0.0, 1000.0, 0.0)), ("turn_rad_s", (0.0, 0.0, 10.0))):
-        driven = Driven(engine)
+        driven = Driven(engine, overrides=OVERRIDES)
         x0, y0, heading = driven.sim.platform.robot_pose()
         turned0 = driven.turned
         driven.request = MotionRequest(motion=MotionType.walk, walk_x=request[0], walk_y=request[1], walk_rotation=request[2])
@@ -62,7 +67,7 @@ def speeds(engine: str) -> dict[str, float]:
 def random_walk(engine: str, minutes: float, seed: int = 1) -> dict[str, float]:
     """Falls and odometry error over random walk requests, a new one every 2 s."""
     rng = np.random.default_rng(seed)
-    driven = Driven(engine)
+    driven = Driven(engine, overrides=OVERRIDES)
     walked = error = 0.0
     for _ in range(int(minutes * 30)):
         x0, y0, h0 = driven.sim.platform.robot_pose()
@@ -98,7 +103,7 @@ def kicks(engine: str, count: int) -> dict[str, float]:
     distances = []
     falls = 0
     for i in range(count):
-        driven = Driven(engine, seed=i)
+        driven = Driven(engine, overrides=OVERRIDES, seed=i)
         x, y, heading = driven.sim.platform.robot_pose()
         foot = Foot.left if i % 2 == 0 else Foot.right
         side = 50.0 if foot is Foot.left else -50.0
@@ -125,7 +130,7 @@ def getups(engine: str, tries: int) -> dict[str, object]:
     for side in ("front", "back"):
         times, fell_again = [], 0
         for seed in range(tries):
-            attempt = get_up(engine, side, seed, seeded_walk_s(seed))
+            attempt = get_up(engine, side, seed, seeded_walk_s(seed), overrides=OVERRIDES)
             if attempt.succeeded and attempt.up_s is not None:
                 times.append(attempt.up_s)
             fell_again += attempt.up_s is not None and not attempt.stayed_up
@@ -144,7 +149,7 @@ def largest_push_survived(engine: str, side: str, seed: int, forces: tuple[float
     seeded, so that the pushes meet the step at different phases) until the robot falls (ground truth):
     the largest force survived (0 when the first one throws it over)."""
     rng = np.random.default_rng(seed)
-    driven = Driven(engine, seed=seed, start="-3500,0,0")
+    driven = Driven(engine, overrides=OVERRIDES, seed=seed, start="-3500,0,0")
     driven.request = MotionRequest(motion=MotionType.walk, walk_x=150.0)
     driven.run(2.0)
     survived = 0.0
@@ -166,7 +171,7 @@ def pushes(engine: str, seeds: int) -> dict[str, dict[str, float]]:
 
 
 def realtime_with_cameras(engine: str, seconds: float = 10.0) -> float:
-    driven = Driven(engine, cameras=True)
+    driven = Driven(engine, overrides=OVERRIDES, cameras=True)
     driven.request = MotionRequest(motion=MotionType.walk, walk_x=200.0, walk_rotation=0.2)
     start = time.perf_counter()
     driven.run(seconds)
@@ -174,6 +179,9 @@ def realtime_with_cameras(engine: str, seconds: float = 10.0) -> float:
     driven.close()
     return round(seconds / wall, 2)
 
+
+#: ``--set`` values every simulation of this run gets (configuration overrides, KEY=VALUE)
+OVERRIDES: list[str] = []
 
 PARTS = ("speeds", "random_walk", "pushes", "kicks", "getups", "realtime")
 
@@ -186,12 +194,19 @@ def main() -> None:
     parser.add_argument("--push-seeds", type=int, default=5, help="seeds of the pushes from each side")
     parser.add_argument("--engines", default="mujoco,pybullet")
     parser.add_argument("--parts", default=",".join(PARTS), help=f"which measurements, of {','.join(PARTS)}")
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                        help="override a configuration value, e.g. parameters.WalkingEngine.foot_lift=25 (repeatable)")
     args = parser.parse_args()
+    OVERRIDES[:] = args.overrides
+    try:  # a wrong key or value is said before minutes of simulation, as tafel run says it
+        Driven(args.engines.split(",")[0], overrides=OVERRIDES).close()
+    except TafelError as error:
+        parser.error(f"--set: {error}")
     parts = args.parts.split(",")
     unknown = sorted(set(parts) - set(PARTS))
     if unknown:
         parser.error(f"--parts: unknown {', '.join(unknown)}; choose from {','.join(PARTS)}")
-    report: dict[str, object] = {"benchmark": "walking"}
+    report: dict[str, object] = {"benchmark": "walking", "overrides": args.overrides}
     for engine in args.engines.split(","):
         started = time.perf_counter()
         figures: dict[str, object] = {}

@@ -33,10 +33,10 @@ class GetUp:
 
 
 def get_up(engine: str, side: str, seed: int, walk_s: float, before: MotionRequest = WALKING,
-           after: MotionRequest = STANDING) -> GetUp:
+           after: MotionRequest = STANDING, overrides: list[str] | None = None) -> GetUp:
     """``before`` for ``walk_s`` s, then laid down on ``side`` (front, back) where the robot is, and ``after``
-    requested from then on (the selector gets the robot up first)."""
-    driven = Driven(engine, seed=seed)
+    requested from then on (the selector gets the robot up first); ``overrides`` as ``tafel run --set``."""
+    driven = Driven(engine, seed=seed, overrides=overrides)
     try:
         driven.request = before
         if walk_s > 0:

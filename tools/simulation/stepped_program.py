@@ -12,7 +12,8 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from tafel.core.framework.config import edit_modules, load_config
+from tafel.core.framework.config import check_config, edit_modules, load_config
+from tafel.core.framework.representation import registered_representations
 from tafel.core.runtime import Limits, LockstepRuntime
 from tafel.core.runtime.platform import load_platform
 from tafel.core.runtime.program import plan_program
@@ -36,6 +37,7 @@ class SteppedProgram:
         rates = [f"runtime.{context}_hz={hz}" for context, hz in (self.platform.rates() or {}).items()]
         config = load_config(DEFAULT_CONFIG, self.platform.config_layers(), overrides=[*rates, *overrides])
         self.config = edit_modules(config, add_modules, remove_modules)
+        check_config(self.config, type(self.platform).config_sections, registered_representations())  # as tafel run does
         self.platform.configure(self.config)
         self.plans = plan_program(self.config, self.platform)
         self.recorder = None
