@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import re
+import signal
 import subprocess
 import sys
 import time
@@ -154,3 +155,47 @@ def test_bad_robot_tables_are_clear_errors(tmp_path: Path, text: str, message: s
     (tmp_path / "robots.toml").write_text(text)
     with pytest.raises(DeployError, match=re.escape(message)):
         load_robots([tmp_path])
+
+
+@pytest.mark.slow
+def test_under_systemd_the_start_counts_when_the_program_reports_it_and_a_failed_one_rolls_back(robot: dict, tmp_path: Path) -> None:
+    """The robot's script with ``service = "systemd"`` against a stand-in ``systemctl`` that starts a
+    ``Type=notify`` unit as systemd does (no systemd runs here), on the release the deploys above installed."""
+    target: Path = robot["target"]
+    if not (target / "current").exists():
+        assert deploy(robot).returncode == 0
+    pid = target / "tafel.pid"
+    if pid.exists():  # the process-mode program of the tests above
+        os.kill(int(pid.read_text()), signal.SIGKILL)
+        pid.unlink()
+    fake = tmp_path / "bin"
+    fake.mkdir()
+    (fake / "systemctl").write_text(f'#!/bin/sh\nexec {sys.executable} {REPO / "tests/support/fake_systemctl.py"} "$@"\n')
+    (fake / "systemctl").chmod(0o755)
+    unit = tmp_path / "home/.config/systemd/user/tafel.service"
+    good = "run --platform dummy --no-debug --status-interval 60"
+
+    def script(command: str) -> subprocess.CompletedProcess:
+        settings = {"TARGET": str(target), "PYTHON": sys.executable, "DEPENDENCIES": "robot", "SERVICE": "systemd",
+                    "COMMAND": command, "START_TIMEOUT_S": "60", "START_CHECK_S": "0.05", "MIN_FREE_MB": "0",
+                    "HOME": str(tmp_path / "home"), "PATH": f"{fake}:{os.environ['PATH']}"}
+        return subprocess.run(["sh", str(target / "stage/deploy_robot.sh")], capture_output=True, text=True, timeout=180,
+                              env={**os.environ, **settings})
+
+    def active() -> bool:
+        return subprocess.run([str(fake / "systemctl"), "--user", "is-active", "--quiet", "tafel.service"],
+                              env={**os.environ, "HOME": str(tmp_path / "home")}).returncode == 0
+
+    try:
+        started = script(good)
+        assert started.returncode == 0, started.stdout + started.stderr
+        assert "running release" in started.stdout
+        assert "Type=notify" in unit.read_text() and f"--ready-file {target}/tafel.ready" in unit.read_text()
+        assert active()
+        broken = script(good + " --set runtime.motion_hz=-5")  # refuses to start: never reports
+        assert broken.returncode == 1
+        assert "failed to start; the robot runs" in broken.stderr and "again" in broken.stderr
+        assert "Type=simple" in unit.read_text() and "motion_hz" not in unit.read_text()  # the one it had
+        assert active()
+    finally:
+        subprocess.run([str(fake / "systemctl"), "--user", "stop", "tafel.service"], env={**os.environ, "HOME": str(tmp_path / "home")})
