@@ -66,3 +66,10 @@ def test_the_teammate_counts_the_keeper_as_a_field_player_while_it_says_it_is_ou
     assert role_of_player_two(Role.goalkeeper, 3000.0) is Role.striker
     assert role_of_player_two(Role.striker, 3000.0) is Role.supporter
     assert role_of_player_two(Role.striker, -3000.0) is Role.striker  # the ball is back: the keeper is too, whatever it said last
+
+
+def test_the_keeper_of_a_pair_comes_out_as_soon_as_the_ball_is_in_the_opponent_half() -> None:
+    """Issue 36: out only 0.5 m into the opponent half, the keeper came too late to be passed to in the midfield."""
+    harness = keeper()
+    assert role_with_ball_at(harness, -200.0) is Role.goalkeeper
+    assert role_with_ball_at(harness, 300.0) is Role.supporter

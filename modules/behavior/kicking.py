@@ -50,6 +50,11 @@ class KickParameters:
     """mm either side of the middle within which a straight walk kick keeps the foot it chose"""
     walk_kick_straight: float = bounded(0.0, 0.5, 0.15)
     """rad within which a kick is straight: the foot on the ball's side kicks"""
+    round_ball_clearance: float = bounded(0.0, 600.0, 250.0)
+    """mm: a robot past the ball on the kick's line whose straight way to the kick's spot passes nearer the
+    ball's centre than this walks round the ball (straight on, it would push the ball back, towards its own goal)"""
+    round_ball_beside: float = bounded(150.0, 800.0, 300.0)
+    """mm beside the ball's centre the way round the ball leads"""
 
 
 #: the kick's parameters tried live: modify values Kick:NAME, declared by the modules that kick
@@ -92,9 +97,40 @@ def approach_and_kick(ball: BallModel, kick_direction: float, p: KickParameters,
     if abs(along - p.behind) < p.kick_tolerance_x and abs(across) < p.kick_tolerance_y and abs(kick_direction) < p.kick_tolerance_angle:
         out.motion, out.kick_foot, out.kick_direction = MotionType.kick, foot, kick_direction
     else:
+        target_x, target_y = round_the_ball(ball, kick_direction, target_x, target_y, p)
         out.motion = MotionType.walk_to
         out.target_x, out.target_y, out.target_rotation = target_x, target_y, kick_direction
     return target_x, target_y, kick_direction
+
+
+#: mm past the ball (along the kick's line, from the ball's centre) from which a robot may have to walk round it
+ROUND_PAST = 50.0
+
+
+def round_the_ball(ball: BallModel, kick_direction: float, target_x: float, target_y: float, p: KickParameters) -> tuple[float, float]:
+    """Where to walk on the way to the kick's spot ``target`` (robot frame mm): the spot itself, unless the robot
+    stands more than ``ROUND_PAST`` past the ball along the kick's line (``kick_direction``, rad) and the straight
+    way to the spot passes within ``round_ball_clearance`` of the ball; then round the ball on the robot's side,
+    ``round_ball_beside`` from it: first out sideways (no farther past the ball than that), then back to beside
+    the spot, from where the spot is reached sideways."""
+    ux, uy = math.cos(kick_direction), math.sin(kick_direction)
+    along, across = -(ball.x * ux + ball.y * uy), ball.x * uy - ball.y * ux  # the robot from the ball, in the kick's frame
+    if along <= ROUND_PAST or segment_distance((target_x, target_y), (ball.x, ball.y)) >= p.round_ball_clearance:
+        return target_x, target_y
+    side = 1.0 if across >= 0.0 else -1.0
+    beside = side * p.round_ball_beside
+    if abs(across) < 0.8 * p.round_ball_beside:  # in front of the ball: out sideways first
+        way_along = min(along, p.round_ball_beside)
+    else:  # beside it: back to beside the spot
+        way_along = (target_x - ball.x) * ux + (target_y - ball.y) * uy
+    return ball.x + way_along * ux - beside * uy, ball.y + way_along * uy + beside * ux
+
+
+def segment_distance(end: tuple[float, float], point: tuple[float, float]) -> float:
+    """mm from ``point`` to the segment from the origin (the robot) to ``end``."""
+    length2 = end[0] ** 2 + end[1] ** 2
+    t = max(0.0, min(1.0, (point[0] * end[0] + point[1] * end[1]) / length2)) if length2 > 0.0 else 0.0
+    return math.hypot(point[0] - t * end[0], point[1] - t * end[1])
 
 
 def walk_kick_approach(ball: BallModel, kick_direction: float, p: KickParameters, out: MotionRequest,
@@ -119,8 +155,11 @@ def walk_kick_approach(ball: BallModel, kick_direction: float, p: KickParameters
     target_x, target_y = Pose2D(ball.x, ball.y, heading).to_global(-spot_x, -spot_y)
     along, across = Pose2D(0.0, side, angle).to_local(ball.x, ball.y)
     out.motion = MotionType.walk_to
-    out.target_x, out.target_y, out.target_rotation = target_x, target_y, heading
     out.kick_foot = foot  # kept for the next frame's choice near the middle
+    way_x, way_y = round_the_ball(ball, kick_direction, target_x, target_y, p)
+    out.target_x, out.target_y, out.target_rotation = way_x, way_y, heading
+    if (way_x, way_y) != (target_x, target_y):  # past the ball: round it first, no kick
+        return way_x, way_y, heading
     if math.hypot(along - distance, across) < p.walk_kick_ask_within and abs(heading) < p.kick_tolerance_angle:
         # the long kick corrects what the robot is still turned away, up to walk_kick_long_max_angle
         residual = min(p.walk_kick_long_max_angle, max(-p.walk_kick_long_max_angle, heading))

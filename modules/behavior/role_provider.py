@@ -59,7 +59,7 @@ class RoleProvider(Module):
         """s the current striker counts quicker"""
         mate_timeout: float = bounded(0.5, 30.0, 4.0)
         """s after a teammate's last message that it still takes part"""
-        keeper_out_x: float = bounded(-4500.0, 4500.0, 500.0)
+        keeper_out_x: float = bounded(-4500.0, 4500.0, 0.0)
         """field mm: in a team of two on the field, the goalkeeper plays as a field player once the ball is beyond this"""
         keeper_back_x: float = bounded(-4500.0, 4500.0, -1000.0)
         """field mm: a goalkeeper playing as a field player keeps its goal again once the ball is behind this"""
