@@ -111,9 +111,9 @@ def supporter(opponents: list[Obstacle]) -> tuple[float, float]:
 
 def test_the_supporter_waits_ahead_and_beside_the_ball_on_the_side_open_to_a_pass() -> None:
     free = supporter([])
-    assert free == pytest.approx((1500.0, 1000.0), abs=1.0)  # supporter_offset ahead, beside
+    assert free == pytest.approx((1400.0, 1400.0), abs=1.0)  # supporter_offset ahead, beside
     assert choose_pass((0.0, 0.0), [free], [], P) is not None  # a place the pass rule passes to
-    marked = supporter([Obstacle(x=2600.0, y=1100.0, kind=ObstacleKind.robot)])  # an opponent at (1600, 1100)
-    assert marked == pytest.approx((1500.0, -1000.0), abs=1.0)
-    both = supporter([Obstacle(x=2600.0, y=1100.0, kind=ObstacleKind.robot), Obstacle(x=2600.0, y=-1100.0, kind=ObstacleKind.robot)])
+    marked = supporter([Obstacle(x=2600.0, y=1500.0, kind=ObstacleKind.robot)])  # an opponent at (1600, 1500)
+    assert marked == pytest.approx((1400.0, -1400.0), abs=1.0)
+    both = supporter([Obstacle(x=2600.0, y=1500.0, kind=ObstacleKind.robot), Obstacle(x=2600.0, y=-1500.0, kind=ObstacleKind.robot)])
     assert both[0] > 1000.0 and both[1] > 500.0  # neither open: the usual side (stopping short of the robot standing there)

@@ -101,9 +101,10 @@ class SoccerBehavior(Module):
         """mm from a position that counts as there (then the robot stands)"""
         team_ball_age: float = bounded(0.0, 30.0, 3.0)
         """s: a teammate's ball older than this is not used"""
-        supporter_offset: list[float] = field(default_factory=lambda: [1500.0, 1000.0])
+        supporter_offset: list[float] = field(default_factory=lambda: [1400.0, 1400.0])
         """mm ahead of (towards the opponent goal; negative: behind) and beside the ball (beside: towards the
-        field's long axis), where the supporter waits for a pass"""
+        field's long axis), where the supporter waits for a pass: 45 degrees off the ball's way to the goal,
+        past an opponent waiting there (at 34 degrees, 1.5 m ahead and 1 m beside, the lane was blocked)"""
         keeper_clear_distance: float = bounded(0.0, 3000.0, 1200.0)
         """mm: a ball this near the goalkeeper, in its penalty area, is cleared"""
         keep_out_margin: float = bounded(0.0, 1000.0, 300.0)
@@ -159,6 +160,8 @@ class SoccerBehavior(Module):
         """field mm: where the ball was last known (own sighting or a teammate's)"""
         self.ball_search = SearchTurn()
         """which way a search for the ball turns: towards the side it was last seen on"""
+        self.support_side = 0.0
+        """the side of the ball the supporter waits on (+1: +y, -1: -y, 0: none yet), kept while open to a pass"""
 
     def execute(self) -> None:
         out = self.motion_request

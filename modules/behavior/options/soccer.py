@@ -215,14 +215,17 @@ class Supporter(Option["SoccerBehavior"]):
     def support(self, b: SoccerBehavior) -> None:
         """``supporter_offset`` ahead of and beside the ball (beside: towards the field's long axis, or the
         other side when an opponent stands within ``pass_open`` of that spot or ``lane_width`` of the ball's
-        way to it and not of the other), at least a metre in front of the own goal and ``SUPPORT_GOAL_GAP``
-        in front of the opponent goal line, ``SUPPORT_TOUCHLINE_GAP`` inside the touchlines; facing the ball."""
+        way to it and not of the other; the side chosen last is kept while open and its spot inside the
+        touchlines, so the supporter does not cross in front of the ball to and fro), at least a metre in front
+        of the own goal and ``SUPPORT_GOAL_GAP`` in front of the opponent goal line, ``SUPPORT_TOUCHLINE_GAP``
+        inside the touchlines; facing the ball."""
         ball = b.ball_on_field() or (0.0, 0.0)
         ahead, beside = b.parameters.supporter_offset
         x = min(max(OWN_GOAL_X + 1000.0, ball[0] + ahead), pitch.LENGTH / 2 - SUPPORT_GOAL_GAP)
         inward = -math.copysign(1.0, ball[1]) if abs(ball[1]) > 100.0 else 1.0
         limit = pitch.WIDTH / 2 - SUPPORT_TOUCHLINE_GAP
-        spots = [(x, max(-limit, min(limit, ball[1] + side * beside))) for side in (inward, -inward)]
+        first = b.support_side if b.support_side and abs(ball[1] + b.support_side * beside) <= limit else inward
+        spots = [(x, max(-limit, min(limit, ball[1] + side * beside))) for side in (first, -first)]
         pose, p = b.robot_pose, b.parameters
         opponents = [pose.to_field(o.x, o.y) for o in b.obstacles.obstacles if o.kind is ObstacleKind.robot] if pose.valid else []
 
@@ -230,7 +233,9 @@ class Supporter(Option["SoccerBehavior"]):
             return (all(math.dist(spot, o) >= p.pass_open for o in opponents)
                     and lane_clearance(ball, spot, opponents) >= p.lane_width)
 
-        x, y = spots[0] if open_to_pass(spots[0]) or not open_to_pass(spots[1]) else spots[1]
+        kept = open_to_pass(spots[0]) or not open_to_pass(spots[1])
+        b.support_side = first if kept else -first
+        x, y = spots[0] if kept else spots[1]
         self.call(GoTo, x=x, y=y, rotation=b.facing_ball(x, y))
 
 

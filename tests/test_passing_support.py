@@ -1,0 +1,49 @@
+"""Where SoccerBehavior's supporter waits for a pass (issue 36): in a 2v2 the opponent striker holds back
+0.6 to 0.7 m before the ball on its way to the goal, and the supporter must stay open past it."""
+
+from __future__ import annotations
+
+import math
+
+from tafel.core.testing import ModuleHarness
+from tafel.modules.behavior.passing import PassParameters, choose_pass
+from tafel.modules.behavior.soccer_behavior import SoccerBehavior
+from tafel.representations.game import GameState, RobotInfo, State, TeamInfo
+from tafel.representations.modeling import BallModel, RobotPose
+from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType
+from tafel.representations.obstacles import Obstacle, ObstacleKind, Obstacles
+from tafel.representations.team import PlayerRole, Role, TeamMates
+
+POSE = RobotPose(valid=True, x=1600.0, y=0.0)  # the supporter, facing the opponent goal, its way to either side free
+
+
+def supporter() -> ModuleHarness:
+    team = TeamInfo(team_number=1, players=[RobotInfo() for _ in range(20)])
+    state = GameState(state=State.playing, teams=[team, TeamInfo(team_number=2)], team_number=1, player_number=2, kicking_team=1)
+    return ModuleHarness(SoccerBehavior, state, PlayerRole(role=Role.supporter), POSE, BallModel(valid=True, seen=True),
+                         TeamMates(), MotionInfo(), Obstacles())
+
+
+def spot(harness: ModuleHarness, ball: tuple[float, float], opponents: list[tuple[float, float]]) -> tuple[float, float]:
+    """Where the supporter walks (field mm) with the ball and the opponents at these field places."""
+    obstacles = [Obstacle(x=x - POSE.x, y=y - POSE.y, kind=ObstacleKind.robot) for x, y in opponents]
+    harness.set(BallModel(valid=True, seen=True, x=ball[0] - POSE.x, y=ball[1] - POSE.y), Obstacles(obstacles=obstacles))
+    out = harness.execute()[MotionRequest]
+    assert out.motion is MotionType.walk_to
+    return POSE.to_field(out.target_x, out.target_y)
+
+
+def test_the_supporter_is_open_to_a_pass_past_an_opponent_holding_back_before_the_ball() -> None:
+    ball, holding = (200.0, -300.0), (850.0, -300.0)  # as in a 2v2 (seed 1): the opponent 0.65 m before the ball
+    place = spot(supporter(), ball, [holding])
+    assert choose_pass(ball, [place], [holding], PassParameters()) is not None  # at 1.5 m ahead, 1 m beside: blocked
+
+
+def test_the_supporter_keeps_its_side_while_it_is_open() -> None:
+    harness = supporter()
+    first = spot(harness, (0.0, 50.0), [])  # towards the long axis: +y
+    assert first[1] > 1000.0
+    moved = spot(harness, (0.0, 200.0), [])  # the ball crossed the axis a little: the supporter does not cross before it
+    assert moved[1] > 1000.0 and math.isclose(moved[1], 200.0 + 1400.0, abs_tol=1.0)
+    other = spot(harness, (0.0, 200.0), [(1400.0, 1600.0)])  # its spot marked: the other side
+    assert other[1] < -1000.0
