@@ -47,3 +47,15 @@ def test_the_supporter_keeps_its_side_while_it_is_open() -> None:
     assert moved[1] > 1000.0 and math.isclose(moved[1], 200.0 + 1400.0, abs_tol=1.0)
     other = spot(harness, (0.0, 200.0), [(1400.0, 1600.0)])  # its spot marked: the other side
     assert other[1] < -1000.0
+
+
+def test_a_blocked_shot_goes_to_a_teammate_with_an_open_shot_though_it_is_not_a_metre_nearer() -> None:
+    """The 2v2 seed 1 (d69f560, 160 to 207 s): the strikers 0.65 m apart kicked the ball into each other ten
+    times while the supporter, 45 degrees off, stood 0.7 to 0.9 m nearer the goal with an open shot."""
+    p = PassParameters()
+    ball, holding, keeper, mate = (1600.0, 130.0), (2250.0, 90.0), (4200.0, 0.0), (3010.0, 1550.0)
+    assert choose_pass(ball, [mate], [holding, keeper], p) is not None
+    assert choose_pass(ball, [mate], [keeper], p) is None  # the own shot open: shoot
+    assert choose_pass(ball, [(3010.0, 1550.0)], [holding, keeper, (3300.0, 1500.0)], p) is None  # the teammate marked
+    far = (-1500.0, 100.0), (-850.0, 90.0), (-700.0, 1550.0)  # far from the goal: no open shot there, no pass (0.6 m nearer)
+    assert choose_pass(far[0], [far[2]], [far[1], keeper], p) is None

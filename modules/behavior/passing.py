@@ -5,7 +5,10 @@ kick (``SoccerBehavior``); not a module.
 The pass rule: the player with the ball passes to a teammate when all of these hold (else it shoots):
 
 1. the teammate is better placed to score: at least ``pass_gain`` mm nearer the opponent goal's centre than
-   the ball;
+   the ball; or, when every lane of the own shot is blocked, it has an open shot itself (a lane to the goal
+   mouth clear by ``lane_width``, from within ``shot_range`` of the goal) and is at least ``blocked_gain`` mm
+   nearer the goal than the ball (in a 2v2 the opponent striker holds back 0.65 m before the ball, on its
+   way to the goal, and the supporter, 45 degrees off that way, could not be 1 m nearer within the field);
 2. it is within a kick's reach: ``pass_min`` to ``pass_max`` mm from the ball;
 3. it is open: no opponent within ``pass_open`` mm of it;
 4. the lane is clear: no opponent within ``lane_width`` mm of the ball's way to it;
@@ -54,6 +57,9 @@ class PassParameters:
     """mm ahead of the teammate (towards the opponent goal) the pass is aimed"""
     shot_aims: int = bounded(1, 9, 5)
     """points across the goal mouth a shot may aim at (the most open is taken)"""
+    blocked_gain: float = bounded(-5000.0, 5000.0, 0.0)
+    """mm a teammate with an open shot must be nearer the opponent goal than the ball to be passed to when the own
+    shot is blocked"""
 
 
 def lane_clearance(start: Point, end: Point, others: Sequence[Point]) -> float:
@@ -84,17 +90,26 @@ def best_shot(ball: Point, opponents: Sequence[Point], p: PassParameters) -> tup
     return aim, clearance
 
 
+def open_shot(place: Point, opponents: Sequence[Point], p: PassParameters) -> bool:
+    """Whether a robot at ``place`` (field mm) has an open shot: within ``shot_range`` of the goal and a lane to
+    the goal mouth clear by ``lane_width``."""
+    return math.dist(place, GOAL) <= p.shot_range and best_shot(place, opponents, p)[1] >= p.lane_width
+
+
 def choose_pass(ball: Point, mates: Sequence[Point], opponents: Sequence[Point], p: PassParameters) -> Point | None:
     """Where to pass by the rule above (field mm: ``pass_lead`` ahead of the chosen teammate), or None: shoot."""
     _, shot_clearance = best_shot(ball, opponents, p)
     if math.dist(ball, GOAL) <= p.shot_range and shot_clearance >= p.lane_width:
         return None  # an open shot from near enough
     ball_to_goal = math.dist(ball, GOAL)
+    blocked = shot_clearance < p.lane_width
     best: tuple[float, Point] | None = None
     for mate in mates:
         to_goal = math.dist(mate, GOAL)
         distance = math.dist(ball, mate)
-        if to_goal > ball_to_goal - p.pass_gain or not p.pass_min <= distance <= p.pass_max:
+        if not p.pass_min <= distance <= p.pass_max:
+            continue
+        if to_goal > ball_to_goal - p.pass_gain and not (blocked and to_goal <= ball_to_goal - p.blocked_gain and open_shot(mate, opponents, p)):
             continue
         if any(math.dist(mate, o) < p.pass_open for o in opponents) or lane_clearance(ball, mate, opponents) < p.lane_width:
             continue
