@@ -73,3 +73,23 @@ def test_a_ball_found_by_searching_is_looked_at_before_the_next_glance() -> None
         harness.set(FrameInfo(frame_number=frame, time_ns=frame * FRAME_NS))
         yaws.append(harness.execute()[HeadMotionRequest].yaw)
     assert all(abs(yaw - math.atan2(500.0, 2000.0)) < 1e-9 for yaw in yaws)
+
+
+def test_each_place_is_looked_at_for_a_dwell_once_the_head_can_be_there() -> None:
+    """The two places lie on either side: the nearer to the head first, and each for ``candidate_dwell`` s
+    after the time the head needs to get there at ``track_speed`` (a dwell counted from the request ended
+    before the head had arrived: the ball behind the shoulder was never in view)."""
+    p = LookAtBallBehavior.Parameters()
+    pose = RobotPose(valid=False, lost=True, x=0.0, y=0.0, rotation=0.0, deviation=120.0)
+    ball = (2000.0 * math.cos(1.9), 2000.0 * math.sin(1.9))  # from the estimate 1.9 rad left, from the twin 1.24 right
+    yaws = [yaw for yaw, _ in requests(pose, ball, 4.0)]
+    left, right = 1.9, 1.9 - math.pi
+    runs: list[tuple[float, int]] = []  # (yaw, frames in a row)
+    for yaw in yaws:
+        if runs and abs(runs[-1][0] - yaw) < 1e-6:
+            runs[-1] = (yaw, runs[-1][1] + 1)
+        else:
+            runs.append((yaw, 1))
+    assert abs(runs[0][0] - right) < 1e-6 and abs(runs[1][0] - left) < 1e-6  # the nearer to the head (at 0) first
+    assert runs[0][1] >= (abs(right) / p.track_speed + p.candidate_dwell) * 30 - 1
+    assert runs[1][1] >= ((left - right) / p.track_speed + p.candidate_dwell) * 30 - 1

@@ -36,12 +36,28 @@ def test_it_turns_towards_the_teams_ball_behind_it() -> None:
     assert turn(pose, (-2000.0, 800.0)) > 0.0  # behind, on the left
 
 
-def test_an_unsure_robot_does_not_turn_by_the_teams_ball() -> None:
-    """With the pose not valid the team's ball may lie where it is seen from the estimate or from its twin (the
-    head looks at both): it does not choose the turn; the last seen ball is no guide either for a robot that
-    lost its pose (it may have been carried): the first search turns left, as it always did."""
+def test_an_unsure_robot_turns_by_both_places_of_the_teams_ball() -> None:
+    """With the pose not valid but the particles gathered, the team's ball lies where it is seen from the
+    estimate or from its twin, each as likely: the turn brings the one beyond the head's reach into reach the
+    shorter way (the other, ahead, the head looks at meanwhile). Spread particles give no place; the last seen
+    ball is no guide either for a robot that lost its pose (it may have been carried): it turns left, as the
+    first search always does."""
     pose = RobotPose(valid=False, lost=True, x=0.0, y=0.0, rotation=0.0, deviation=150.0, mirror_probability=0.5)
-    assert turn(pose, (-2000.0, -800.0), BallModel(valid=False, x=-500.0, y=-1000.0, time_since_seen=2.0)) > 0.0
+    last_seen = BallModel(valid=False, x=-500.0, y=1000.0, time_since_seen=2.0)
+    assert turn(pose, (-2000.0, -800.0), last_seen) < 0.0  # from the estimate behind on the right, from the twin ahead
+    assert turn(pose, (2000.0, -800.0), last_seen) > 0.0  # from the twin behind on the left, from the estimate ahead
+    spread = RobotPose(valid=False, lost=True, x=0.0, y=0.0, rotation=0.0, deviation=2000.0, mirror_probability=0.5)
+    assert turn(spread, (-2000.0, -800.0), BallModel(valid=False, x=-500.0, y=-1000.0, time_since_seen=2.0)) > 0.0
+
+
+def test_places_looked_at_from_a_pose_the_particles_left_count_again() -> None:
+    """The estimate jumps (the particles found another place): a place that was within the head's reach from the
+    old estimate lies elsewhere from the new one and counts again in the turn."""
+    harness = ModuleHarness(Striker, BallModel(valid=False), team((2000.0, 300.0)), Odometry(), MotionInfo())
+    harness.set(RobotPose(valid=False, lost=True, x=0.0, y=0.0, rotation=0.0, deviation=150.0, mirror_probability=0.5))
+    assert harness.execute()[MotionRequest].walk_rotation < 0.0  # the estimate's place ahead, the twin's behind on the right
+    harness.set(RobotPose(valid=False, lost=True, x=0.0, y=0.0, rotation=-2.54, deviation=150.0, mirror_probability=0.5))
+    assert harness.execute()[MotionRequest].walk_rotation > 0.0  # now the estimate's place lies behind on the left
 
 
 def test_without_a_teams_ball_it_turns_towards_the_last_seen_ball_or_the_way_it_turned_last() -> None:

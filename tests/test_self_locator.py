@@ -194,6 +194,25 @@ def test_the_watch_for_a_carry_starts_only_on_contradictions_in_frames_in_a_row(
     assert run.harness.module.contradicted >= after
 
 
+def test_a_ball_seen_far_from_the_teams_ball_and_from_its_mirror_image_contradicts_the_estimate() -> None:
+    """Carried next to the ball where the lines the head sees (looking at the ball) half fit the old place, the
+    ball seen from the old pose lies far from where the team says it is and from its mirror image: that counts
+    towards the watch as a seen post where none stands does. Near the team's ball it agrees; near its mirror
+    image it says nothing (the side belief weighs the twins)."""
+    run = Run()
+    truth = (-1500.0, 500.0, 0.2)
+    for _ in range(120):
+        run.step(truth)
+    locator, ball = run.harness.module, (-500.0, 800.0)
+    for frame in range(2):  # nothing else seen: the ball alone says so
+        run.step(truth, seeing=False, ball=ball, team_ball=(2500.0, -2000.0))
+        assert locator.contradicted == frame + 1
+    run.step(truth, seeing=False, ball=ball, team_ball=(500.0, -800.0))  # the mirror image
+    assert locator.contradicted == 2
+    run.step(truth, seeing=False, ball=ball, team_ball=ball)
+    assert locator.contradicted == 0
+
+
 def test_found_again_as_the_twin_of_where_it_was_decided_it_takes_the_decided_side() -> None:
     """The side was decided at a place; the particles scatter (a frame that saw little) and gather again
     folded onto the twin of that place: the belief is about the place, so the pose is found there again,

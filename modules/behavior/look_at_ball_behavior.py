@@ -14,6 +14,8 @@ from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.team import TeamMates
 
+HEAD_YAW_LIMIT = 2.0857  # rad: the farthest the head turns to either side (requests beyond go there)
+
 
 def sweep(start: float, direction: float, distance: float, amplitude: float) -> float:
     """Where a point moving ``distance`` from ``start`` in ``direction`` (+1/-1) is, bouncing at ±amplitude."""
@@ -39,8 +41,10 @@ class LookAtBallBehavior(Module):
 
     While the pose is not valid (a robot carried elsewhere: the field cannot tell it from its twin, only
     the team's ball can) and the particles have gathered, the search looks first where a teammate's ball
-    would be from the estimate and from its twin, each within the head's reach for ``candidate_dwell`` s,
-    then sweeps; the sweep reaches ``search_amplitude_lost`` then, to show the field round the robot.
+    would be from the estimate and from its twin, those within the head's reach, the one nearer the head
+    first, each for ``candidate_dwell`` s once the head can have got there (at ``track_speed``: from one
+    side to the other takes over a second, and a dwell counted from the request ended before the head
+    arrived), then sweeps; the sweep reaches ``search_amplitude_lost`` then, to show the field round the robot.
 
     While penalized the head holds still where it is (``max_speed`` 0): the rules allow a penalized
     robot no motion at all until the GameController unpenalizes it. Then it looks for the ball anew."""
@@ -100,7 +104,10 @@ class LookAtBallBehavior(Module):
     def __init__(self) -> None:
         self.search_start: tuple[float, float, float] | None = None  # (time s, yaw rad, direction)
         self.last_glance = 0.0  # s when the last glance started
-        self.candidates_since: float | None = None  # s since when the search has had a teammate's ball to look at
+        self.cycle: list[int] | None = None  # the candidate places (0: from the estimate, 1: from the twin) still to look at in turn
+        self.step_ends: float | None = None  # s when the look at the first of them ends (None: not begun)
+        self.sweep_until: float | None = None  # s until which the search sweeps between two rounds of candidates
+        self.looked = 0  # candidate places looked at in this round: the sweep after it lasts a dwell for each
         self.searching = False  # whether the last frame searched: a ball found is looked at a while before a glance
 
     def execute(self) -> None:
@@ -110,7 +117,7 @@ class LookAtBallBehavior(Module):
             request.max_speed, self.search_start = HOLD_SPEED, None
             return
         if ball.valid and ball.time_since_seen <= p.lost_after:
-            self.search_start = None
+            self.search_start, self.cycle, self.sweep_until = None, None, None
             if self.searching:  # just found: the next glance only after an interval (an unsure pose needs the ball)
                 self.searching, self.last_glance = False, now - p.glance_duration
             if self.glance(now, math.hypot(ball.x, ball.y)):
@@ -132,40 +139,56 @@ class LookAtBallBehavior(Module):
         request.pitch = p.search_pitch
         request.max_speed = p.search_speed * 1.5  # the request itself moves at search speed; keep up with it
 
-    def candidates(self) -> list[tuple[float, float]]:
-        """Where a teammate's ball would be (robot frame, mm) from the estimate and from its twin, those
+    def candidates(self) -> dict[int, tuple[float, float]]:
+        """Where a teammate's ball would be (robot frame, mm) from the estimate (0) and from its twin (1), those
         within the head's reach; none while the pose is valid or the particles are spread."""
         p, pose = self.parameters, self.robot_pose
         if pose.valid or pose.deviation > p.candidate_deviation:
-            return []
+            return {}
         team = self.team_mates.freshest_ball(p.team_ball_age)
         if team is None:
-            return []
+            return {}
         # seen from the twin (turned by 180 degrees about the centre spot), a point lies where its mirror
         # image lies seen from the estimate
-        places = [pose.to_robot(team.x, team.y), pose.to_robot(-team.x, -team.y)]
-        return [(x, y) for x, y in places
-                if abs(math.atan2(y, x)) <= p.candidate_reach and 0.0 < math.hypot(x, y) <= p.candidate_range]
+        places = {0: pose.to_robot(team.x, team.y), 1: pose.to_robot(-team.x, -team.y)}
+        return {place: (x, y) for place, (x, y) in places.items()
+                if abs(math.atan2(y, x)) <= p.candidate_reach and 0.0 < math.hypot(x, y) <= p.candidate_range}
 
     def look_at_candidates(self, now: float) -> bool:
-        """Look in turn where the teammate's ball would be from either twin, ``candidate_dwell`` s each, then
-        sweep for as long before looking again; whether the head is doing so."""
+        """Look in turn where the teammate's ball would be from either twin (the one nearer the head first),
+        ``candidate_dwell`` s each once the head can be there, then sweep for as long before looking again;
+        whether the head is doing so."""
         p, request = self.parameters, self.head_motion_request
         places = self.candidates()
         if not places:
-            self.candidates_since = None
+            self.cycle = self.step_ends = self.sweep_until = None
             return False
-        if self.candidates_since is None:
-            self.candidates_since = now
-        phase = int((now - self.candidates_since) / p.candidate_dwell) % (2 * len(places))
-        if phase >= len(places):
-            return False  # the sweep's turn: the ball may lie elsewhere, and the field round helps the particles
-        x, y = places[phase]
-        request.yaw = math.atan2(y, x)
-        request.pitch = math.atan2(p.camera_height, math.hypot(x, y)) - p.camera_tilt
-        request.max_speed = p.track_speed
-        self.search_start = None  # the sweep starts from where the head looked
-        return True
+        if self.sweep_until is not None:
+            if now < self.sweep_until:
+                return False  # the sweep's turn: the ball may lie elsewhere, and the field round helps the particles
+            self.sweep_until = None
+        head = max(-HEAD_YAW_LIMIT, min(HEAD_YAW_LIMIT, request.yaw))  # where the head is (about: it follows the request)
+        if self.cycle is None:
+            self.cycle = sorted(places, key=lambda place: abs(math.atan2(places[place][1], places[place][0]) - head))
+            self.step_ends, self.looked = None, 0
+        while self.cycle:
+            place = self.cycle[0]
+            if place in places:
+                x, y = places[place]
+                yaw = math.atan2(y, x)
+                if self.step_ends is None:  # a look begins: the head's way there, then the dwell
+                    travel = abs(max(-HEAD_YAW_LIMIT, min(HEAD_YAW_LIMIT, yaw)) - head) / p.track_speed
+                    self.step_ends, self.looked = now + travel + p.candidate_dwell, self.looked + 1
+                if now < self.step_ends:
+                    request.yaw = yaw
+                    request.pitch = math.atan2(p.camera_height, math.hypot(x, y)) - p.camera_tilt
+                    request.max_speed = p.track_speed
+                    self.search_start = None  # the sweep starts from where the head looked
+                    return True
+            self.cycle.pop(0)  # looked there (or it went out of reach): the next
+            self.step_ends = None
+        self.cycle, self.sweep_until = None, now + max(1, self.looked) * p.candidate_dwell
+        return False
 
     def glance(self, now: float, ball_distance: float) -> bool:
         """Glance round if it is time (or go on with a glance begun); whether the head is glancing."""

@@ -336,10 +336,10 @@ class SelfLocator(Module):
 
     def count_contradictions(self) -> None:
         """Count the frames in a row in which the centre circle or a goal post, seen from the estimate (moved by
-        odometry), lies beyond 2.5 standard deviations of the circle's or the nearest post's place, or many line
-        points (``WATCH_LINES_OFF``) lie that far off every line: the robot may have been carried where the
-        particles still half fit. A frame that sees none of them leaves the count; one in which all agree
-        starts it anew."""
+        odometry), lies beyond 2.5 standard deviations of the circle's or the nearest post's place, many line
+        points (``WATCH_LINES_OFF``) lie that far off every line, or the ball seen lies that far from the team's
+        ball and from its mirror image: the robot may have been carried where the particles still half fit. A
+        frame that sees none of them leaves the count; one in which all agree starts it anew."""
         p = self.parameters
         if self.estimate is None:
             return
@@ -357,8 +357,24 @@ class SelfLocator(Module):
             off = float(np.mean(FIELD_MODEL.line_distance(seen)[0] / self.point_std(points) >= 2.5))
             if off >= WATCH_LINES_OFF or off <= WATCH_LINES_ON:  # in between, lines say nothing either way
                 verdicts.append(off >= WATCH_LINES_OFF)
+        ball_off = self.team_ball_off(pose)
+        if ball_off is not None and (ball_off[0] < 2.5 or min(ball_off) >= 2.5):  # near the mirror image: the side belief's matter
+            verdicts.append(min(ball_off) >= 2.5)
         if verdicts:
             self.contradicted = self.contradicted + 1 if any(verdicts) else 0
+
+    def team_ball_off(self, pose: Pose2D) -> tuple[float, float] | None:
+        """The ball seen this frame, placed on the field from ``pose``, against the team's ball and its mirror image
+        (the twin's view): the distances in standard deviations (as the side belief weighs them); None without
+        either ball. Far from both, the pose is wrong, not mirrored: a robot carried where the lines it looks at
+        (next to the ball) half fit the old place."""
+        p, ball = self.parameters, self.ball_percept
+        team = self.team_mates.freshest_ball(p.team_ball_max_age)
+        if team is None or not (ball.seen and math.isfinite(ball.x) and math.isfinite(ball.y)):
+            return None
+        std = p.team_ball_std + p.team_ball_std_per_m * math.hypot(ball.x, ball.y) / 1000.0 + p.team_ball_std_per_s * team.age
+        x, y = pose.to_global(ball.x, ball.y)
+        return math.hypot(x - team.x, y - team.y) / std, math.hypot(x + team.x, y + team.y) / std
 
     def usable_percepts(self) -> bool:
         """Whether this frame saw something fresh poses can be made from: the circle, a post, a line segment."""
