@@ -73,7 +73,8 @@ def test_the_striker_turns_its_kick_to_a_better_placed_teammate_with_a_walk_kick
     ball_x, ball_y = -2500.0, 0.0
     aim = math.atan2(1500.0 - ball_y, -1000.0 - ball_x)  # about 0.79 rad (the lead turns it a little towards the goal)
     assert passing.motion is MotionType.walk_to and passing.target_rotation == pytest.approx(aim, abs=0.1)  # the long walk kick faces it
-    marked = striker([mate], [Obstacle(x=2000.0, y=1700.0, kind=ObstacleKind.robot)])  # an opponent beside the teammate: a shot (through the open side)
+    marked = striker([mate], [Obstacle(x=2500.0, y=1500.0, kind=ObstacleKind.robot),  # the teammate seen 0.5 m on from where it said
+                              Obstacle(x=2600.0, y=1800.0, kind=ObstacleKind.robot)])  # an opponent beside it: a shot (through the open side)
     assert marked.target_rotation == pytest.approx(0.0, abs=0.1)
     fallen = striker([TeamMessage(team=1, player=3, pose_valid=True, fallen=True, x=-1000.0, y=1500.0)])
     assert fallen.target_rotation == pytest.approx(0.0, abs=0.1)

@@ -59,3 +59,26 @@ def test_a_blocked_shot_goes_to_a_teammate_with_an_open_shot_though_it_is_not_a_
     assert choose_pass(ball, [(3010.0, 1550.0)], [holding, keeper, (3300.0, 1500.0)], p) is None  # the teammate marked
     far = (-1500.0, 100.0), (-850.0, 90.0), (-700.0, 1550.0)  # far from the goal: no open shot there, no pass (0.6 m nearer)
     assert choose_pass(far[0], [far[2]], [far[1], keeper], p) is None
+
+
+def striker_kick_deg(mate_said: tuple[float, float], seen: list[tuple[float, float]]) -> float:
+    """The direction (field degrees) the striker at (-400, 0), the ball 0.2 m ahead, walks to kick with a
+    teammate that said it was at ``mate_said`` and robots seen at ``seen`` (field mm); 0: at the goal."""
+    from tafel.representations.team import TeamMate, TeamMessage
+    team = TeamInfo(team_number=1, players=[RobotInfo() for _ in range(20)])
+    state = GameState(state=State.playing, teams=[team, TeamInfo(team_number=2)], team_number=1, player_number=2, kicking_team=1)
+    pose = RobotPose(valid=True, x=-400.0, y=0.0)
+    obstacles = Obstacles(obstacles=[Obstacle(x=x - pose.x, y=y - pose.y, kind=ObstacleKind.robot) for x, y in seen])
+    message = TeamMessage(team=1, player=1, pose_valid=True, x=mate_said[0], y=mate_said[1])
+    harness = ModuleHarness(SoccerBehavior, state, PlayerRole(role=Role.striker), pose, BallModel(valid=True, seen=True, x=200.0, y=0.0),
+                            TeamMates(mates=[TeamMate(message, age=0.3)]), MotionInfo(), obstacles)
+    return math.degrees(harness.execute()[MotionRequest].target_rotation)
+
+
+def test_the_teammate_seen_where_it_walked_since_its_message_does_not_mark_itself() -> None:
+    """In the 2v2 seed 1 (d69f560, 548 to 559 s) the striker shot into the opponent before it although the supporter
+    stood open 40 degrees off: with the supporter also seen 0.5 m from where it last said it was, it shot."""
+    mate, holding = (1200.0, 1400.0), (450.0, 0.0)  # the opponent 0.65 m before the ball
+    assert striker_kick_deg(mate, [holding]) > 30.0  # seen where it said (the obstacles count it as the teammate): a pass
+    assert striker_kick_deg(mate, [holding, (1600.0, 1700.0)]) > 30.0  # seen 0.5 m on: still a pass
+    assert abs(striker_kick_deg(mate, [holding, (1600.0, 1700.0), (1700.0, 1100.0)])) < 15.0  # and an opponent beside: no pass

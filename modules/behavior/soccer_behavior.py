@@ -28,6 +28,17 @@ from tafel.representations.team import PlayerRole, TeamMates
 OPPONENT_PENALTY_MARK_X = pitch.LENGTH / 2 - pitch.PENALTY_MARK_DISTANCE
 
 
+def not_the_mates(seen: list[tuple[float, float]], mates: list[tuple[float, float]], within: float) -> list[tuple[float, float]]:
+    """The robots ``seen`` (field mm) without the one nearest each teammate's said place (field mm) if within
+    ``within`` mm: that is the teammate itself, seen where it walked since its message."""
+    left = list(seen)
+    for mate in mates:
+        nearest = min(left, key=lambda robot: math.dist(robot, mate), default=None)
+        if nearest is not None and math.dist(nearest, mate) <= within:
+            left.remove(nearest)
+    return left
+
+
 @requires(GameState, PlayerRole, BallModel, Odometry, MotionInfo, FrameInfo)
 @uses(RobotPose, TeamMates, Obstacles)
 @provides(MotionRequest, ActivationGraph, OptionGraph)
@@ -142,6 +153,9 @@ class SoccerBehavior(Module):
         does not waver between two kick poses"""
         pass_mate_age: float = bounded(0.0, 10.0, 2.5)
         """s: a teammate whose last message is older is not passed to"""
+        pass_mate_seen: float = bounded(0.0, 3000.0, 800.0)
+        """mm: the robot seen nearest where a teammate last said it was, if this near, is that teammate (it walked
+        since; the obstacles count it as a teammate only within 400 mm), not an opponent marking it, for the pass rule"""
 
     parameters: Parameters
 
@@ -283,9 +297,10 @@ class SoccerBehavior(Module):
         bx, by = ball.field_position(pose)
         now = self.frame_info.time_s
         if self.aim is None or now - self.aim_s >= p.pass_decide_s or now < self.aim_s:
-            opponents = [pose.to_field(o.x, o.y) for o in self.obstacles.obstacles if o.kind is ObstacleKind.robot]
+            seen = [pose.to_field(o.x, o.y) for o in self.obstacles.obstacles if o.kind is ObstacleKind.robot]
             mates = [(m.message.x, m.message.y) for m in self.team_mates.fresh(p.pass_mate_age)
                      if m.message.pose_valid and not (m.message.fallen or m.message.penalized)]
+            opponents = not_the_mates(seen, [(m.message.x, m.message.y) for m in self.team_mates.fresh(p.pass_mate_age)], p.pass_mate_seen)
             target = choose_pass((bx, by), mates, opponents, p)
             self.aim, self.aim_is_pass, self.aim_s = target or best_shot((bx, by), opponents, p)[0], target is not None, now
         ax, ay = pose.to_robot(*self.aim)
