@@ -93,3 +93,22 @@ def test_each_place_is_looked_at_for_a_dwell_once_the_head_can_be_there() -> Non
     assert abs(runs[0][0] - right) < 1e-6 and abs(runs[1][0] - left) < 1e-6  # the nearer to the head (at 0) first
     assert runs[0][1] >= (abs(right) / p.track_speed + p.candidate_dwell) * 30 - 1
     assert runs[1][1] >= ((left - right) / p.track_speed + p.candidate_dwell) * 30 - 1
+
+
+def test_a_place_that_comes_within_reach_during_the_round_is_looked_at_before_the_sweep() -> None:
+    """The body turns while the head looks: the place from the estimate, out of reach at first, comes within
+    reach while the head looks at the twin's; it is looked at next, not left for the sweep (it was, when the
+    round was fixed at its start)."""
+    p = LookAtBallBehavior.Parameters()
+    ball = (2000.0 * math.cos(2.6), 2000.0 * math.sin(2.6))  # from the estimate 2.6 rad left (beyond reach), from the twin 0.54 right
+    said = TeamMessage(team=1, player=3, sent_ms=0, pose_valid=True, ball_seen=True, ball_x=ball[0], ball_y=ball[1], ball_age=0.2)
+    harness = ModuleHarness(LookAtBallBehavior, BallModel(valid=False), TeamMates(mates=[TeamMate(message=said, age=0.3)]))
+    looks: list[tuple[float, float, float]] = []  # (requested yaw, the estimate's place, the twin's place), rad
+    for i in range(1, 91):  # 3 s, the body turning left at 0.6 rad/s
+        pose = RobotPose(valid=False, lost=True, x=0.0, y=0.0, rotation=0.02 * i, deviation=120.0)
+        harness.set(FrameInfo(frame_number=i, time_ns=i * FRAME_NS), pose)
+        yaw = harness.execute()[HeadMotionRequest].yaw
+        looks.append((yaw, math.atan2(*reversed(pose.to_robot(*ball))), math.atan2(*reversed(pose.to_robot(-ball[0], -ball[1])))))
+    assert abs(looks[0][0] - looks[0][2]) < 1e-6 and abs(looks[0][1]) > p.candidate_reach  # the twin's first: the other is out of reach
+    twin_done = next(i for i, (yaw, _, twin) in enumerate(looks) if abs(yaw - twin) > 1e-6)
+    assert all(abs(yaw - estimate) < 1e-6 for yaw, estimate, _ in looks[twin_done:twin_done + int(p.candidate_dwell * 30)])

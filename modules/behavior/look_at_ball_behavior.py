@@ -96,6 +96,8 @@ class LookAtBallBehavior(Module):
         """mm: candidate places this near are looked at"""
         candidate_reach: float = 2.4
         """rad: candidate places this far to either side are looked at (the head turns to 2.09, the top camera sees 0.5 beyond)"""
+        candidate_jump: float = 500.0
+        """mm (a radian counting 1000 mm): the estimate moved this far in a frame, the candidate places are looked at anew"""
         team_ball_age: float = 3.0
         """s: a teammate's ball reported this recently gives candidate places"""
 
@@ -104,10 +106,11 @@ class LookAtBallBehavior(Module):
     def __init__(self) -> None:
         self.search_start: tuple[float, float, float] | None = None  # (time s, yaw rad, direction)
         self.last_glance = 0.0  # s when the last glance started
-        self.cycle: list[int] | None = None  # the candidate places (0: from the estimate, 1: from the twin) still to look at in turn
-        self.step_ends: float | None = None  # s when the look at the first of them ends (None: not begun)
+        self.current: int | None = None  # the candidate place (0: from the estimate, 1: from the twin) looked at now
+        self.step_ends = 0.0  # s when the look at it ends
+        self.done: set[int] = set()  # the candidate places looked at in this round: the sweep after it lasts a dwell for each
         self.sweep_until: float | None = None  # s until which the search sweeps between two rounds of candidates
-        self.looked = 0  # candidate places looked at in this round: the sweep after it lasts a dwell for each
+        self.last_pose: tuple[float, float, float] | None = None  # the pose of the last frame: did it jump?
         self.searching = False  # whether the last frame searched: a ball found is looked at a while before a glance
 
     def execute(self) -> None:
@@ -117,7 +120,7 @@ class LookAtBallBehavior(Module):
             request.max_speed, self.search_start = HOLD_SPEED, None
             return
         if ball.valid and ball.time_since_seen <= p.lost_after:
-            self.search_start, self.cycle, self.sweep_until = None, None, None
+            self.search_start, self.current, self.done, self.sweep_until = None, None, set(), None
             if self.searching:  # just found: the next glance only after an interval (an unsure pose needs the ball)
                 self.searching, self.last_glance = False, now - p.glance_duration
             if self.glance(now, math.hypot(ball.x, ball.y)):
@@ -157,38 +160,40 @@ class LookAtBallBehavior(Module):
     def look_at_candidates(self, now: float) -> bool:
         """Look in turn where the teammate's ball would be from either twin (the one nearer the head first),
         ``candidate_dwell`` s each once the head can be there, then sweep for as long before looking again;
-        whether the head is doing so."""
-        p, request = self.parameters, self.head_motion_request
+        whether the head is doing so. A place that comes within reach during the round (the estimate moved) is
+        looked at in it too; an estimate that jumps (the particles found another place) starts a new round."""
+        p, request, pose = self.parameters, self.head_motion_request, self.robot_pose
         places = self.candidates()
-        if not places:
-            self.cycle = self.step_ends = self.sweep_until = None
-            return False
+        jumped = self.last_pose is not None and (math.hypot(pose.x - self.last_pose[0], pose.y - self.last_pose[1])
+                                                 + 1000.0 * abs(math.remainder(pose.rotation - self.last_pose[2], math.tau))) > p.candidate_jump
+        self.last_pose = (pose.x, pose.y, pose.rotation)
+        if not places or jumped:
+            self.current, self.done, self.sweep_until = None, set(), None
+            if not places:
+                return False
         if self.sweep_until is not None:
             if now < self.sweep_until:
                 return False  # the sweep's turn: the ball may lie elsewhere, and the field round helps the particles
-            self.sweep_until = None
+            self.sweep_until, self.done = None, set()
         head = max(-HEAD_YAW_LIMIT, min(HEAD_YAW_LIMIT, request.yaw))  # where the head is (about: it follows the request)
-        if self.cycle is None:
-            self.cycle = sorted(places, key=lambda place: abs(math.atan2(places[place][1], places[place][0]) - head))
-            self.step_ends, self.looked = None, 0
-        while self.cycle:
-            place = self.cycle[0]
-            if place in places:
-                x, y = places[place]
-                yaw = math.atan2(y, x)
-                if self.step_ends is None:  # a look begins: the head's way there, then the dwell
-                    travel = abs(max(-HEAD_YAW_LIMIT, min(HEAD_YAW_LIMIT, yaw)) - head) / p.track_speed
-                    self.step_ends, self.looked = now + travel + p.candidate_dwell, self.looked + 1
-                if now < self.step_ends:
-                    request.yaw = yaw
-                    request.pitch = math.atan2(p.camera_height, math.hypot(x, y)) - p.camera_tilt
-                    request.max_speed = p.track_speed
-                    self.search_start = None  # the sweep starts from where the head looked
-                    return True
-            self.cycle.pop(0)  # looked there (or it went out of reach): the next
-            self.step_ends = None
-        self.cycle, self.sweep_until = None, now + max(1, self.looked) * p.candidate_dwell
-        return False
+        if self.current is not None and (self.current not in places or now >= self.step_ends):
+            self.done.add(self.current)  # looked there (or it went out of reach)
+            self.current = None
+        if self.current is None:
+            pending = [place for place in places if place not in self.done]
+            if not pending:
+                self.sweep_until = now + max(1, len(self.done)) * p.candidate_dwell
+                return False
+            self.current = min(pending, key=lambda place: abs(math.atan2(places[place][1], places[place][0]) - head))
+            target = math.atan2(places[self.current][1], places[self.current][0])
+            travel = abs(max(-HEAD_YAW_LIMIT, min(HEAD_YAW_LIMIT, target)) - head) / p.track_speed  # the head's way there, then the dwell
+            self.step_ends = now + travel + p.candidate_dwell
+        x, y = places[self.current]
+        request.yaw = math.atan2(y, x)
+        request.pitch = math.atan2(p.camera_height, math.hypot(x, y)) - p.camera_tilt
+        request.max_speed = p.track_speed
+        self.search_start = None  # the sweep starts from where the head looked
+        return True
 
     def glance(self, now: float, ball_distance: float) -> bool:
         """Glance round if it is time (or go on with a glance begun); whether the head is glancing."""
