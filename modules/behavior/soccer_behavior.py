@@ -26,6 +26,8 @@ from tafel.representations.obstacles import ROBOT_RADIUS, ObstacleKind, Obstacle
 from tafel.representations.team import PlayerRole, TeamMates
 
 OPPONENT_PENALTY_MARK_X = pitch.LENGTH / 2 - pitch.PENALTY_MARK_DISTANCE
+KEEPER_AREA_MARGIN = 150.0  # mm inside its penalty area's lines a goalkeeper is sure to be in it (the pose's error)
+KICK_HELD_BACK = 30.0  # mm a walk's target may be held back from a robot (``keep_from_pushing``) and the walk kick still be asked for
 
 
 def not_the_mates(seen: list[tuple[float, float]], mates: list[tuple[float, float]], within: float) -> list[tuple[float, float]]:
@@ -156,6 +158,9 @@ class SoccerBehavior(Module):
         pass_mate_seen: float = bounded(0.0, 3000.0, 800.0)
         """mm: the robot seen nearest where a teammate last said it was, if this near, is that teammate (it walked
         since; the obstacles count it as a teammate only within 400 mm), not an opponent marking it, for the pass rule"""
+        push_distance: float = bounded(330.0, 1000.0, 380.0)
+        """mm between this robot's centre and another robot's up to which a walk may approach it (the referee
+        calls contact at 330 mm): a walk's target is held back that far along the line to every robot near"""
 
     parameters: Parameters
 
@@ -190,6 +195,7 @@ class SoccerBehavior(Module):
         out.motion, out.walk_kick = MotionType.stand, WalkKick.none  # each frame's request starts afresh
         self.options.run(self, self.frame_info.time_s, self.activation_graph)
         self.stay_on_field()
+        self.keep_from_pushing()
         if busy is not None:  # a kick or get-up plays to its end: the options went on, the request stays
             for name, value in busy.items():
                 setattr(out, name, value)
@@ -217,6 +223,36 @@ class SoccerBehavior(Module):
                 return
             target = way_x, way_y
         out.target_x, out.target_y = target
+
+    def keep_from_pushing(self) -> None:
+        """The rules' pushing is walking into a touching opponent (its torso approaching faster than 80 mm/s):
+        a walk's target is held back along the line to every robot (not a teammate) so that the way towards it
+        ends ``push_distance`` from its centre, as near as the robot may come. Sideways to it the walk goes
+        on; the walk slows as it nears its target, so it comes to rest there rather than at contact. One
+        already nearer steps back a little, straight away from it. The rules spare the goalkeeper in its own
+        penalty area (the GameController's goalkeeper, ``KEEPER_AREA_MARGIN`` inside the area's lines by the
+        pose): it plays the ball there whoever stands at it."""
+        out, pose, team = self.motion_request, self.robot_pose, self.game_state.own_team()
+        if out.motion is not MotionType.walk_to:
+            return
+        if (team is not None and team.goalkeeper == self.game_state.player_number and pose.valid
+                and pose.x < OWN_GOAL_X + pitch.PENALTY_AREA_LENGTH - KEEPER_AREA_MARGIN
+                and abs(pose.y) < pitch.PENALTY_AREA_WIDTH / 2 - KEEPER_AREA_MARGIN):
+            return
+        x, y = out.target_x, out.target_y
+        robots = [o for o in self.obstacles.obstacles if o.kind is ObstacleKind.robot]
+        for _ in range(3):  # held back from one, the target may lead further towards another: again
+            for robot in robots:
+                distance = math.hypot(robot.x, robot.y)
+                if distance < 1.0:
+                    continue
+                ux, uy = robot.x / distance, robot.y / distance
+                towards, limit = x * ux + y * uy, distance - self.parameters.push_distance
+                if towards > limit:
+                    x, y = x - (towards - limit) * ux, y - (towards - limit) * uy
+        if math.hypot(x - out.target_x, y - out.target_y) > KICK_HELD_BACK:  # the kick's spot is out of reach: no kick
+            out.walk_kick = WalkKick.none
+        out.target_x, out.target_y = x, y
 
     # ------------------------------------------------------------------------ what the options do
     def stand(self) -> None:

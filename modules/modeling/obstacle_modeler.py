@@ -29,7 +29,8 @@ class ObstacleModeler(Module):
     walking backwards or sideways still keeps clear of it. It adds every teammate that said
     where it is within ``mate_timeout`` s and is not penalized (a penalized robot is off the field).
     A teammate's radius grows with the age of its message (``mate_spread`` mm/s: it may have walked
-    meanwhile); a seen robot within ``same_robot`` mm of a teammate is that teammate, and one seen
+    meanwhile); the seen robot nearest a teammate, if within ``same_robot`` mm, is that teammate (another one
+    beside it, say an opponent in a duel with it, stays a robot), and one seen
     again within two robot radii of where it was remembered replaces that memory. Something seen within
     ``post_radius`` mm of a goal post (where the pose puts them) is that post, not a robot. While the
     pose is not valid, seen robots are remembered as long where ``Odometry`` puts them (no teammates then)."""
@@ -57,7 +58,7 @@ class ObstacleModeler(Module):
         mate_spread: float = bounded(0.0, 500.0, 60.0)
         """mm/s the uncertainty of a teammate's position grows with the age of its message"""
         same_robot: float = bounded(0.0, 2000.0, 400.0)
-        """mm: a seen robot this near a teammate is the teammate"""
+        """mm: the seen robot nearest a teammate, if this near, is the teammate"""
         max_distance: float = bounded(500.0, 15000.0, 4000.0)
         """mm: obstacles farther away are left out"""
         post_radius: float = bounded(0.0, 1000.0, 300.0)
@@ -83,8 +84,14 @@ class ObstacleModeler(Module):
             for mate in mates:
                 x, y = pose.to_robot(mate.message.x, mate.message.y)
                 obstacles.append(Obstacle(x, y, ROBOT_RADIUS + p.mate_spread * mate.age, ObstacleKind.teammate, mate.age))
-            for fx, fy, when in self.seen:
-                if any(math.hypot(fx - m.message.x, fy - m.message.y) < p.same_robot for m in mates):
+            claimed: set[int] = set()  # each teammate is one robot seen: the nearest its message (an opponent at its side stays)
+            for mate in mates:
+                near = [(math.hypot(fx - mate.message.x, fy - mate.message.y), k) for k, (fx, fy, _) in enumerate(self.seen) if k not in claimed]
+                distance, nearest = min(near, default=(math.inf, -1))
+                if distance < p.same_robot:
+                    claimed.add(nearest)
+            for k, (fx, fy, when) in enumerate(self.seen):
+                if k in claimed:
                     continue
                 x, y = pose.to_robot(fx, fy)
                 obstacles.append(Obstacle(x, y, ROBOT_RADIUS, ObstacleKind.robot, now - when))

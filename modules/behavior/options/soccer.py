@@ -45,6 +45,10 @@ SHOT_SETTLE_S, SHOT_MISSED = 1.0, 300.0
 SHOT_POSE_TRUST = 0.6
 #: mm the supporter waits at least in front of the opponent goal line (out of the keeper's way) and inside the touchlines
 SUPPORT_GOAL_GAP, SUPPORT_TOUCHLINE_GAP = 1200.0, 400.0
+#: rad between the way to the kick's spot and the kick's heading beyond which the striker would walk there backwards,
+#: where it sees nothing (robots are seen within 100 degrees of the heading): it faces the way instead while the
+#: spot is farther than FACE_BACK_WAY mm (then it turns to the kick)
+BACKWARDS, FACE_BACK_WAY = math.radians(100.0), 150.0
 
 
 class GoTo(Option["SoccerBehavior"]):
@@ -132,7 +136,8 @@ class Striker(Option["SoccerBehavior"]):
     @state
     def kick(self, b: SoccerBehavior) -> None:
         """Walk behind the ball on the kick's line and kick (``kicking.approach_and_kick``); far from the
-        spot, facing the way (so that the robot sees what it walks into), round the robots in it."""
+        spot, facing the way (so that the robot sees what it walks into), round the robots in it; never
+        backwards to a spot behind it (``BACKWARDS``): it faces that way too."""
         ball, p, out = b.ball_model, b.parameters, b.motion_request
         direction, kick, strength = b.kick_plan()  # a shot, or a pass by the pass rule (``passing.py``)
         approach_and_kick(ball, direction, kick, out, strength)
@@ -143,6 +148,10 @@ class Striker(Option["SoccerBehavior"]):
             if detoured:  # on the way round, no walk kick (it would go where the detour faces)
                 out.walk_kick = WalkKick.none
             out.target_x, out.target_y = x, y
+        if out.motion is MotionType.walk_to and math.hypot(out.target_x, out.target_y) > FACE_BACK_WAY:
+            way = math.atan2(out.target_y, out.target_x)
+            if abs(math.remainder(way - out.target_rotation, math.tau)) > BACKWARDS:  # it would walk backwards, blind
+                out.target_rotation, out.walk_kick = way, WalkKick.none
 
     @state
     def hold_back(self, b: SoccerBehavior) -> None:

@@ -1,0 +1,134 @@
+"""No pushing (issue 32, the rule book's "Player Pushing": a robot whose torso approaches a touching
+opponent faster than 80 mm/s over 0.5 s): ``SoccerBehavior.keep_from_pushing`` holds a walk's target back
+from every robot, the striker does not walk backwards to the ball, and ``ObstacleModeler`` keeps an opponent
+beside a teammate. Checked through the mocked blackboard, with the walk as a simple kinematic model (the
+walking engine's ``target_gain``, speed and acceleration limits) and the referee's measure of an approach;
+whole games in ``test_match.py``, the referee's side in ``test_referee.py``."""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tafel.core.testing import ModuleHarness
+from tafel.modules.behavior.soccer_behavior import SoccerBehavior
+from tafel.modules.modeling.obstacle_modeler import ObstacleModeler
+from tafel.representations.game import GameState, RobotInfo, State, TeamInfo
+from tafel.representations.modeling import BallModel, RobotPose
+from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType
+from tafel.representations.obstacles import Obstacle, ObstacleKind, Obstacles, RobotsPercept, SeenRobot
+from tafel.representations.team import PlayerRole, Role, TeamMate, TeamMates, TeamMessage
+
+CONTACT, PUSH_SPEED, PUSH_WINDOW_S = 330.0, 80.0, 0.5  # the simulated referee's (tools/simulation/fouls.py)
+GAIN, MAX_SPEED, ACCELERATION, MAX_TURN = 1.5, 320.0, 400.0, 2.0  # the walking engine's defaults (1/s, mm/s, mm/s^2, rad/s)
+FRAME_S = 1 / 30
+
+
+def playing(role: Role = Role.striker) -> GameState:
+    team = TeamInfo(team_number=1, goalkeeper=1, players=[RobotInfo() for _ in range(20)])
+    return GameState(state=State.playing, teams=[team, TeamInfo(team_number=2)], team_number=1,
+                     player_number=1 if role is Role.goalkeeper else 2, kicking_team=1)
+
+
+def robot_frame(pose: RobotPose, x: float, y: float) -> tuple[float, float]:
+    return pose.to_robot(x, y)
+
+
+def approach(track: deque[tuple[float, float, float]], other: tuple[float, float]) -> float:
+    """mm/s the robot's torso moved towards ``other`` over its track, as the referee measures it."""
+    (t0, x0, y0), (t1, x1, y1) = track[0], track[-1]
+    distance = max(math.hypot(other[0] - x1, other[1] - y1), 1.0)
+    return ((x1 - x0) * (other[0] - x1) + (y1 - y0) * (other[1] - y1)) / distance / max(t1 - t0, 1e-9)
+
+
+def play(start: tuple[float, float, float], ball: tuple[float, float], opponent: tuple[float, float], seconds: float = 6.0,
+         role: Role = Role.striker, challenge: bool = False) -> tuple[float, float]:
+    """The robot walks from ``start`` (field mm, mm, rad) as ``SoccerBehavior`` asks (walk_to, kinematically), the
+    ball and a standing opponent seen where they are (field mm). Returns the fastest approach to the opponent
+    (mm/s over ``PUSH_WINDOW_S``) while touching it, and the nearest the robot's centre came to the ball (mm).
+    ``challenge``: a striker goes for the ball at once (``hold_max_s`` 0), the opponent nearer it or not."""
+    x, y, heading = start
+    vx = vy = 0.0
+    track: deque[tuple[float, float, float]] = deque()
+    harness = ModuleHarness(SoccerBehavior, playing(role), PlayerRole(role=role), RobotPose(valid=True, x=x, y=y, rotation=heading),
+                            BallModel(), TeamMates(), MotionInfo(), Obstacles(), parameters={"hold_max_s": 0.0} if challenge else None)
+    worst, nearest_ball = 0.0, math.inf
+    for frame in range(int(seconds / FRAME_S)):
+        pose = RobotPose(valid=True, x=x, y=y, rotation=heading)
+        bx, by = robot_frame(pose, *ball)
+        ox, oy = robot_frame(pose, *opponent)
+        harness.set(pose, BallModel(valid=True, seen=True, x=bx, y=by), Obstacles(obstacles=[Obstacle(x=ox, y=oy, kind=ObstacleKind.robot)]))
+        out = harness.execute()[MotionRequest]
+        wanted_x = wanted_y = turn = 0.0
+        if out.motion is MotionType.walk_to:
+            wanted_x, wanted_y = (GAIN * v for v in pose.to_field(out.target_x, out.target_y))
+            wanted_x, wanted_y = wanted_x - GAIN * x, wanted_y - GAIN * y
+            turn = max(-MAX_TURN, min(MAX_TURN, GAIN * out.target_rotation))
+        speed = math.hypot(wanted_x, wanted_y)
+        if speed > MAX_SPEED:
+            wanted_x, wanted_y = wanted_x * MAX_SPEED / speed, wanted_y * MAX_SPEED / speed
+        change = math.hypot(wanted_x - vx, wanted_y - vy)
+        step = min(1.0, ACCELERATION * FRAME_S / max(change, 1e-9))
+        vx, vy = vx + (wanted_x - vx) * step, vy + (wanted_y - vy) * step
+        x, y, heading = x + vx * FRAME_S, y + vy * FRAME_S, math.remainder(heading + turn * FRAME_S, math.tau)
+        now = frame * FRAME_S
+        track.append((now, x, y))
+        while len(track) > 2 and now - track[1][0] >= PUSH_WINDOW_S:
+            track.popleft()
+        nearest_ball = min(nearest_ball, math.hypot(ball[0] - x, ball[1] - y))
+        if math.hypot(opponent[0] - x, opponent[1] - y) < CONTACT and now >= PUSH_WINDOW_S:
+            worst = max(worst, approach(track, opponent))
+    return worst, nearest_ball
+
+
+def test_the_striker_never_walks_backwards_to_a_kicking_spot_behind_it() -> None:
+    """The ball behind the striker (it rolled past): the spot to kick from lies behind it, and so may an opponent
+    it cannot see (robots are seen within 100 degrees of the heading). Before, it walked there backwards,
+    facing the kick, into the opponent beyond the ball (2v2 seed 1, 201.9 s); now it faces the way."""
+    pose = RobotPose(valid=True, x=-1000.0, y=0.0)
+    harness = ModuleHarness(SoccerBehavior, playing(), PlayerRole(role=Role.striker), pose, BallModel(valid=True, seen=True, x=-600.0, y=100.0),
+                            TeamMates(), MotionInfo(), Obstacles())
+    out = harness.execute()[MotionRequest]
+    assert out.motion is MotionType.walk_to and out.target_x < -200.0  # its way leads behind it (round the ball)
+    assert abs(math.remainder(out.target_rotation - math.atan2(out.target_y, out.target_x), math.tau)) < 0.05
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.floats(-math.pi, math.pi), st.floats(300.0, 1200.0), st.floats(-math.pi, math.pi), st.floats(150.0, 450.0))
+def test_a_striker_never_walks_into_a_standing_opponent_near_the_ball(start_bearing: float, start_distance: float,
+                                                                      opponent_bearing: float, opponent_distance: float) -> None:
+    """From anywhere round the ball, with an opponent standing anywhere near it: never an approach faster than
+    the rules' 80 mm/s while touching (whatever the rule book's exceptions might still excuse), also when it
+    challenges an opponent nearer the ball."""
+    start = (start_distance * math.cos(start_bearing), start_distance * math.sin(start_bearing), start_bearing + math.pi)
+    opponent = (opponent_distance * math.cos(opponent_bearing), opponent_distance * math.sin(opponent_bearing))
+    worst, _ = play(start, (0.0, 0.0), opponent, seconds=4.0, challenge=True)
+    assert worst <= PUSH_SPEED
+
+
+def test_a_walk_target_is_held_back_along_the_line_to_a_robot_and_not_from_a_teammate() -> None:
+    pose = RobotPose(valid=True, x=-400.0, y=0.0)
+    for kind, held in ((ObstacleKind.robot, True), (ObstacleKind.teammate, False)):
+        near = Obstacle(x=300.0, y=-100.0, kind=kind)  # beside the way to the ball, 316 mm: touching
+        harness = ModuleHarness(SoccerBehavior, playing(), PlayerRole(role=Role.striker), pose,
+                                BallModel(valid=True, seen=True, x=400.0, y=0.0), TeamMates(), MotionInfo(), Obstacles(obstacles=[near]))
+        out = harness.execute()[MotionRequest]
+        assert out.motion is MotionType.walk_to
+        distance = math.hypot(near.x, near.y)
+        towards = (out.target_x * near.x + out.target_y * near.y) / distance
+        assert (towards <= distance - SoccerBehavior.Parameters().push_distance + 1e-6) is held
+
+
+def test_an_opponent_in_a_duel_with_a_teammate_stays_an_obstacle() -> None:
+    """Two robots seen where a teammate said it was (it and the opponent it duels with): one is the teammate,
+    the other stays a robot to keep from (before, both within ``same_robot`` were taken for the teammate and
+    the opponent was walked into)."""
+    mate = TeamMate(TeamMessage(team=1, player=3, pose_valid=True, x=1000.0, y=0.0), age=0.3)
+    harness = ModuleHarness(ObstacleModeler, RobotPose(valid=True), RobotsPercept(robots=[SeenRobot(1030.0, 20.0), SeenRobot(1000.0, 300.0)]),
+                            TeamMates(mates=[mate]))
+    found = harness.execute()[Obstacles].obstacles
+    robots = [(round(o.x), round(o.y)) for o in found if o.kind is ObstacleKind.robot]
+    assert robots == [(1000, 300)] and sum(o.kind is ObstacleKind.teammate for o in found) == 1
