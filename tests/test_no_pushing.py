@@ -1,7 +1,7 @@
 """No pushing (issue 32, the rule book's "Player Pushing": a robot whose torso approaches a touching
 opponent faster than 80 mm/s over 0.5 s): ``SoccerBehavior.keep_from_pushing`` holds a walk's target back
-from every robot, the striker does not walk backwards to the ball, and ``ObstacleModeler`` keeps an opponent
-beside a teammate. Checked through the mocked blackboard, with the walk as a simple kinematic model (the
+from every robot, the striker does not walk backwards to the ball nor to one the own goalkeeper plays, and
+``ObstacleModeler`` keeps an opponent beside a teammate. Checked through the mocked blackboard, with the walk as a simple kinematic model (the
 walking engine's ``target_gain``, speed and acceleration limits) and the referee's measure of an approach;
 whole games in ``test_match.py``, the referee's side in ``test_referee.py``."""
 
@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.soccer_behavior import SoccerBehavior
 from tafel.modules.modeling.obstacle_modeler import ObstacleModeler
+from tafel.representations.behavior import ActivationGraph
 from tafel.representations.game import GameState, RobotInfo, State, TeamInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType
@@ -132,3 +133,18 @@ def test_an_opponent_in_a_duel_with_a_teammate_stays_an_obstacle() -> None:
     found = harness.execute()[Obstacles].obstacles
     robots = [(round(o.x), round(o.y)) for o in found if o.kind is ObstacleKind.robot]
     assert robots == [(1000, 300)] and sum(o.kind is ObstacleKind.teammate for o in found) == 1
+
+
+def test_the_striker_leaves_a_ball_in_the_own_penalty_area_to_the_keeper_nearer_it() -> None:
+    """The ball just before the own goal, the own goalkeeper nearer it: the striker holds back on the field's side
+    (before, both went for it and the keeper clearing pushed the striker over the goal line: leaving the field,
+    2v2 seed 2 at 161.8 s)."""
+    pose = RobotPose(valid=True, x=-3900.0, y=-400.0)
+    ball_field = (-4300.0, 0.0)
+    bx, by = pose.to_robot(*ball_field)
+    keeper = TeamMate(TeamMessage(team=1, player=1, pose_valid=True, x=-4450.0, y=100.0, role=Role.goalkeeper), age=0.5)
+    harness = ModuleHarness(SoccerBehavior, playing(), PlayerRole(role=Role.striker), pose, BallModel(valid=True, seen=True, x=bx, y=by),
+                            TeamMates(mates=[keeper]), MotionInfo(), Obstacles())
+    out = harness.execute()[MotionRequest]
+    assert ("Striker", "hold_back") in [(o.name, o.state) for o in harness[ActivationGraph].options]
+    assert out.motion is MotionType.walk_to and pose.to_field(out.target_x, out.target_y)[0] > ball_field[0] + 300.0

@@ -23,7 +23,7 @@ from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType, Odometry, WalkKick
 from tafel.representations.obstacles import ROBOT_RADIUS, ObstacleKind, Obstacles
-from tafel.representations.team import PlayerRole, TeamMates
+from tafel.representations.team import PlayerRole, Role, TeamMates
 
 OPPONENT_PENALTY_MARK_X = pitch.LENGTH / 2 - pitch.PENALTY_MARK_DISTANCE
 KEEPER_AREA_MARGIN = 150.0  # mm inside its penalty area's lines a goalkeeper is sure to be in it (the pose's error)
@@ -402,11 +402,27 @@ class SoccerBehavior(Module):
         nearest = min(rivals, default=math.inf)
         return nearest < p.contest_distance and nearest < math.hypot(ball.x, ball.y) - (0.0 if holding else p.contest_margin)
 
+    def keeper_plays(self) -> bool:
+        """Whether the own goalkeeper plays the ball in its penalty area: the ball there, and a teammate in the
+        goalkeeper role (heard within ``pass_mate_age``) nearer to it than this robot, which is not the goalkeeper.
+        Two of a team at the ball push each other: the keeper clearing pushed the striker over the goal line."""
+        ball, pose = self.ball_model, self.robot_pose
+        if not (ball.valid and pose.valid) or self.player_role.role is Role.goalkeeper:
+            return False
+        bx, by = ball.field_position(pose)
+        if bx > OWN_GOAL_X + pitch.PENALTY_AREA_LENGTH or abs(by) > pitch.PENALTY_AREA_WIDTH / 2:
+            return False
+        mine = math.hypot(ball.x, ball.y)
+        return any(m.message.role is Role.goalkeeper and m.message.pose_valid and not (m.message.fallen or m.message.penalized)
+                   and math.hypot(m.message.x - bx, m.message.y - by) < mine for m in self.team_mates.fresh(self.parameters.pass_mate_age))
+
     def hold_point(self) -> tuple[float, float, float]:
         """Where the striker waits while an opponent plays the ball: ``hold_distance`` from the ball towards
-        the own goal's centre (towards this robot without a pose), facing the ball; robot frame mm, mm, rad."""
+        the own goal's centre (towards this robot without a pose), facing the ball; while the own goalkeeper
+        plays it (``keeper_plays``), towards the opponent goal instead, out of its way; robot frame mm, mm, rad."""
         ball, pose = self.ball_model, self.robot_pose
-        gx, gy = pose.to_robot(OWN_GOAL_X, 0.0) if pose.valid else (0.0, 0.0)
+        goal_x = -OWN_GOAL_X if self.keeper_plays() else OWN_GOAL_X
+        gx, gy = pose.to_robot(goal_x, 0.0) if pose.valid else (0.0, 0.0)
         dx, dy = gx - ball.x, gy - ball.y
         distance = math.hypot(dx, dy)
         if distance < 1.0:

@@ -108,7 +108,8 @@ class GoTo(Option["SoccerBehavior"]):
 class Striker(Option["SoccerBehavior"]):
     """Get the ball to the opponent goal: kick it there (an own free kick: ahead and towards the middle),
     go by a teammate's ball without an own sighting, search by turning without any. While an opponent
-    nearer the ball plays it, hold back (pushing is a foul); after ``hold_max_s`` challenge for it."""
+    nearer the ball plays it, hold back (pushing is a foul); after ``hold_max_s`` challenge for it. While the
+    own goalkeeper nearer the ball plays it in its penalty area, hold back too, on the field's side."""
 
     calls = (GoTo,)
 
@@ -122,7 +123,7 @@ class Striker(Option["SoccerBehavior"]):
                 return "challenge"
             if self.state == "hold_back" and self.time_in_state >= p.hold_max_s:
                 return "challenge"
-            return "hold_back" if b.contested(holding=self.state == "hold_back") else "kick"
+            return "hold_back" if b.contested(holding=self.state == "hold_back") or b.keeper_plays() else "kick"
         if ball is not None and b.robot_pose.valid:
             return "to_teammates_ball"
         return "search"
