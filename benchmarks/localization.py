@@ -27,7 +27,7 @@
 - Cognition frame time (all modules of the frame, measured by the module manager) p95 at 320x240,
   and the real-time factor of the whole program with both cameras rendered, along the route.
 
-    python benchmarks/localization.py [--frames 600] [--engine mujoco] [--kidnap-seeds 3] [--only ball_far]
+    python benchmarks/localization.py [--frames 600] [--engine mujoco] [--kidnap-seeds 3] [--kidnap-first-seed 0] [--only ball_far]
 
 ``--realism LEVEL`` (default full): the ball detector is judged a second time, on the same scenes rendered
 as a real camera sees them (``ball_realistic``: the hall's clutter, nets, carpet, exposure, noise, blur,
@@ -222,10 +222,11 @@ def kidnaps(engine: str) -> dict[str, object]:
     return {"kidnap_recovery_s": [finite(t) for t in seconds], "kidnap_recovery_max_s": finite(max(seconds))}
 
 
-def kidnaps_anywhere(engine: str, seeds: int) -> dict[str, object]:
-    """``KIDNAPS_PER_SEED`` kidnappings to random poses per seed (``tests.support.kidnapping``)."""
+def kidnaps_anywhere(engine: str, seeds: int, first_seed: int = 0) -> dict[str, object]:
+    """``KIDNAPS_PER_SEED`` kidnappings to random poses per seed (``tests.support.kidnapping``), seeds ``first_seed``
+    on."""
     runs: list[Kidnapping] = []
-    for seed in range(seeds):
+    for seed in range(first_seed, first_seed + seeds):
         run = KidnapRun(engine, seed)
         try:
             for _ in range(KIDNAPS_PER_SEED):
@@ -262,6 +263,8 @@ def main() -> None:
     parser.add_argument("--frames", type=int, default=600, help="rendered scenes for the ball detector (>= 500)")
     parser.add_argument("--engine", default="mujoco", choices=["mujoco", "pybullet"])
     parser.add_argument("--kidnap-seeds", type=int, default=3, help=f"seeds of {KIDNAPS_PER_SEED} kidnappings anywhere each (>= 1)")
+    parser.add_argument("--kidnap-first-seed", type=int, default=0,
+                        help="the first of the --kidnap-seeds seeds (default 0): other kidnappings than the target's 30, to judge a change on")
     parser.add_argument("--only", action="append", choices=PARTS, help="run only these parts (repeat for several); default all")
     parser.add_argument("--realism", default="full", choices=["off", "mild", "full"],
                         help="the ball detector is also judged on renders at this --realism level (ball_realistic; default "
@@ -287,7 +290,7 @@ def main() -> None:
     if "kidnap" in parts:
         figures |= kidnaps(args.engine)
     if "kidnap_anywhere" in parts:
-        figures |= kidnaps_anywhere(args.engine, args.kidnap_seeds)
+        figures |= kidnaps_anywhere(args.engine, args.kidnap_seeds, args.kidnap_first_seed)
     figures["targets"] = {"ball_precision": 0.97, "ball_recall": 0.90, "ball_far_precision": 0.97, "ball_far_recall": 0.8,
                           "route_error_mean_mm": 100, "route_error_mean_deg": 5,
                           "route_error_p95_mm": 250, "kidnap_recovery_max_s": 10, "cognition_frame_ms_p95": 25,
