@@ -18,15 +18,20 @@ from tafel.modules.behavior.passing import PassParameters, best_shot, choose_pas
 from tafel.modules.behavior.paths import Disc, clear, detour, free_direction, outside
 from tafel.representations import field as pitch
 from tafel.representations.behavior import ActivationGraph, OptionGraph
-from tafel.representations.game import GameState, SetPlay
+from tafel.representations.game import GameState, SetPlay, State
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType, Odometry, WalkKick
-from tafel.representations.obstacles import ROBOT_RADIUS, ObstacleKind, Obstacles
+from tafel.representations.obstacles import ROBOT_RADIUS, ObstacleKind, Obstacles, RobotsPercept
 from tafel.representations.team import PlayerRole, Role, TeamMates
 
 OPPONENT_PENALTY_MARK_X = pitch.LENGTH / 2 - pitch.PENALTY_MARK_DISTANCE
 KEEPER_AREA_MARGIN = 150.0  # mm inside its penalty area's lines a goalkeeper is sure to be in it (the pose's error)
+#: rad beside the heading beyond which the robot sees nothing (robots are seen within 100 degrees); mm a walk's target
+#: lies that way at most (with the walk's target_gain, 1.5/s: no faster than 70 mm/s, below the rules' pushing) when it
+#: is nearer than BLIND_TURN mm; farther, the robot turns to face its way
+BLIND, BLIND_STEP, BLIND_TURN = math.radians(100.0), 45.0, 400.0
+POST_SEEN = 300.0  # mm round a goal post within which ObstacleModeler takes what is seen for the post (its post_radius)
 KICK_HELD_BACK = 30.0  # mm a walk's target may be held back from a robot (``keep_from_pushing``) and the walk kick still be asked for
 
 
@@ -42,7 +47,7 @@ def not_the_mates(seen: list[tuple[float, float]], mates: list[tuple[float, floa
 
 
 @requires(GameState, PlayerRole, BallModel, Odometry, MotionInfo, FrameInfo)
-@uses(RobotPose, TeamMates, Obstacles)
+@uses(RobotPose, TeamMates, Obstacles, RobotsPercept)
 @provides(MotionRequest, ActivationGraph, OptionGraph)
 class SoccerBehavior(Module):
     """What the robot does in each game state:
@@ -89,6 +94,7 @@ class SoccerBehavior(Module):
     robot_pose: RobotPose
     team_mates: TeamMates
     obstacles: Obstacles
+    robots_percept: RobotsPercept
     motion_request: MotionRequest
     activation_graph: ActivationGraph
     option_graph: OptionGraph
@@ -229,7 +235,10 @@ class SoccerBehavior(Module):
         a walk's target is held back along the line to every robot (not a teammate) so that the way towards it
         ends ``push_distance`` from its centre, as near as the robot may come. Sideways to it the walk goes
         on; the walk slows as it nears its target, so it comes to rest there rather than at contact. One
-        already nearer steps back a little, straight away from it. The rules spare the goalkeeper in its own
+        already nearer steps back a little, straight away from it. Robots seen at a goal post count too
+        (``ObstacleModeler`` takes them for the post: a keeper by its post was walked into). A walk backwards,
+        ``BLIND`` of the heading where nothing is seen, goes no faster than the rules' pushing (``BLIND_STEP``).
+        The rules spare the goalkeeper in its own
         penalty area (the GameController's goalkeeper, ``KEEPER_AREA_MARGIN`` inside the area's lines by the
         pose): it plays the ball there whoever stands at it."""
         out, pose, team = self.motion_request, self.robot_pose, self.game_state.own_team()
@@ -240,16 +249,26 @@ class SoccerBehavior(Module):
                 and abs(pose.y) < pitch.PENALTY_AREA_WIDTH / 2 - KEEPER_AREA_MARGIN):
             return
         x, y = out.target_x, out.target_y
-        robots = [o for o in self.obstacles.obstacles if o.kind is ObstacleKind.robot]
+        robots = [(o.x, o.y) for o in self.obstacles.obstacles if o.kind is ObstacleKind.robot]
+        if pose.valid:  # what is seen at a goal post: the post, or a keeper standing by it
+            robots += [(r.x, r.y) for r in self.robots_percept.robots if any(
+                math.dist(pose.to_field(r.x, r.y), (sx * pitch.LENGTH / 2, sy * (pitch.GOAL_INNER_WIDTH + pitch.GOAL_POST_DIAMETER) / 2)) < POST_SEEN
+                for sx in (-1, 1) for sy in (-1, 1))]
         for _ in range(3):  # held back from one, the target may lead further towards another: again
-            for robot in robots:
-                distance = math.hypot(robot.x, robot.y)
+            for rx, ry in robots:
+                distance = math.hypot(rx, ry)
                 if distance < 1.0:
                     continue
-                ux, uy = robot.x / distance, robot.y / distance
+                ux, uy = rx / distance, ry / distance
                 towards, limit = x * ux + y * uy, distance - self.parameters.push_distance
                 if towards > limit:
                     x, y = x - (towards - limit) * ux, y - (towards - limit) * uy
+        length, way = math.hypot(x, y), math.atan2(y, x)
+        if abs(way) > BLIND and length > BLIND_STEP and self.game_state.state is State.playing:  # backwards, blind
+            if length > BLIND_TURN:  # far: turn and walk there facing the way
+                out.target_rotation = way
+            else:  # near: slowly
+                x, y = x * BLIND_STEP / length, y * BLIND_STEP / length
         if math.hypot(x - out.target_x, y - out.target_y) > KICK_HELD_BACK:  # the kick's spot is out of reach: no kick
             out.walk_kick = WalkKick.none
         out.target_x, out.target_y = x, y
