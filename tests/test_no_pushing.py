@@ -164,7 +164,7 @@ def test_a_keeper_seen_by_its_goal_post_is_kept_from_and_a_walk_backwards_is_slo
     out = harness.execute()[MotionRequest]
     distance = math.hypot(*keeper)
     assert out.motion is MotionType.walk_to
-    assert (out.target_x * keeper[0] + out.target_y * keeper[1]) / distance <= distance - SoccerBehavior.Parameters().push_distance + 1e-6
+    assert (out.target_x * keeper[0] + out.target_y * keeper[1]) / distance <= max(distance - SoccerBehavior.Parameters().push_distance, 0.0) + 1e-6
     for behind, slow in ((300.0, True), (1500.0, False)):  # the defender's place behind it, near and far
         spot_x = OWN_GOAL_X + 0.35 * (1000.0 - OWN_GOAL_X)  # a third of the way to the ball at (1000, 0), 400 mm right
         pose = RobotPose(valid=True, x=spot_x + behind, y=-400.0)

@@ -164,7 +164,7 @@ class SoccerBehavior(Module):
         pass_mate_seen: float = bounded(0.0, 3000.0, 800.0)
         """mm: the robot seen nearest where a teammate last said it was, if this near, is that teammate (it walked
         since; the obstacles count it as a teammate only within 400 mm), not an opponent marking it, for the pass rule"""
-        push_distance: float = bounded(330.0, 1000.0, 380.0)
+        push_distance: float = bounded(330.0, 1000.0, 420.0)
         """mm between this robot's centre and another robot's up to which a walk may approach it (the referee
         calls contact at 330 mm): a walk's target is held back that far along the line to every robot near"""
 
