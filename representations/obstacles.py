@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import enum
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from tafel.core import bounded, representation
@@ -53,3 +55,16 @@ class Obstacles:
     obstacles: list[Obstacle]
     clearance: float = bounded(0.0, 2000.0, 0.0)
     """mm between this robot's centre and the nearest obstacle's edge (0: none near or touching)"""
+
+
+def same_robots(places: Sequence[tuple[float, float]], seen: Sequence[tuple[float, float]], within: float) -> set[int]:
+    """Which of the robots ``seen`` are the robots said to be at ``places`` (say, where teammates reported
+    themselves; one frame, mm): for each place in turn the nearest seen robot not yet taken, if nearer than
+    ``within`` mm. Each place is one robot: another beside it (an opponent in a duel with it) stays apart."""
+    taken: set[int] = set()
+    for px, py in places:
+        distance, nearest = min(((math.hypot(sx - px, sy - py), k) for k, (sx, sy) in enumerate(seen) if k not in taken),
+                                default=(math.inf, -1))
+        if distance < within:
+            taken.add(nearest)
+    return taken

@@ -14,7 +14,7 @@ from tafel.modules.modeling.obstacle_modeler import GOAL_POSTS, ObstacleModeler
 from tafel.modules.motion.sonar_filter import SonarFilter
 from tafel.representations.modeling import RobotPose
 from tafel.representations.motion_control import FallPhase, FallState, Odometry
-from tafel.representations.obstacles import ROBOT_RADIUS, ObstacleKind, Obstacles, RobotsPercept, SeenRobot
+from tafel.representations.obstacles import ROBOT_RADIUS, ObstacleKind, Obstacles, RobotsPercept, SeenRobot, same_robots
 from tafel.representations.sonar import SONAR_ANGLE, SonarData, SonarEcho, SonarPercept
 from tafel.representations.team import TeamMate, TeamMates, TeamMessage
 
@@ -131,3 +131,13 @@ def test_without_a_pose_a_robot_seen_now_and_then_stays_where_odometry_puts_it()
     assert len(held) == 1 and (held[0].x, held[0].y) == pytest.approx((0.0, -500.0), abs=1e-6)
     harness.execute(70)  # > 2 s later
     assert harness.blackboard[Obstacles].obstacles == []
+
+
+def test_each_place_said_is_one_robot_seen_the_nearest_and_a_robot_beside_it_stays_apart() -> None:
+    assert same_robots([], [(0.0, 0.0)], 400.0) == set()
+    assert same_robots([(0.0, 0.0)], [], 400.0) == set()
+    # a teammate in a duel: the opponent 250 mm beside it is not merged into it
+    assert same_robots([(0.0, 0.0)], [(250.0, 0.0), (50.0, 0.0)], 400.0) == {1}
+    # two teammates near one seen robot: it is only one of them
+    assert same_robots([(0.0, 0.0), (100.0, 0.0)], [(60.0, 0.0)], 400.0) == {0}
+    assert same_robots([(0.0, 0.0)], [(400.0, 0.0)], 400.0) == set()  # not nearer than within

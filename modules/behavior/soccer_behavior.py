@@ -22,7 +22,7 @@ from tafel.representations.game import GameState, SetPlay, State
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType, Odometry, WalkKick
-from tafel.representations.obstacles import ROBOT_RADIUS, ObstacleKind, Obstacles, RobotsPercept
+from tafel.representations.obstacles import ROBOT_RADIUS, ObstacleKind, Obstacles, RobotsPercept, same_robots
 from tafel.representations.team import PlayerRole, Role, TeamMates
 
 OPPONENT_PENALTY_MARK_X = pitch.LENGTH / 2 - pitch.PENALTY_MARK_DISTANCE
@@ -33,17 +33,6 @@ KEEPER_AREA_MARGIN = 150.0  # mm inside its penalty area's lines a goalkeeper is
 BLIND, BLIND_STEP, BLIND_TURN = math.radians(100.0), 45.0, 400.0
 POST_SEEN = 300.0  # mm round a goal post within which ObstacleModeler takes what is seen for the post (its post_radius)
 KICK_HELD_BACK = 30.0  # mm a walk's target may be held back from a robot (``keep_from_pushing``) and the walk kick still be asked for
-
-
-def not_the_mates(seen: list[tuple[float, float]], mates: list[tuple[float, float]], within: float) -> list[tuple[float, float]]:
-    """The robots ``seen`` (field mm) without the one nearest each teammate's said place (field mm) if within
-    ``within`` mm: that is the teammate itself, seen where it walked since its message."""
-    left = list(seen)
-    for mate in mates:
-        nearest = min(left, key=lambda robot: math.dist(robot, mate), default=None)
-        if nearest is not None and math.dist(nearest, mate) <= within:
-            left.remove(nearest)
-    return left
 
 
 @requires(GameState, PlayerRole, BallModel, Odometry, MotionInfo, FrameInfo)
@@ -355,7 +344,9 @@ class SoccerBehavior(Module):
             seen = [pose.to_field(o.x, o.y) for o in self.obstacles.obstacles if o.kind is ObstacleKind.robot]
             mates = [(m.message.x, m.message.y) for m in self.team_mates.fresh(p.pass_mate_age)
                      if m.message.pose_valid and not (m.message.fallen or m.message.penalized)]
-            opponents = not_the_mates(seen, [(m.message.x, m.message.y) for m in self.team_mates.fresh(p.pass_mate_age)], p.pass_mate_seen)
+            # the robot seen nearest where a teammate said it was is that teammate, walked on since
+            mates_seen = same_robots([(m.message.x, m.message.y) for m in self.team_mates.fresh(p.pass_mate_age)], seen, p.pass_mate_seen)
+            opponents = [robot for k, robot in enumerate(seen) if k not in mates_seen]
             target = choose_pass((bx, by), mates, opponents, p)
             self.aim, self.aim_is_pass, self.aim_s = target or best_shot((bx, by), opponents, p)[0], target is not None, now
         ax, ay = pose.to_robot(*self.aim)

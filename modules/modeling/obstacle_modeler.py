@@ -10,7 +10,7 @@ from tafel.representations.field import GOAL_INNER_WIDTH, GOAL_POST_DIAMETER, LE
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import RobotPose
 from tafel.representations.motion_control import Odometry
-from tafel.representations.obstacles import ROBOT_RADIUS, Obstacle, ObstacleKind, Obstacles, RobotsPercept
+from tafel.representations.obstacles import ROBOT_RADIUS, Obstacle, ObstacleKind, Obstacles, RobotsPercept, same_robots
 from tafel.representations.sonar import SonarPercept
 from tafel.representations.team import TeamMates
 
@@ -84,12 +84,7 @@ class ObstacleModeler(Module):
             for mate in mates:
                 x, y = pose.to_robot(mate.message.x, mate.message.y)
                 obstacles.append(Obstacle(x, y, ROBOT_RADIUS + p.mate_spread * mate.age, ObstacleKind.teammate, mate.age))
-            claimed: set[int] = set()  # each teammate is one robot seen: the nearest its message (an opponent at its side stays)
-            for mate in mates:
-                near = [(math.hypot(fx - mate.message.x, fy - mate.message.y), k) for k, (fx, fy, _) in enumerate(self.seen) if k not in claimed]
-                distance, nearest = min(near, default=(math.inf, -1))
-                if distance < p.same_robot:
-                    claimed.add(nearest)
+            claimed = same_robots([(m.message.x, m.message.y) for m in mates], [(fx, fy) for fx, fy, _ in self.seen], p.same_robot)
             for k, (fx, fy, when) in enumerate(self.seen):
                 if k in claimed:
                     continue
