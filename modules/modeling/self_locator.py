@@ -18,7 +18,7 @@ from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import KnownPose, RobotPose
 from tafel.representations.motion_control import FallState, Odometry
 from tafel.representations.perception import BallPercept, GoalPostPercept, LinePercept
-from tafel.representations.team import TeamMates
+from tafel.representations.team import TeamBall, TeamMates
 
 KNOWN_POSE_STD, KNOWN_ROTATION_STD = 30.0, 0.03  # mm and rad: the particles' spread round a pose told (KnownPose)
 WATCH_MIN_POINTS = 10  # line points a frame needs to say whether the lines fit the estimate ...
@@ -368,13 +368,21 @@ class SelfLocator(Module):
         (the twin's view): the distances in standard deviations (as the side belief weighs them); None without
         either ball. Far from both, the pose is wrong, not mirrored: a robot carried where the lines it looks at
         (next to the ball) half fit the old place."""
+        seen = self.ball_against_team()
+        if seen is None:
+            return None
+        team, std = seen
+        x, y = pose.to_global(self.ball_percept.x, self.ball_percept.y)
+        return math.hypot(x - team.x, y - team.y) / std, math.hypot(x + team.x, y + team.y) / std
+
+    def ball_against_team(self) -> tuple[TeamBall, float] | None:
+        """The team's ball and the standard deviation (mm) of where the ball seen this frame may lie against it
+        (its own distance's error and the team ball's age); None without either ball."""
         p, ball = self.parameters, self.ball_percept
         team = self.team_mates.freshest_ball(p.team_ball_max_age)
         if team is None or not (ball.seen and math.isfinite(ball.x) and math.isfinite(ball.y)):
             return None
-        std = p.team_ball_std + p.team_ball_std_per_m * math.hypot(ball.x, ball.y) / 1000.0 + p.team_ball_std_per_s * team.age
-        x, y = pose.to_global(ball.x, ball.y)
-        return math.hypot(x - team.x, y - team.y) / std, math.hypot(x + team.x, y + team.y) / std
+        return team, p.team_ball_std + p.team_ball_std_per_m * math.hypot(ball.x, ball.y) / 1000.0 + p.team_ball_std_per_s * team.age
 
     def usable_percepts(self) -> bool:
         """Whether this frame saw something fresh poses can be made from: the circle, a post, a line segment."""
@@ -440,10 +448,10 @@ class SelfLocator(Module):
                 self.turn_to_twin(pose)  # old place (the anchor), which is tracked again; it must not flip
         odometry = (self.odometry.x, self.odometry.y, self.odometry.rotation)
         side.add_placement(self.estimate, odometry, p.placement_cap, p.placement_rate * p.placement_cap, p.side_cap)
-        team, ball = self.team_mates.freshest_ball(p.team_ball_max_age), self.ball_percept
-        if team is not None and ball.seen and math.isfinite(ball.x) and math.isfinite(ball.y):
-            std = p.team_ball_std + p.team_ball_std_per_m * math.hypot(ball.x, ball.y) / 1000.0 + p.team_ball_std_per_s * team.age
-            side.add_team_ball(self.estimate, (ball.x, ball.y), team, std, p.team_ball_rate, p.team_message_cap, p.side_cap)
+        seen = self.ball_against_team()
+        if seen is not None:
+            side.add_team_ball(self.estimate, (self.ball_percept.x, self.ball_percept.y), seen[0], seen[1], p.team_ball_rate,
+                               p.team_message_cap, p.side_cap)
         if side.odds < 0.0:
             self.turn_to_twin(pose)
             side.flip()
