@@ -546,13 +546,20 @@ def test_log_start_never_replaces_a_file_but_records_under_the_next_free_name(tm
     logs.mkdir()
     (logs / "game.mcap").write_bytes(b"an older game")
     running = Program("--platform", "dummy", "--record", str(logs / "own.mcap"), cwd=tmp_path)
+
+    def recorded_motion_frames(at_least: int) -> None:  # frames, not a sleep: a loaded machine runs fewer a second
+        deadline = time.monotonic() + 30.0
+        while json.loads(running.ask("log:status"))["frames"].get("motion", 0) < at_least:
+            assert time.monotonic() < deadline, running.ask("log:status")
+            time.sleep(0.05)
+
     try:
-        time.sleep(0.3)
+        recorded_motion_frames(15)
         kept = "exists and is kept"
         assert running.ask("log:start -file own.mcap") == f"recording to {logs / 'own-1.mcap'} (own.mcap {kept})"  # the user's --record
         assert running.ask("log:start -file game.mcap") == f"recording to {logs / 'game-1.mcap'} (game.mcap {kept})"
         assert running.ask("log:start -file game.mcap") == f"recording to {logs / 'game-2.mcap'} (game.mcap {kept})"
-        time.sleep(0.3)
+        recorded_motion_frames(15)
         assert running.ask("log:stop").startswith(f"stopped recording {logs / 'game-2.mcap'}")
     finally:
         running.stop()
