@@ -16,6 +16,7 @@ from dataclasses import dataclass, fields
 
 from tafel.core import bounded
 from tafel.debug import ModifyParameters
+from tafel.modules.behavior.passing import segment_distance
 from tafel.representations import field
 from tafel.representations.geometry import Pose2D
 from tafel.representations.modeling import BallModel, RobotPose
@@ -124,13 +125,6 @@ def round_the_ball(ball: BallModel, kick_direction: float, target_x: float, targ
     else:  # beside it: back to beside the spot
         way_along = (target_x - ball.x) * ux + (target_y - ball.y) * uy
     return ball.x + way_along * ux - beside * uy, ball.y + way_along * uy + beside * ux
-
-
-def segment_distance(end: tuple[float, float], point: tuple[float, float]) -> float:
-    """mm from ``point`` to the segment from the origin (the robot) to ``end``."""
-    length2 = end[0] ** 2 + end[1] ** 2
-    t = max(0.0, min(1.0, (point[0] * end[0] + point[1] * end[1]) / length2)) if length2 > 0.0 else 0.0
-    return math.hypot(point[0] - t * end[0], point[1] - t * end[1])
 
 
 def walk_kick_approach(ball: BallModel, kick_direction: float, p: KickParameters, out: MotionRequest,

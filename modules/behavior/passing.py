@@ -67,15 +67,15 @@ def lane_clearance(start: Point, end: Point, others: Sequence[Point]) -> float:
     start (the kicker's own side) does not count."""
     sx, sy = start
     dx, dy = end[0] - sx, end[1] - sy
-    length2 = dx * dx + dy * dy
-    nearest = math.inf
-    for ox, oy in others:
-        t = ((ox - sx) * dx + (oy - sy) * dy) / length2 if length2 > 0 else 0.0
-        if t <= 0.0:
-            continue
-        t = min(t, 1.0)
-        nearest = min(nearest, math.hypot(ox - sx - t * dx, oy - sy - t * dy))
-    return nearest
+    ahead = [(ox - sx, oy - sy) for ox, oy in others if (ox - sx) * dx + (oy - sy) * dy > 0.0]
+    return min((segment_distance((dx, dy), other) for other in ahead), default=math.inf)
+
+
+def segment_distance(end: Point, point: Point) -> float:
+    """mm from ``point`` to the segment from the origin to ``end`` (same frame, mm)."""
+    length2 = end[0] ** 2 + end[1] ** 2
+    t = max(0.0, min(1.0, (point[0] * end[0] + point[1] * end[1]) / length2)) if length2 > 0.0 else 0.0
+    return math.hypot(point[0] - t * end[0], point[1] - t * end[1])
 
 
 def best_shot(ball: Point, opponents: Sequence[Point], p: PassParameters) -> tuple[Point, float]:
