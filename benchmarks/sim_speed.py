@@ -3,8 +3,10 @@
 MuJoCo and PyBullet side by side in one run. For each engine, runs the default configuration (every module of both contexts) in lockstep as fast as
 possible for ``--seconds`` of simulated time, with both cameras rendered at 320x240 at 30 Hz and with
 the cameras off; and times each physics step and each camera render inside those runs. PyBullet with
-cameras runs twice: with its render worker (the top camera drawn in a process of its own, the default
-where a core is spare) and without (``cameras_on_one_process``), before and after side by side.
+cameras runs three times: as it runs by default, its world drawn by MuJoCo's renderer (``cameras_on``), and
+with its own CPU renderer (``--renderer pybullet``, the default before MuJoCo drew its images), with its
+render worker (the top camera drawn in a process of its own; ``cameras_on_pybullet_renderer``) and without
+(``cameras_on_pybullet_renderer_one_process``): before and after side by side.
 
 Beside each real-time factor, the limit this machine allows, from the CPU the run used in the same run:
 ``cpu_s_per_sim_s`` (every process of the simulation, per simulated second) and
@@ -99,9 +101,11 @@ def main() -> None:
     for engine in args.engines.split(","):
         if engine not in ENGINES:
             parser.error(f"--engines takes {' and '.join(ENGINES)}, got {engine!r}")
-        if engine == "pybullet":  # with and without the render worker, whatever the machine's load would choose
-            report[engine] = {"cameras_on": measure(engine, args.seconds, cameras=True, render_worker="on"),
-                              "cameras_on_one_process": measure(engine, args.seconds, cameras=True, render_worker="off")}
+        if engine == "pybullet":  # its own renderer with and without the render worker, whatever the machine's load would choose
+            report[engine] = {"cameras_on": measure(engine, args.seconds, cameras=True, renderer="mujoco"),
+                              "cameras_on_pybullet_renderer": measure(engine, args.seconds, cameras=True, renderer="pybullet", render_worker="on"),
+                              "cameras_on_pybullet_renderer_one_process": measure(engine, args.seconds, cameras=True, renderer="pybullet",
+                                                                                  render_worker="off")}
         else:
             report[engine] = {"cameras_on": measure(engine, args.seconds, cameras=True)}
         report[engine]["cameras_off"] = measure(engine, args.seconds, cameras=False)

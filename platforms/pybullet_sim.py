@@ -1,9 +1,15 @@
 """The PyBullet platform: the same robot, field and ball as MuJoCo, from the same description.
 
 The robot is the URDF that ``platforms.robot_model`` generates from ``representations.nao``; the field
-is built from the same ``field_parts``. Cameras render with PyBullet's CPU renderer (no OpenGL at all).
+is built from the same ``field_parts``.
 
-Rendering is most of a simulated second's work (about 15 ms of CPU per 320x240 image, 60 images a
+The cameras (``--renderer``): by default MuJoCo's renderer draws PyBullet's world (``MujocoDrawing``: the
+same scene from the same description, posed from PyBullet's state before each image), at about 1.5 ms
+of CPU per 320x240 image. ``--renderer pybullet`` keeps PyBullet's own CPU renderer (TinyRenderer, no
+OpenGL at all: where EGL and OSMesa are missing, or to test perception on a second renderer's look);
+``auto`` (the default) is MuJoCo where it can render headless, else PyBullet's.
+
+PyBullet's renderer is most of a simulated second's work (about 15 ms of CPU per 320x240 image, 60 images a
 second), and PyBullet holds the GIL while it renders, so a thread cannot help: with cameras on and a
 spare core (more than one, and the last minute's load leaves one idle), a render worker
 (``RenderWorker``, a process with a copy of the world that only renders) draws the top camera while
@@ -38,6 +44,7 @@ from tafel.platforms.field_world import (
     cylinder_mesh,
     field_parts,
 )
+from tafel.platforms.mujoco_sim import MujocoDrawing
 from tafel.platforms.robot_model import BALL_FRICTION, STANDING_HEIGHT, fsr_sites, joint_motor, sun_direction, urdf
 from tafel.platforms.simulated import TIMESTEP, SimulatedRobotPlatform
 from tafel.representations.field import BALL_RADIUS
@@ -125,7 +132,7 @@ WORKER_IMAGE_S = 10.0
 def _serve_renders(connection: Connection, options: dict[str, Any]) -> None:
     """A render worker's life: build the world as the platform does, then for each (state, camera) pose
     what moves and send the camera's image back as raw bytes, until None or the pipe closes."""
-    platform = PybulletPlatform({**options, "render_worker": "off", "viewer": False})
+    platform = PybulletPlatform({**options, "render_worker": "off", "renderer": "pybullet", "viewer": False})
     platform.build(frozenset(), viewer=False)
     connection.send("ready")
     try:
@@ -196,6 +203,17 @@ def spare_core() -> bool:
     return cores > 1 and os.getloadavg()[0] <= cores - 1
 
 
+RENDERERS = ("auto", "mujoco", "pybullet")
+
+
+def parse_renderer(value: Any) -> str:
+    """``--renderer``: auto, mujoco or pybullet (what draws the cameras' images)."""
+    text = str(value if value is not None else "auto").lower()
+    if text not in RENDERERS:
+        raise PlatformOptionError(f"--renderer takes auto, mujoco or pybullet, got {value!r}")
+    return text
+
+
 def parse_render_worker(value: Any) -> bool | None:
     """``--render-worker``: on, off, or auto (None: on where cameras render headless and a core is spare)."""
     text = str(value if value is not None else "auto").lower()
@@ -207,20 +225,25 @@ def parse_render_worker(value: Any) -> bool | None:
 class PybulletPlatform(SimulatedRobotPlatform):
     name = "pybullet"
     engine = "PyBullet"
-    description = "PyBullet physics: the same robot, field and ball, cameras on the CPU renderer"
+    description = "PyBullet physics: the same robot, field and ball, cameras drawn by MuJoCo's renderer (or PyBullet's)"
 
     def __init__(self, options: dict[str, Any] | None = None) -> None:
         super().__init__(options)
         self.client: int | None = None
         self.viewer = False
         self.render_worker = parse_render_worker(self.options.get("render_worker"))
+        self.renderer = parse_renderer(self.options.get("renderer"))
         self.worker: RenderWorker | None = None
+        self.drawing: MujocoDrawing | None = None  # MuJoCo drawing this world's images (--renderer)
 
     @classmethod
     def add_arguments(cls, parser: Any) -> None:
         super().add_arguments(parser)
+        parser.add_argument("--renderer", choices=RENDERERS, default="auto",
+                            help="pybullet: what draws the cameras: mujoco (MuJoCo's renderer, EGL or OSMesa, about ten times "
+                                 "faster), pybullet (its CPU renderer, no OpenGL) or auto (mujoco where it can render headless)")
         parser.add_argument("--render-worker", choices=["on", "off", "auto"], default="auto",
-                            help="pybullet: render the top camera in a process of its own, in parallel with the bottom one "
+                            help="pybullet: with --renderer pybullet, render the top camera in a process of its own, in parallel with the bottom one "
                                  "(auto: with cameras on, no viewer and a core to spare: more than one, not all busy)")
 
     # ------------------------------------------------------------------------------- the world
@@ -240,8 +263,20 @@ class PybulletPlatform(SimulatedRobotPlatform):
             self.bodies[part.name] = self._field_body(part)
         self._load_robot()
         self.previous_velocity = np.zeros(3)
+        if self.cameras and "cognition" in contexts and self.renderer != "pybullet":
+            try:
+                self.drawing = MujocoDrawing(self.width, self.height, self.ball_color, self.scene_look, self.shadows)
+                names = [pybullet.getJointInfo(self.robot, j, physicsClientId=c)[1].decode() for j in self.all_joints]
+                pairs = [(joint, self.drawing.joint_address(name)) for joint, name in zip(self.all_joints, names)]
+                #: (PyBullet joint, MuJoCo qpos address) of every joint both worlds have
+                self.drawn_joints = [(joint, address) for joint, address in pairs if address is not None]
+            except PlatformError as exc:
+                if self.renderer == "mujoco":
+                    self.stop()
+                    raise
+                print(f"pybullet: {exc}; the cameras render with PyBullet's CPU renderer", file=sys.stderr)
         wanted = self.render_worker if self.render_worker is not None else spare_core()
-        if wanted and self.cameras and not viewer and "cognition" in contexts:
+        if wanted and self.cameras and self.drawing is None and not viewer and "cognition" in contexts:
             try:
                 self.worker = RenderWorker(dict(self.options), self.width, self.height)
             except PlatformError as exc:
@@ -391,6 +426,9 @@ class PybulletPlatform(SimulatedRobotPlatform):
 
     def stop(self) -> None:
         super().stop()
+        if self.drawing is not None:
+            self.drawing.close()
+            self.drawing = None
         if self.worker is not None:
             self.worker.close()
             self.worker = None
@@ -482,6 +520,9 @@ class PybulletPlatform(SimulatedRobotPlatform):
         pybullet.resetBasePositionAndOrientation(self.bodies["ball"], ball_position, ball_orientation, physicsClientId=c)
 
     def render(self, camera: str) -> np.ndarray:
+        if self.drawing is not None:
+            self._pose_drawing(self.drawing)
+            return self.drawing.render(camera)
         rgba, _ = self._camera_image(camera, segmentation=False)
         return np.asarray(rgba, dtype=np.uint8).reshape(self.height, self.width, 4)[:, :, :3].copy()
 
@@ -518,7 +559,20 @@ class PybulletPlatform(SimulatedRobotPlatform):
         for follower, leader in self.follower_ids:
             pybullet.resetJointState(self.robot, follower, float(angles[leader]), 0.0, physicsClientId=self.client)
 
+    def _pose_drawing(self, drawing: MujocoDrawing) -> None:
+        """Pose MuJoCo's copy of the world as this one is now: the torso's frame, every joint, the ball."""
+        c = self.client
+        states = pybullet.getJointStates(self.robot, [j for j, _ in self.drawn_joints], physicsClientId=c)
+        angles = {address: state[0] for (_, address), state in zip(self.drawn_joints, states)}
+        position, _ = self.torso_pose()
+        _, (x, y, z, w) = pybullet.getBasePositionAndOrientation(self.robot, physicsClientId=c)
+        ball, (bx, by, bz, bw) = pybullet.getBasePositionAndOrientation(self.bodies["ball"], physicsClientId=c)
+        drawing.pose(position, np.array([w, x, y, z]), angles, np.array(ball), np.array([bw, bx, by, bz]))
+
     def ball_mask(self, camera: str) -> np.ndarray:
+        if self.drawing is not None:
+            self._pose_drawing(self.drawing)
+            return self.drawing.ball_mask(camera)
         _, segments = self._camera_image(camera, segmentation=True)
         return (np.asarray(segments).reshape(self.height, self.width) & ((1 << 24) - 1)) == self.bodies["ball"]
 

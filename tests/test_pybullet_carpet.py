@@ -26,7 +26,7 @@ POSE, HEAD = (-500.0, 1500.0, -0.4), (0.0, 0.35)
 @contextmanager
 def platform(realism: str, seed: int) -> Iterator[PybulletPlatform]:
     """A PyBullet platform at ``realism`` with the robot posed at ``POSE`` (no render worker)."""
-    p = PybulletPlatform({"realism": realism, "seed": seed, "render_worker": "off", "resolution": "320x240"})
+    p = PybulletPlatform({"realism": realism, "seed": seed, "renderer": "pybullet", "render_worker": "off", "resolution": "320x240"})
     p.start(frozenset({"motion", "cognition"}))
     try:
         angles = stand_pose()
@@ -119,7 +119,7 @@ def test_the_realistic_carpet_is_textured_seeded_and_the_lines_stay_white_where_
 @pytest.mark.slow  # starts a render worker process
 def test_the_render_worker_draws_the_same_realistic_carpet() -> None:
     """The worker builds its own copy of the world from the options: the same seeded carpet and strips."""
-    p = PybulletPlatform({"realism": "mild", "seed": 4, "render_worker": "on", "resolution": "160x120"})
+    p = PybulletPlatform({"realism": "mild", "seed": 4, "renderer": "pybullet", "render_worker": "on", "resolution": "160x120"})
     p.start(frozenset({"motion", "cognition"}))
     try:
         assert p.worker is not None, "the render worker did not start"

@@ -39,7 +39,7 @@ def cognition_images(sim: Simulation, seconds: float) -> list[tuple[np.ndarray, 
 def test_render_worker_images_are_those_one_process_renders() -> None:
     """While the robot walks (every joint and the ball moving), the worker's top image is, pixel for
     pixel, what the simulation's own world renders at that moment."""
-    sim = Simulation("pybullet", scene="default", cameras="on", resolution="160x120", render_worker="on")
+    sim = Simulation("pybullet", scene="default", cameras="on", resolution="160x120", renderer="pybullet", render_worker="on")
     try:
         assert sim.platform.worker is not None
         frames = cognition_images(sim, 1.5)
@@ -56,7 +56,7 @@ def test_render_worker_images_are_those_one_process_renders() -> None:
 
 @pytest.mark.slow
 def test_a_dead_render_worker_leaves_the_simulation_rendering_alone(capfd: pytest.CaptureFixture[str]) -> None:
-    sim = Simulation("pybullet", scene="default", cameras="on", resolution="160x120", render_worker="on")
+    sim = Simulation("pybullet", scene="default", cameras="on", resolution="160x120", renderer="pybullet", render_worker="on")
     try:
         worker = sim.platform.worker
         assert worker is not None

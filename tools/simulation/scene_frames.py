@@ -65,8 +65,10 @@ class SceneRenderer:
     def __init__(self, engine: str = "mujoco", resolution: str = "320x240", ball_color: str = "spl", realism: str = "off",
                  seed: int = 0) -> None:
         """``realism``: the platform's ``--realism`` level (the hall and the camera pipeline, seeded by ``seed``);
-        posed frames have no motion of their own, so each gets a seeded head turn for its blur."""
-        options = {"resolution": resolution, "ball_color": ball_color, "realism": realism, "seed": seed}
+        posed frames have no motion of their own, so each gets a seeded head turn for its blur. Each engine
+        draws with its own renderer (PyBullet's CPU one, not MuJoCo's it uses by default): perception is
+        judged on two renderers' looks."""
+        options = {"resolution": resolution, "ball_color": ball_color, "realism": realism, "seed": seed, "renderer": engine}
         self.platform: SimulatedRobotPlatform = load_platform(engine)(options)
         self.platform.start(frozenset({"motion", "cognition"}))
         self.angles = stand_pose()
