@@ -33,7 +33,7 @@ import numpy as np
 from tafel.core.framework.manager import Blackboard
 from tafel.core.runtime.platform import EndOfData, PlatformError, PlatformOptionError
 from tafel.platforms.match_world import Side, Snapshot
-from tafel.platforms.mujoco_sim import GL_BACKEND, MujocoRobot, close_renderers, mujoco, set_render_flags
+from tafel.platforms.mujoco_sim import MujocoCameras, MujocoRobot, mujoco
 from tafel.platforms.network import NETWORK_INPUTS, NETWORK_OUTPUTS
 from tafel.platforms.robot_model import mjcf_assets, robot_prefix
 from tafel.platforms.simulated import SimulatedRobotPlatform
@@ -72,7 +72,7 @@ class MatchRobotPlatform(SimulatedRobotPlatform):
         self.snapshot: Snapshot | None = None
         self.command = (np.zeros(JOINT_COUNT), np.zeros(JOINT_COUNT))
         self.model: Any = None
-        self.renderers: dict[str, Any] = {}
+        self.renderers: MujocoCameras | None = None
 
     @classmethod
     def add_arguments(cls, parser: argparse.ArgumentParser) -> None:
@@ -97,19 +97,16 @@ class MatchRobotPlatform(SimulatedRobotPlatform):
             self.model = mujoco.MjModel.from_xml_string(xml, mjcf_assets(ball_color, look))
             self.data = mujoco.MjData(self.model)
             self.robot = MujocoRobot(self.model, robot_prefix(self.index, robots))
-            try:
-                self.renderers = {camera: mujoco.Renderer(self.model, self.height, self.width) for camera in ("top", "bottom")}
-            except Exception as exc:  # noqa: BLE001 - the GL stack raises several kinds
-                raise PlatformError(f"MuJoCo cannot render headless with MUJOCO_GL={GL_BACKEND} ({exc}); use --cameras off") from None
-            if self.realism_level is not None:  # as the MuJoCo platform renders with --realism; off renders as it always did
-                for renderer in self.renderers.values():
-                    set_render_flags(renderer, self.shadows)
+            # as the MuJoCo platform renders with --realism; off renders as it always did (MuJoCo's own flags)
+            self.renderers = MujocoCameras(self.model, self.robot, self.sizes, self.shadows if self.realism_level is not None else None)
         if "cognition" in contexts:
             self.network.open()
 
     def stop(self) -> None:
         super().stop()
-        close_renderers(self.renderers)
+        if self.renderers is not None:
+            self.renderers.close()
+            self.renderers = None
         if self.connection is not None:
             self.connection.close()
             self.connection = None
@@ -189,14 +186,13 @@ class MatchRobotPlatform(SimulatedRobotPlatform):
         return x, y
 
     def render(self, camera: str) -> np.ndarray:
-        if self.snapshot is None or self.snapshot.qpos is None:
-            return np.zeros((self.height, self.width, 3), np.uint8)
+        if self.snapshot is None or self.snapshot.qpos is None or self.renderers is None:
+            width, height = self.sizes[camera]
+            return np.zeros((height, width, 3), np.uint8)
         self.data.qpos[:] = self.snapshot.qpos
         mujoco.mj_kinematics(self.model, self.data)
         mujoco.mj_camlight(self.model, self.data)
-        renderer = self.renderers[camera]
-        renderer.update_scene(self.data, camera=self.robot.camera(camera))
-        return renderer.render().copy()
+        return self.renderers.render(self.data, camera)
 
     def camera_rotation(self, camera: str) -> np.ndarray | None:
         """The camera's orientation at the last rendered tick (``--realism``'s motion blur); None without cameras."""

@@ -147,6 +147,11 @@ def set_render_flags(renderer: Any, shadows: bool) -> None:
     renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = 0
 
 
+def offscreen_size(sizes: dict[str, tuple[int, int]]) -> tuple[int, int]:
+    """The model's offscreen buffer (px): room for the largest camera image, and at least 640x480."""
+    return max(640, *(w for w, _ in sizes.values())), max(480, *(h for _, h in sizes.values()))
+
+
 def close_renderers(renderers: dict[str, Any]) -> None:
     """Close MuJoCo renderers; closing must never raise (it also runs after errors)."""
     for renderer in renderers.values():
@@ -160,13 +165,16 @@ def close_renderers(renderers: dict[str, Any]) -> None:
 class MujocoCameras:
     """One robot's ``top`` and ``bottom`` cameras, rendered headless from a MuJoCo model (a renderer each)."""
 
-    def __init__(self, model: Any, robot: MujocoRobot, width: int, height: int, shadows: bool) -> None:
+    def __init__(self, model: Any, robot: MujocoRobot, sizes: dict[str, tuple[int, int]], shadows: bool | None) -> None:
+        """``sizes``: camera -> (width, height) px; ``shadows`` None keeps MuJoCo's own render flags."""
         self.model, self.robot = model, robot
         self.renderers: dict[str, Any] = {}
         try:
             for camera in ("top", "bottom"):
+                width, height = sizes[camera]
                 renderer = mujoco.Renderer(model, height, width)
-                set_render_flags(renderer, shadows)
+                if shadows is not None:
+                    set_render_flags(renderer, shadows)
                 self.renderers[camera] = renderer
         except Exception as exc:  # noqa: BLE001 - the GL stack raises several kinds
             self.close()
@@ -203,13 +211,13 @@ class MujocoDrawing:
     PyBullet's CPU renderer takes about 15 ms of CPU for a 320x240 image and 55 ms for 640x480; this
     one 1.5 and 3 ms here (EGL on Mesa), so a PyBullet simulation with cameras can keep real time."""
 
-    def __init__(self, width: int, height: int, ball_color: str, look: Any, shadows: bool) -> None:
-        xml = mjcf(offscreen=(max(width, 640), max(height, 480)), ball_color=ball_color, look=look, shadows=shadows)
+    def __init__(self, sizes: dict[str, tuple[int, int]], ball_color: str, look: Any, shadows: bool) -> None:
+        xml = mjcf(offscreen=offscreen_size(sizes), ball_color=ball_color, look=look, shadows=shadows)
         self.model = mujoco.MjModel.from_xml_string(xml, mjcf_assets(ball_color, look))
         self.data = mujoco.MjData(self.model)
         self.robot = MujocoRobot(self.model)
         self.ball = MujocoBall(self.model)
-        self.cameras = MujocoCameras(self.model, self.robot, width, height, shadows)
+        self.cameras = MujocoCameras(self.model, self.robot, sizes, shadows)
 
     def joint_address(self, name: str) -> int | None:
         """Where joint ``name``'s angle sits in ``qpos`` (None: this model has no such joint)."""
@@ -253,7 +261,7 @@ class MujocoPlatform(SimulatedRobotPlatform):
         self.viewer: Any = None
 
     def build(self, contexts: frozenset[str], viewer: bool) -> None:
-        xml = mjcf(offscreen=(max(self.width, 640), max(self.height, 480)), timestep=TIMESTEP, ball_color=self.ball_color,
+        xml = mjcf(offscreen=offscreen_size(self.sizes), timestep=TIMESTEP, ball_color=self.ball_color,
                    look=self.scene_look, shadows=self.shadows)
         self.model = mujoco.MjModel.from_xml_string(xml, mjcf_assets(self.ball_color, self.scene_look))
         self.data = mujoco.MjData(self.model)
@@ -268,7 +276,7 @@ class MujocoPlatform(SimulatedRobotPlatform):
 
     def _open_renderers(self) -> None:
         try:
-            self.renderers = MujocoCameras(self.model, self.robot, self.width, self.height, self.shadows)
+            self.renderers = MujocoCameras(self.model, self.robot, self.sizes, self.shadows)
         except PlatformError:
             self.stop()
             raise

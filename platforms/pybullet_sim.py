@@ -155,7 +155,9 @@ class RenderWorker:
     ``request`` hands it the poses of what moves and the camera; ``image`` waits for the picture. Any
     failure (it died, it is slow to answer) raises ``PlatformError``; the platform then renders alone."""
 
-    def __init__(self, options: dict[str, Any], width: int, height: int) -> None:
+    def __init__(self, options: dict[str, Any], size: tuple[int, int]) -> None:
+        """``size``: (width, height) px of the camera it draws."""
+        width, height = size
         context = multiprocessing.get_context("spawn")  # a fork would share this process's PyBullet client
         self.connection, child = context.Pipe()
         self.process = context.Process(target=_serve_renders, args=(child, options), name="pybullet-render", daemon=True)
@@ -265,7 +267,7 @@ class PybulletPlatform(SimulatedRobotPlatform):
         self.previous_velocity = np.zeros(3)
         if self.cameras and "cognition" in contexts and self.renderer != "pybullet":
             try:
-                self.drawing = MujocoDrawing(self.width, self.height, self.ball_color, self.scene_look, self.shadows)
+                self.drawing = MujocoDrawing(self.sizes, self.ball_color, self.scene_look, self.shadows)
                 names = [pybullet.getJointInfo(self.robot, j, physicsClientId=c)[1].decode() for j in self.all_joints]
                 pairs = [(joint, self.drawing.joint_address(name)) for joint, name in zip(self.all_joints, names)]
                 #: (PyBullet joint, MuJoCo qpos address) of every joint both worlds have
@@ -278,7 +280,7 @@ class PybulletPlatform(SimulatedRobotPlatform):
         wanted = self.render_worker if self.render_worker is not None else spare_core()
         if wanted and self.cameras and self.drawing is None and not viewer and "cognition" in contexts:
             try:
-                self.worker = RenderWorker(dict(self.options), self.width, self.height)
+                self.worker = RenderWorker(dict(self.options), self.sizes["top"])
             except PlatformError as exc:
                 print(f"pybullet: {exc}; rendering both cameras in this process", file=sys.stderr)
 
@@ -524,7 +526,8 @@ class PybulletPlatform(SimulatedRobotPlatform):
             self._pose_drawing(self.drawing)
             return self.drawing.render(camera)
         rgba, _ = self._camera_image(camera, segmentation=False)
-        return np.asarray(rgba, dtype=np.uint8).reshape(self.height, self.width, 4)[:, :, :3].copy()
+        width, height = self.sizes[camera]
+        return np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3].copy()
 
     def _camera_pose(self, camera: str) -> tuple[np.ndarray, np.ndarray]:
         """(position m, axes 3x3: columns forward, left, up) of the ``top`` or ``bottom`` camera in the world."""
@@ -541,13 +544,14 @@ class PybulletPlatform(SimulatedRobotPlatform):
     def _camera_image(self, camera: str, segmentation: bool) -> tuple[Any, Any]:
         eye, axes = self._camera_pose(camera)
         view = pybullet.computeViewMatrix(eye.tolist(), (eye + axes[:, 0]).tolist(), axes[:, 2].tolist())
-        projection = pybullet.computeProjectionMatrixFOV(math.degrees(VERTICAL_FOV), self.width / self.height, 0.01, 30.0)
+        width, height = self.sizes[camera]
+        projection = pybullet.computeProjectionMatrixFOV(math.degrees(VERTICAL_FOV), width / height, 0.01, 30.0)
         # lit from behind the camera and from above, like MuJoCo's headlight and sun: posts look alike
         light = -axes[:, 0] + np.array([0.0, 0.0, 1.0])
         if self.shadows and self.scene_look:  # --realism: the hall's sun, where shadows fall the same way from every view
             light = -np.array(sun_direction(self.scene_look.seed))
         flags = pybullet.ER_SEGMENTATION_MASK_OBJECT_AND_LINKINDEX if segmentation else pybullet.ER_NO_SEGMENTATION_MASK
-        _, _, rgba, _, segments = pybullet.getCameraImage(self.width, self.height, view, projection, renderer=pybullet.ER_TINY_RENDERER,
+        _, _, rgba, _, segments = pybullet.getCameraImage(width, height, view, projection, renderer=pybullet.ER_TINY_RENDERER,
                                                           flags=flags, shadow=int(self.shadows), lightDirection=light.tolist(),
                                                           lightAmbientCoeff=0.55, lightDiffuseCoeff=0.5, lightSpecularCoeff=0.0,
                                                           physicsClientId=self.client)
@@ -574,7 +578,8 @@ class PybulletPlatform(SimulatedRobotPlatform):
             self._pose_drawing(self.drawing)
             return self.drawing.ball_mask(camera)
         _, segments = self._camera_image(camera, segmentation=True)
-        return (np.asarray(segments).reshape(self.height, self.width) & ((1 << 24) - 1)) == self.bodies["ball"]
+        width, height = self.sizes[camera]
+        return (np.asarray(segments).reshape(height, width) & ((1 << 24) - 1)) == self.bodies["ball"]
 
     def world_state(self) -> int:
         return pybullet.saveState(physicsClientId=self.client)

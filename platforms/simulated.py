@@ -90,16 +90,28 @@ def parse_pose(text: str) -> tuple[float, float, float]:
 
 
 def parse_resolution(text: str) -> tuple[int, int]:
-    """``--resolution``: ``WIDTHxHEIGHT``, 16 to 4096 pixels a side."""
+    """One camera's ``WIDTHxHEIGHT``, 16 to 4096 pixels a side."""
     side = Annotated[int, Range(16, 4096)]
     return convert(str(text).lower(), tuple[side, side], where="--resolution", separator="x", error=PlatformOptionError,
-                   expected="WIDTHxHEIGHT with 16 to 4096 pixels a side, e.g. 320x240")
+                   expected="WIDTHxHEIGHT with 16 to 4096 pixels a side, e.g. 320x240, or TOP,BOTTOM: 640x480,320x240")
+
+
+def parse_resolutions(text: str) -> dict[str, tuple[int, int]]:
+    """``--resolution``: ``WIDTHxHEIGHT`` for both cameras, or ``TOP,BOTTOM`` (``640x480,320x240``, as the NAO's
+    cameras are usually set: the top one sees far, the bottom one the feet)."""
+    parts = str(text).split(",")
+    if len(parts) > 2:
+        raise PlatformOptionError(f"--resolution takes WIDTHxHEIGHT or TOP,BOTTOM (e.g. 640x480,320x240), got {text!r}")
+    top = parse_resolution(parts[0].strip())
+    return {"top": top, "bottom": parse_resolution(parts[-1].strip())}
 
 
 def has_display() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
+#: the cameras' image size, both (``--resolution``)
+DEFAULT_RESOLUTION = "320x240"
 MAX_PUSH = 500.0  # N: more would throw the robot off the field, not test a fall
 #: how far from the centre spot things can be put (mm): the field and its border strip
 CARPET_X = field.LENGTH / 2 + field.BORDER_STRIP
@@ -137,7 +149,8 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         super().__init__(options)
         self.seed = convert(self.options.get("seed") or 0, int, where="--seed", bounds=(0, 2**32 - 1), error=PlatformOptionError)
         self.cameras = convert(self.options.get("cameras", "on"), bool, where="--cameras", error=PlatformOptionError)
-        self.width, self.height = parse_resolution(self.options.get("resolution") or "320x240")
+        #: camera -> (width, height) px of its images (--resolution)
+        self.sizes = parse_resolutions(self.options.get("resolution") or DEFAULT_RESOLUTION)
         self.initial_ball = parse_pair(self.options.get("ball") or DEFAULT_BALL, "--ball")
         self.initial_ball_velocity = parse_velocity(self.options.get("ball_velocity") or "0,0")
         self.sensor_noise = parse_noise(self.options.get("sensor_noise"))
@@ -181,7 +194,8 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         name = cls.name
         parser.add_argument("--seed", type=seed_number, default=0, help=f"{name}: seed of the sensor noise")
         parser.add_argument("--cameras", choices=["on", "off"], default="on", help=f"{name}: render the cameras")
-        parser.add_argument("--resolution", default="320x240", help=f"{name}: camera image size WIDTHxHEIGHT")
+        parser.add_argument("--resolution", default=DEFAULT_RESOLUTION,
+                            help=f"{name}: camera image size WIDTHxHEIGHT for both, or TOP,BOTTOM (the NAO's: 640x480,320x240)")
         parser.add_argument("--ball", default=DEFAULT_BALL, help=f"{name}: ball start X,Y in mm on the field (default: the centre spot)")
         parser.add_argument("--ball-velocity", default="0,0", metavar="VX,VY",
                             help=f"{name}: the ball rolls off at VX,VY mm/s on the field (default: it lies still)")
@@ -376,7 +390,7 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
                 image = blackboard[rep]
                 image.image = images[camera]
                 image.time_ns = taken_ns
-                image.horizontal_fov, image.vertical_fov = self.fov()
+                image.horizontal_fov, image.vertical_fov = self.fov(camera)
 
     def realistic(self, images: dict[str, np.ndarray], time_ns: int) -> dict[str, np.ndarray]:
         """The rendered images as the real cameras would deliver them (``--realism``), blurred by how fast
@@ -389,15 +403,16 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
                 last = self.last_camera.get(camera)
                 if last is not None:
                     pipeline = self.camera_realism[camera]
-                    shift = image_shift(last[1], rotation, (time_ns - last[0]) * 1e-9, pipeline.exposure_s, self.focal_px())
+                    shift = image_shift(last[1], rotation, (time_ns - last[0]) * 1e-9, pipeline.exposure_s, self.focal_px(camera))
                 self.last_camera[camera] = (time_ns, rotation)
             result[camera] = self.camera_realism[camera](image, shift)
         return result
 
-    def focal_px(self) -> tuple[float, float]:
-        """(horizontal, vertical) focal length of the rendered images (px)."""
-        horizontal, vertical = self.fov()
-        return self.width / 2 / math.tan(horizontal / 2), self.height / 2 / math.tan(vertical / 2)
+    def focal_px(self, camera: str = "top") -> tuple[float, float]:
+        """(horizontal, vertical) focal length of ``camera``'s rendered images (px)."""
+        horizontal, vertical = self.fov(camera)
+        width, height = self.sizes[camera]
+        return width / 2 / math.tan(horizontal / 2), height / 2 / math.tan(vertical / 2)
 
     def tell_known_pose(self, blackboard: Blackboard) -> None:
         """``KnownPose``: the last pose told, and after ``sim:move_robot -reset on`` a new one, where the
@@ -431,9 +446,11 @@ class SimulatedRobotPlatform(NetworkedPlatform, Platform):
         targets, self.stiffness = self.guard(command.position, command.stiffness)
         self.drive(targets, self.stiffness)
 
-    def fov(self) -> tuple[float, float]:
-        """(horizontal, vertical) field of view of the rendered images (rad)."""
-        return 2 * math.atan(math.tan(VERTICAL_FOV / 2) * self.width / self.height), VERTICAL_FOV
+    def fov(self, camera: str = "top") -> tuple[float, float]:
+        """(horizontal, vertical) field of view of ``camera``'s rendered images (rad): the vertical one is the
+        NAO's, the horizontal one follows the image's width to height."""
+        width, height = self.sizes[camera]
+        return 2 * math.atan(math.tan(VERTICAL_FOV / 2) * width / height), VERTICAL_FOV
 
     # ------------------------------------------------------------------------- ground truth
     def torso_angles(self) -> tuple[float, float]:

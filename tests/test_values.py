@@ -179,7 +179,7 @@ def test_platform_options_say_what_would_be_right() -> None:
     with pytest.raises(PlatformOptionError, match=r"^--start takes X,Y,ROT .*, got '1,2'$"):
         parse_pose("1,2")
     assert parse_pose("0,0,7")[2] == pytest.approx(7 - 2 * math.pi)
-    with pytest.raises(PlatformOptionError, match=r"^--resolution takes WIDTHxHEIGHT with 16 to 4096 pixels a side, e.g. 320x240, got '8x8'$"):
+    with pytest.raises(PlatformOptionError, match=r"^--resolution takes WIDTHxHEIGHT with 16 to 4096 pixels a side, e.g. 320x240, or TOP,BOTTOM: 640x480,320x240, got '8x8'$"):
         parse_resolution("8x8")
     assert parse_noise(None) == 1.0 and parse_noise("0") == 0.0
     assert number({"x": "12.5"}, "x") == 12.5 and number({}, "x", default=3.0) == 3.0

@@ -109,7 +109,8 @@ def add_match_command(commands: Any) -> None:
     match.add_argument("--record-dir", type=Path, metavar="DIR", help="every robot records its log here (TEAM_PLAYER.mcap)")
     match.add_argument("--record-reps", metavar="A,B", help="record only these representations (as tafel run --record-reps)")
     match.add_argument("--result", type=Path, metavar="FILE.json", help="also write the result's JSON object here")
-    match.add_argument("--resolution", default="320x240", help="camera image size WIDTHxHEIGHT")
+    match.add_argument("--resolution", default="320x240",  # the platforms' DEFAULT_RESOLUTION
+                       help="camera image size WIDTHxHEIGHT for both cameras, or TOP,BOTTOM (the NAO's: 640x480,320x240)")
     match.add_argument("--ready-seconds", type=positive(float), default=30.0, help="longest READY (default 30)")
     match.add_argument("--goals", type=positive(int), metavar="N", help="end the game when a team has scored N goals (drills, tests)")
     match.add_argument("--halves", type=int, choices=[1, 2], default=2, help="play both halves (default) or only the first (drills, tests)")

@@ -30,7 +30,9 @@ from typing import Any, TextIO
 from tafel.platforms.field_world import level_look
 from tafel.platforms.match_robot import AUTHKEY_ENV
 from tafel.platforms.match_world import TICK_NS, MatchWorld, Side
+from tafel.platforms.mujoco_sim import offscreen_size
 from tafel.platforms.realism import parse_realism, realism_level
+from tafel.platforms.simulated import parse_resolutions
 from tafel.representations.game import GamePhase, SetPlay, State
 from tafel.tools.simulation.officiating import Player
 from tafel.tools.simulation.passes import PassCounter
@@ -92,12 +94,12 @@ class Match:
         for index, player in enumerate(self.players):
             player.index = index
         places = [player.side.to_world(*ENTRY[player.number - 1]) for player in self.players]
-        width, height = (int(v) for v in str(args.resolution).lower().split("x"))
+        sizes = parse_resolutions(args.resolution)
         #: --realism: every robot's camera pipeline (seeded by its own seed) and the world's hall (seeded by --seed)
         self.realism = parse_realism(getattr(args, "realism", "off"))
         level = realism_level(self.realism)
         look = level_look(args.seed, level)
-        self.world = MatchWorld([(x, y) for x, y, _ in places], offscreen=(max(width, 640), max(height, 480)), look=look,
+        self.world = MatchWorld([(x, y) for x, y, _ in places], offscreen=offscreen_size(sizes), look=look,
                                 shadows=bool(level and level.shadows))
         for player, (x, y, heading) in zip(self.players, places):
             self.world.move_robot(player.index, x, y, heading)

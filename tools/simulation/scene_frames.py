@@ -108,18 +108,18 @@ class SceneRenderer:
                       np.array([math.cos(heading / 2), 0.0, 0.0, math.sin(heading / 2)]))
         p.move_ball(*ball)
         ball_robot = robot.to_local(*ball)
-        horizontal_fov, vertical_fov = p.fov()
         result = {}
         for name, mount in CAMERAS.items():
+            horizontal_fov, vertical_fov = p.fov(name)
             camera = torso_in_robot @ camera_pose_in_torso(poses, mount)
             matrix = CameraMatrix(camera[:3, :3].copy(), camera[:3, 3].copy(), True)
             image = p.render(name)
-            projected = project_ball(matrix, ball_robot, p.width, p.height, horizontal_fov, vertical_fov)
+            projected = project_ball(matrix, ball_robot, *p.sizes[name], horizontal_fov, vertical_fov)
             if paint is not None:
                 image = paint(name, image, projected)
             pipeline = p.camera_realism.get(name)
             if pipeline is not None:
-                image = pipeline(image, pipeline.posed_shift(p.focal_px()[0]))
+                image = pipeline(image, pipeline.posed_shift(p.focal_px(name)[0]))
             mask = p.ball_mask(name)
             visible = 0.0
             if projected is not None:
