@@ -18,8 +18,17 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tafel.core.framework.manager import make_module
-from tafel.modules.perception.field_boundary_detector import cell_shares
-from tafel.modules.perception.field_color_provider import below, byte_median, byte_percentile, white_pixels
+from tafel.modules.perception.field_boundary_detector import cell_shares, chain, lower_hull
+from tafel.modules.perception.field_color_provider import (
+    below,
+    byte_median,
+    byte_percentile,
+    channel_histogram,
+    every,
+    histogram_median,
+    histogram_percentile,
+    white_pixels,
+)
 from tafel.modules.perception.goal_post_detector import (
     GoalPostDetector,
     band_passes,
@@ -38,6 +47,7 @@ from tafel.modules.perception.spl_ball_detector import (
     SPLBallDetector,
     Spot,
     carpet,
+    carpet_light,
     carpet_sample,
     centroids,
     green_below,
@@ -102,6 +112,13 @@ def reference_dark_pixels(self: SPLBallDetector, hsv: np.ndarray, green: np.ndar
     if sampled.size < 10:
         return None
     return hsv[..., 2] < self.parameters.black_contrast * float(np.median(sampled))
+
+
+def reference_carpet(hsv: np.ndarray, green: np.ndarray) -> tuple[float, float]:
+    sampled = carpet_sample(hsv, green)
+    if len(sampled) < 10:
+        return 128.0, 128.0
+    return float(np.median(sampled[:, 2])), float(np.median(sampled[:, 1]))
 
 
 def reference_strict_green(self: SPLBallDetector, hsv: np.ndarray, green: np.ndarray) -> np.ndarray:
@@ -348,14 +365,14 @@ def test_spl_candidates_are_the_loops(painted: tuple[np.ndarray, np.ndarray, np.
     height, width = green.shape
     self = detector()
     projection = level_projection(width, height, pitch)
-    sampled = carpet_sample(hsv, green)
+    sampled = carpet_light(hsv, green)
     strict = self.strict_green(hsv, green, sampled)
     np.testing.assert_array_equal(strict, reference_strict_green(self, hsv, green))
     dark, old_dark = self.dark_pixels(hsv, green, sampled), reference_dark_pixels(self, hsv, green)
     assert (dark is None) == (old_dark is None)
     if dark is not None:
         np.testing.assert_array_equal(dark, old_dark)
-    assert carpet(hsv, green, sampled) == carpet(hsv, green)
+    assert carpet(hsv, green, sampled) == carpet(hsv, green) == reference_carpet(hsv, green)
     for rows in (boundary, np.zeros(0, np.float32)):
         spots = self.spots(strict, rows, projection, dark)
         same_spots(spots, reference_spots(self, strict, rows, projection, old_dark))
@@ -393,10 +410,10 @@ def same_band_spots(self: SPLBallDetector, hsv: np.ndarray, green: np.ndarray, b
                     taken: list[Spot]) -> int:
     """The band search's spots, asserted those of the loops over the whole band, with the module's parameters and with
     ``LOOSE_BAND``; how many the loose search found."""
-    sampled = carpet_sample(hsv, green)
-    if len(sampled) < 10:
+    sampled = carpet_light(hsv, green)
+    if sampled.count < 10:
         return 0
-    strict, value = self.strict_green(hsv, green, sampled), byte_median(sampled[:, 2])
+    strict, value = self.strict_green(hsv, green, sampled), byte_median(carpet_sample(hsv, green)[:, 2])
     found = 0
     for loose in (False, True):
         if loose:
@@ -551,6 +568,65 @@ def test_byte_percentile_is_numpys(seed: int, count: int, low: int, high: int, q
     """The white's percentile from a histogram: numpy's percentile of the same bytes, to the last bit."""
     values = np.random.default_rng(seed).integers(min(low, high), max(low, high) + 1, count).astype(np.uint8)
     assert byte_percentile(values, q) == float(np.percentile(values, q))
+
+
+@settings(max_examples=300)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 70), st.integers(1, 70), st.integers(1, 9), st.sampled_from([0, 1, 3]), st.booleans(),
+       st.integers(0, 69))
+def test_every_is_numpys_strided_copy(seed: int, rows: int, columns: int, step: int, channels: int, boolean: bool, start: int) -> None:
+    """The subsample by OpenCV's nearest-neighbour resize: numpy's ``[::step, ::step]``, for any size (part-blocks at the
+    ends) and from any first row (the field colour's samples start below the horizon)."""
+    rng = np.random.default_rng(seed)
+    shape = (rows, columns, channels) if channels else (rows, columns)
+    image = rng.random(shape) < 0.5 if boolean else rng.integers(0, 256, shape).astype(np.uint8)
+    image = image[min(start, rows - 1) :]
+    sampled = every(image, step)
+    assert sampled.dtype == image.dtype and sampled.flags.c_contiguous
+    np.testing.assert_array_equal(sampled, image[::step, ::step])
+
+
+@settings(max_examples=300)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 60), st.integers(1, 60), st.integers(0, 2), st.floats(0.0, 1.0),
+       st.one_of(st.sampled_from([99, 0, 100, 50]), st.floats(0.0, 100.0)))
+def test_histograms_give_the_medians_and_percentiles_of_the_gathered_bytes(seed: int, rows: int, columns: int, channel: int, share: float,
+                                                                         q: float) -> None:
+    """A channel's histogram under a mask counts the bytes the mask gathers; their median and percentile from it are
+    numpy's of those bytes, to the last bit."""
+    rng = np.random.default_rng(seed)
+    image = rng.integers(0, 256, (rows, columns, 3)).astype(np.uint8)
+    mask = rng.random((rows, columns)) < share
+    counts = channel_histogram(image, channel, mask)
+    gathered = image[..., channel][mask]
+    np.testing.assert_array_equal(counts, np.bincount(gathered, minlength=256))
+    if gathered.size:
+        assert histogram_median(counts) == float(np.median(gathered))
+        assert histogram_percentile(counts, q) == float(np.percentile(gathered, q))
+
+
+@settings(max_examples=200)
+@given(scenes)
+def test_the_carpets_light_from_histograms_is_the_samples(painted: tuple[np.ndarray, np.ndarray, np.ndarray, float]) -> None:
+    """The carpet's count and medians from the sample's histograms: those of the gathered sample."""
+    hsv, green, _, _ = painted
+    light, sampled = carpet_light(hsv, green), carpet_sample(hsv, green)
+    assert light.count == len(sampled)
+    if len(sampled):
+        assert (light.value, light.saturation) == (float(np.median(sampled[:, 2])), float(np.median(sampled[:, 1])))
+
+
+@settings(max_examples=300)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 170), st.sampled_from(["noise", "flat", "ridge", "steps"]))
+def test_the_lower_hull_over_opencvs_hull_is_the_chain_over_every_point(seed: int, count: int, kind: str) -> None:
+    """The boundary's lower hull from the vertices of OpenCV's convex hull: the monotone chain over every point,
+    for noisy, flat (all collinear), ridged and stepped columns of cells."""
+    rng = np.random.default_rng(seed)
+    xs = (np.arange(count) + 0.5) * 4
+    ys = {"noise": rng.integers(0, 120, count), "flat": np.full(count, int(rng.integers(0, 120))),
+          "ridge": np.abs(np.arange(count) - count // 2) * int(rng.integers(0, 3)),
+          "steps": rng.integers(0, 3, count) + np.arange(count) // 7}[kind].astype(np.float32) * 4
+    for ours, theirs in zip(lower_hull(xs, ys), chain(xs, ys), strict=True):
+        assert ours.dtype == theirs.dtype
+        np.testing.assert_array_equal(ours, theirs)
 
 
 def test_byte_percentile_interpolates_as_numpy_does() -> None:

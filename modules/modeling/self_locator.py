@@ -262,12 +262,13 @@ class SelfLocator(Module):
             distance = FIELD_MODEL.line_distance(self.to_field(points))
             log_weight += p.point_weight * robust(distance / std).sum(axis=1)
             measurements += p.point_weight * len(points)
-        for post in self.goal_post_percept.posts:
-            if not (math.isfinite(post.x) and math.isfinite(post.y)):
-                continue
-            distance = FIELD_MODEL.post_distance(self.to_field(np.array([[post.x, post.y]]))[:, 0])
-            log_weight += robust(distance / self.post_std(post.x, post.y))
-            measurements += 1
+        posts = [(post.x, post.y) for post in self.goal_post_percept.posts if math.isfinite(post.x) and math.isfinite(post.y)]
+        if posts:  # every post from every particle at once; each post's term added in turn, as one by one
+            seen = np.array(posts)
+            distances = FIELD_MODEL.post_distance(self.to_field(seen).reshape(-1, 2)).reshape(len(self.particles), len(posts))
+            for k, (x, y) in enumerate(posts):
+                log_weight += robust(distances[:, k] / self.post_std(x, y))
+            measurements += len(posts)
         if self.line_percept.circle_seen and math.isfinite(self.line_percept.circle_x) and math.isfinite(self.line_percept.circle_y):
             centre = self.to_field(np.array([[self.line_percept.circle_x, self.line_percept.circle_y]]))[:, 0]
             log_weight += robust(np.linalg.norm(centre, axis=1) / p.circle_std)

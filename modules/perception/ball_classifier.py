@@ -60,7 +60,7 @@ def features(hsv: np.ndarray, green: np.ndarray, x: float, y: float, radius: flo
     corners = np.array([[x - side, y - side], [x + side, y - side], [x - side, y + side]], np.float32)
     target = np.array([[0, 0], [PATCH, 0], [0, PATCH]], np.float32)
     warp = cv2.getAffineTransform(corners, target)
-    grey = cv2.warpAffine(np.ascontiguousarray(hsv[..., 2]), warp, (PATCH, PATCH), flags=cv2.INTER_AREA, borderMode=cv2.BORDER_REPLICATE)
+    grey = cv2.warpAffine(cv2.extractChannel(np.ascontiguousarray(hsv), 2), warp, (PATCH, PATCH), flags=cv2.INTER_AREA, borderMode=cv2.BORDER_REPLICATE)
     out[: PATCH * PATCH] = np.clip(grey.astype(np.float32).ravel() / bright, 0.0, 2.0)
     # the carpet's share in each sector of the ring, clockwise from above (image y grows downwards)
     angle = (np.arctan2(dx, -dy) % (2 * math.pi)) / (2 * math.pi) * SECTORS

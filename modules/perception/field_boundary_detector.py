@@ -17,7 +17,21 @@ from tafel.representations.perception import CameraImageBottom, CameraImageTop, 
 
 def lower_hull(xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The largest convex function below the points (image y grows downwards, so: the boundary with the
-    dents of goal posts and robots in front of it removed). ``xs`` ascending."""
+    dents of goal posts and robots in front of it removed). ``xs`` ascending.
+
+    The chain runs over the vertices of the points' convex hull (OpenCV's, a few of the points): the
+    points inside it are never on the lower hull, and for the cells' points (whole px, exact in float32)
+    the result is the chain over all points (``tests/test_perception_speed.py``)."""
+    if len(xs) > 3:
+        points = np.column_stack([xs, ys]).astype(np.float32)
+        if np.array_equal(points[:, 0], xs) and np.array_equal(points[:, 1], ys):  # exact in float32: OpenCV's hull is exact
+            vertices = np.sort(cv2.convexHull(points, returnPoints=False).ravel())
+            return chain(xs[vertices], ys[vertices])
+    return chain(xs, ys)
+
+
+def chain(xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``lower_hull`` by the monotone chain over every point (``xs`` ascending)."""
     hull: list[int] = []
     x, y = xs.tolist(), ys.tolist()  # Python floats: numpy scalars made this loop several times slower
     for i in range(len(x)):
@@ -70,13 +84,17 @@ def local_medians(tops: np.ndarray, found: np.ndarray, reach: int) -> np.ndarray
 def cell_shares(mask: np.ndarray, cell: int) -> np.ndarray:
     """The share of each ``cell`` x ``cell`` square of a mask that is set (float32), as
     ``cv2.resize(mask.astype(np.float32), ..., interpolation=cv2.INTER_AREA)`` gives it: where the cells
-    tile the mask and hold a power of two pixels, from the mask's integral image (the same values, a
-    fraction of the time); else by that resize."""
+    tile the mask and hold a power of two pixels, from each cell's count (the same values, a fraction of
+    the time: OpenCV's area resize of the bytes, each set pixel weighing the cell's area, or the mask's
+    integral image); else by that resize."""
     height, width = mask.shape
     n_rows, n_cols = max(1, height // cell), max(1, width // cell)
     area = cell * cell
     if height % cell or width % cell or area & (area - 1):
         return cv2.resize(mask.astype(np.float32), (n_cols, n_rows), interpolation=cv2.INTER_AREA)
+    if mask.dtype == np.bool_ and area <= 255:  # each pixel weighs the cell's area: OpenCV's area mean of the bytes is the count
+        counts = cv2.resize(mask.view(np.uint8) * np.uint8(area), (n_cols, n_rows), interpolation=cv2.INTER_AREA)
+        return counts.astype(np.float32) * (np.float32(1) / np.float32(area))
     corners = cv2.integral(mask.view(np.uint8) if mask.dtype == np.bool_ else mask.astype(np.uint8))[::cell, ::cell]
     counts = corners[1:, 1:] - corners[:-1, 1:] - corners[1:, :-1] + corners[:-1, :-1]
     return counts.astype(np.float32) * (np.float32(1) / np.float32(area))

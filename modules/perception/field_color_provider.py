@@ -49,8 +49,14 @@ def byte_median(values: np.ndarray) -> float:
     """``np.median`` of uint8 values (the same number), from their histogram instead of a partitioned copy."""
     if len(values) == 0:
         return float(np.median(values))  # nan, with numpy's warning
-    cumulative = np.cumsum(np.bincount(values, minlength=256))
-    low, high = np.searchsorted(cumulative, [(len(values) - 1) // 2, len(values) // 2], side="right")
+    return histogram_median(np.bincount(values, minlength=256))
+
+
+def histogram_median(counts: np.ndarray) -> float:
+    """``byte_median`` of the values whose histogram is ``counts`` (how many of each of 0..255; at least one value)."""
+    cumulative = np.cumsum(counts)
+    count = int(cumulative[-1])
+    low, high = np.searchsorted(cumulative, [(count - 1) // 2, count // 2], side="right")
     return (int(low) + int(high)) / 2
 
 
@@ -60,14 +66,49 @@ def byte_percentile(values: np.ndarray, q: float) -> float:
     partitioned copy of the values."""
     if len(values) == 0 or not 0 <= q <= 100:
         return float(np.percentile(values, q))  # nan with numpy's warning, or numpy's error
-    count = len(values)
+    return histogram_percentile(np.bincount(values, minlength=256), q)
+
+
+def histogram_percentile(counts: np.ndarray, q: float) -> float:
+    """``byte_percentile`` of the values whose histogram is ``counts`` (how many of each of 0..255; at least one value;
+    0 <= q <= 100)."""
+    cumulative = np.cumsum(counts)
+    count = int(cumulative[-1])
     virtual = (count - 1) * (q / 100)  # where the percentile lies among the sorted values
     previous = count - 1 if virtual >= count - 1 else math.floor(virtual)
     gamma = virtual - (-1 if virtual >= count - 1 else previous)  # numpy indexes the last value as -1
-    cumulative = np.cumsum(np.bincount(values, minlength=256))
     low, high = (float(v) for v in np.searchsorted(cumulative, [previous, min(previous + 1, count - 1)], side="right"))
     difference = high - low
     return low + difference * gamma if gamma < 0.5 else high - difference * (1 - gamma)
+
+
+def every(image: np.ndarray, step: int) -> np.ndarray:
+    """``image[::step, ::step]`` (h x w, or h x w x channels; uint8 or bool) as a contiguous array: the whole blocks of
+    ``step`` x ``step`` pixels by OpenCV's nearest-neighbour resize (it takes pixel ``step * i`` for pixel ``i``: the
+    same pixels, a fraction of the time numpy takes for the strided copy), the last part-block's row and column by numpy."""
+    height, width = image.shape[:2]
+    rows, columns = height - height % step, width - width % step  # the whole blocks
+    if step <= 1 or not rows or not columns or image.dtype not in (np.uint8, np.bool_) or image.ndim not in (2, 3):
+        return np.ascontiguousarray(image[::step, ::step])
+    core = cv2.resize(image[:rows, :columns].view(np.uint8), (columns // step, rows // step), interpolation=cv2.INTER_NEAREST)
+    core = core.reshape(rows // step, columns // step, *image.shape[2:]).view(image.dtype)
+    if rows == height and columns == width:
+        return core
+    out = np.empty((-(-height // step), -(-width // step), *image.shape[2:]), image.dtype)
+    out[: rows // step, : columns // step] = core
+    out[: rows // step, columns // step :] = image[:rows:step, columns::step]
+    out[rows // step :] = image[rows::step, ::step]
+    return out
+
+
+def channel_histogram(image: np.ndarray, channel: int, mask: np.ndarray) -> np.ndarray:
+    """How many of ``image``'s pixels (h x w x channels, uint8) where ``mask`` (h x w, bool or uint8: not 0) is set have
+    each value 0..255 in ``channel`` (int64): ``np.bincount(image[..., channel][mask != 0], minlength=256)`` without
+    gathering them."""
+    if not image.size:
+        return np.zeros(256, np.int64)
+    counts = cv2.calcHist([np.ascontiguousarray(image)], [channel], np.ascontiguousarray(mask).view(np.uint8), [256], [0, 256])
+    return counts.ravel().astype(np.int64)  # float32 counts: exact below 2**24 pixels
 
 
 def green_mask(color: FieldColor, hsv: np.ndarray) -> np.ndarray:
@@ -136,9 +177,13 @@ class FieldColorProvider(Module):
             setattr(segmented, f"{camera}_green", green)
             # white: the brightest unsaturated pixels off the field (sampled: a percentile of every pixel costs)
             step = self.parameters.step
-            sampled, off_field = hsv[::step, ::step], ~green[::step, ::step]
-            values = sampled[off_field & (sampled[..., 1] <= WHITE_SATURATION_MAX)][:, 2]
-            setattr(segmented, f"{camera}_white", byte_percentile(values, 99) if values.size else 255.0)
+            sampled = every(hsv, step)
+            counts = np.zeros(256, np.int64)
+            if sampled.size:  # the values' histogram of the unsaturated pixels off the field, without gathering them
+                chosen = cv2.inRange(sampled, (0, 0, 0), (255, WHITE_SATURATION_MAX, 255))  # unsaturated
+                chosen[every(green, step)] = 0  # and off the field
+                counts = channel_histogram(sampled, 2, chosen)
+            setattr(segmented, f"{camera}_white", histogram_percentile(counts, 99) if counts.any() else 255.0)
 
     def estimate(self) -> None:
         """This frame's field colour from samples of both images, blended into the last estimate."""
@@ -148,23 +193,30 @@ class FieldColorProvider(Module):
             if camera == "top" and (projection.height, projection.width) == segmented.top_hsv.shape[:2]:
                 horizon = max(projection.horizon(0.0), projection.horizon(projection.width - 1.0))  # its lower end
                 top_start = float(np.clip(horizon + p.horizon_margin * projection.height, 0.0, 0.9 * projection.height))
-        samples = [hsv[int(start) :: p.step, :: p.step].reshape(-1, 3)
+        samples = [every(hsv[int(start) :], p.step).reshape(-1, 3)
                    for hsv, start in ((segmented.bottom_hsv, 0.0), (segmented.top_hsv, top_start)) if hsv.size]
         if not samples:
             return
-        hsv = np.concatenate(samples)
-        chosen = cv2.inRange(hsv.reshape(-1, 1, 3), (p.hue_low, p.saturation_floor, 30), (p.hue_high, 255, 255))  # bounds kept
-        greenish = hsv[np.bitwise_and(chosen, 1, out=chosen).view(bool).ravel()]
-        if len(greenish) < p.min_share * len(hsv):
+        hsv = np.concatenate(samples).reshape(-1, 1, 3)
+        chosen = cv2.inRange(hsv, (p.hue_low, p.saturation_floor, 30), (p.hue_high, 255, 255))  # bounds kept
+        # the greenish pixels' hues, and below the peak's pixels' saturations and values, counted without gathering them
+        counts = channel_histogram(hsv, 0, chosen.view(bool))
+        if int(counts.sum()) < p.min_share * len(hsv):
             return
-        histogram = np.bincount(greenish[:, 0], minlength=180).astype(float)
+        highest = int(np.flatnonzero(counts)[-1]) if counts.any() else 0
+        histogram = counts[: max(180, highest + 1)].astype(float)  # as np.bincount(hues, minlength=180)
         histogram = np.convolve(histogram, np.ones(5) / 5, mode="same")
         peak = float(np.argmax(histogram))
-        hue = greenish[:, 0]
-        near = greenish[(hue >= peak - 15) & (hue <= peak + 15)]  # the peak is a whole hue
-        tolerance = float(np.clip(3.0 * near[:, 0].std() + 4.0, 6.0, 20.0))
-        saturation = float(max(p.saturation_floor, 0.45 * byte_median(near[:, 1])))
-        value = float(max(25.0, 0.35 * byte_median(near[:, 2])))
+        # the peak is a whole hue: the greenish pixels within 15 of it, in their order (the spread's sum is taken in it)
+        near = cv2.inRange(hsv, (max(p.hue_low, peak - 15), p.saturation_floor, 30), (min(p.hue_high, peak + 15), 255, 255)).view(bool)
+        hues = hsv[:, 0, 0][near.ravel()]
+        tolerance = float(np.clip(3.0 * hues.std() + 4.0, 6.0, 20.0))
+        if len(hues):
+            saturation_median, value_median = (histogram_median(channel_histogram(hsv, channel, near)) for channel in (1, 2))
+        else:
+            saturation_median = value_median = byte_median(hues)  # none: numpy's nan
+        saturation = float(max(p.saturation_floor, 0.45 * saturation_median))
+        value = float(max(25.0, 0.35 * value_median))
         weight = p.smoothing if out.valid else 1.0
         out.hue += weight * (peak - out.hue)
         out.hue_tolerance += weight * (tolerance - out.hue_tolerance)

@@ -254,8 +254,8 @@ class GoalPostDetector(Module):
     parameters: Parameters
 
     def __init__(self) -> None:
-        self.colour: np.ndarray = np.zeros((0, 0, 3), np.uint8)
-        """the image being searched, in YCrCb"""
+        self.image: np.ndarray = np.zeros((0, 0, 3), np.uint8)
+        """the image being searched (RGB); ``ycrcb`` gives its rows in YCrCb"""
         self.band_colour = np.zeros((0, 3), np.float32)
         """each column's mean colour (YCrCb) in the band above the boundary"""
         self.band_white = np.zeros(0, np.float32)
@@ -290,12 +290,12 @@ class GoalPostDetector(Module):
         room = top > band
         if not room.any():
             return []
-        self.colour = cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2YCrCb)
+        self.image = image
         first_row, last_row = int(top[room].min()) - band, int(top[room].max())
         # each column's band: its rows from high up to low (in the rows from first_row on)
         low = np.clip(top - first_row, 0, last_row - first_row)
         high = np.clip(top - band - first_row, 0, last_row - first_row)
-        colour = cv2.integral(self.colour[first_row:last_row], sdepth=cv2.CV_32S)
+        colour = cv2.integral(self.ycrcb(slice(first_row, last_row)), sdepth=cv2.CV_32S)
         profile = np.where(room, edge_profile(colour, low, high, max(1, width // 320)), 0.0)
         edges = edge_peaks(profile, p.edge_min)
         # the least width a post can have at each edge: the one it has standing on the boundary (its foot is no farther)
@@ -333,6 +333,11 @@ class GoalPostDetector(Module):
                 self.draw.canvas(Canvas.image(camera)).line(post.image_x, 0, post.image_x, post.image_foot, color="yellow", width=2)
                 self.draw.canvas(Canvas.ROBOT).circle(post.x, post.y, GOAL_POST_DIAMETER / 2, color="yellow", width=2)
         return found
+
+    def ycrcb(self, rows: slice) -> np.ndarray:
+        """Those rows of the image in YCrCb (a pixel's conversion depends on it alone: only the rows looked at are
+        converted, the band's and the posts')."""
+        return cv2.cvtColor(np.ascontiguousarray(self.image[rows]), cv2.COLOR_RGB2YCrCb)
 
     def possible(self, left: np.ndarray, right: np.ndarray, top: np.ndarray, green: np.ndarray,
                  projection: ImageProjection) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -404,7 +409,7 @@ class GoalPostDetector(Module):
         very operations the pixel-by-pixel code did for each (``ImageProjection``'s ``exact``, ``exact_norms``, numpy's
         linspace), so the posts are the same to the last bit."""
         p = self.parameters
-        height = self.colour.shape[0]
+        height = self.image.shape[0]
         if not len(left):
             nothing = np.zeros(0, int)
             return [], (nothing, nothing, nothing, nothing), (nothing, nothing, nothing, nothing)
@@ -452,7 +457,7 @@ class GoalPostDetector(Module):
         half, side, edge = np.maximum(1, post_width // 4), np.maximum(2, post_width // 2), (post_width + 1) // 2
         first_row = int(ys.min())
         block = slice(first_row, int(ys.max()) + 1)
-        pixels = self.colour[block]
+        pixels = self.ycrcb(block)
         colour = cv2.integral(pixels, sdepth=cv2.CV_32S)
         inside = strip_means(colour, pixels, ys - first_row, xs - half, xs + half)
         left, right = (strip_means(colour, pixels, ys - first_row, xs + a, xs + b) for a, b in ((-edge - side, -edge - 1), (edge + 1, edge + side)))

@@ -11,7 +11,15 @@ import numpy as np
 from tafel.core import Module, bounded, provides, requires
 from tafel.debug import Canvas, DebugRequest, Stopwatch
 from tafel.modules.perception.ball_classifier import BallClassifier, features
-from tafel.modules.perception.field_color_provider import below, byte_median, byte_percentile, white_pixels
+from tafel.modules.perception.field_color_provider import (
+    below,
+    byte_median,
+    byte_percentile,
+    channel_histogram,
+    every,
+    histogram_median,
+    white_pixels,
+)
 from tafel.modules.perception.image_geometry import ImageProjection, camera_views
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import CameraMatrixBuffer
@@ -41,6 +49,26 @@ def carpet_sample(hsv: np.ndarray, green: np.ndarray) -> np.ndarray:
     return hsv[::4, ::4][green[::4, ::4]]
 
 
+@dataclass
+class CarpetLight:
+    """The measures of the light from ``carpet_sample``: how many pixels it holds, and their median value and
+    saturation (0 where it holds none)."""
+
+    count: int
+    value: float
+    saturation: float
+
+
+def carpet_light(hsv: np.ndarray, green: np.ndarray) -> CarpetLight:
+    """``carpet_sample``'s count and medians (the same numbers), from the sample's histograms instead of its pixels."""
+    sampled, carpet = every(hsv, 4), every(green, 4)
+    values, saturations = (channel_histogram(sampled, channel, carpet) for channel in (2, 1))
+    count = int(values.sum())
+    if not count:
+        return CarpetLight(0, 0.0, 0.0)
+    return CarpetLight(count, histogram_median(values), histogram_median(saturations))
+
+
 def square_inside(spot: Spot, shape: tuple[int, ...]) -> bool:
     """Whether the classifier's square round ``spot`` (1.1 radii either side) lies within an image of ``shape``."""
     height, width = shape[:2]
@@ -48,14 +76,14 @@ def square_inside(spot: Spot, shape: tuple[int, ...]) -> bool:
     return side <= spot.x <= width - side and side <= spot.y <= height - side
 
 
-def carpet(hsv: np.ndarray, green: np.ndarray, sampled: np.ndarray | None = None) -> tuple[float, float]:
+def carpet(hsv: np.ndarray, green: np.ndarray, light: CarpetLight | None = None) -> tuple[float, float]:
     """The carpet's median value and saturation (sampled), the measures of the light; (128, 128) without carpet.
-    ``sampled``: ``carpet_sample(hsv, green)`` where it is at hand."""
-    if sampled is None:
-        sampled = carpet_sample(hsv, green)
-    if len(sampled) < 10:
+    ``light``: ``carpet_light(hsv, green)`` where it is at hand."""
+    if light is None:
+        light = carpet_light(hsv, green)
+    if light.count < 10:
         return 128.0, 128.0
-    return byte_median(sampled[:, 2]), byte_median(sampled[:, 1])
+    return light.value, light.saturation
 
 
 def windows(xs: np.ndarray, ys: np.ndarray, columns: range, rows: range, shape: tuple[int, int], left: int = 0
@@ -258,12 +286,12 @@ class SPLBallDetector(Module):
         for camera, image, projection in camera_views(self.camera_image_top, self.camera_image_bottom, self.camera_matrix_buffer):
             with self.image:
                 hsv, green = self.segmented_image.hsv(camera), self.segmented_image.green(camera)
-                sampled = carpet_sample(hsv, green)  # one sample of the carpet for every measure of the light below
+                sampled = carpet_light(hsv, green)  # one sample of the carpet for every measure of the light below
                 strict = self.strict_green(hsv, green, sampled)
                 boundary = self.field_boundary.rows(camera)
                 spots = self.spots(strict, boundary, projection, self.dark_pixels(hsv, green, sampled))
-                if self.parameters.edge_search and len(sampled) >= 10:
-                    spots += self.edge_spots(hsv, strict, boundary, projection, byte_median(sampled[:, 2]), spots)
+                if self.parameters.edge_search and sampled.count >= 10:
+                    spots += self.edge_spots(hsv, strict, boundary, projection, sampled.value, spots)
                 white = self.segmented_image.white(camera)
                 light: tuple[float, float] | None = None
                 for spot in spots:
@@ -326,23 +354,23 @@ class SPLBallDetector(Module):
         p = self.parameters
         return replace(p, dark_ratio=p.second_dark_ratio, black_contrast=p.second_black_contrast, saturation_max=p.second_saturation_max)
 
-    def dark_pixels(self, hsv: np.ndarray, green: np.ndarray, sampled: np.ndarray | None = None) -> np.ndarray | None:
+    def dark_pixels(self, hsv: np.ndarray, green: np.ndarray, sampled: CarpetLight | None = None) -> np.ndarray | None:
         """Pixels darker than ``black_contrast`` times the carpet's median value (the ball's black patches
-        are); None without carpet to compare with. ``sampled``: ``carpet_sample(hsv, green)`` where it is at hand."""
+        are); None without carpet to compare with. ``sampled``: ``carpet_light(hsv, green)`` where it is at hand."""
         if sampled is None:
-            sampled = carpet_sample(hsv, green)
-        if len(sampled) < 10:
+            sampled = carpet_light(hsv, green)
+        if sampled.count < 10:
             return None
-        return below(hsv, 2, self.parameters.black_contrast * byte_median(sampled[:, 2]))
+        return below(hsv, 2, self.parameters.black_contrast * sampled.value)
 
-    def strict_green(self, hsv: np.ndarray, green: np.ndarray, sampled: np.ndarray | None = None) -> np.ndarray:
+    def strict_green(self, hsv: np.ndarray, green: np.ndarray, sampled: CarpetLight | None = None) -> np.ndarray:
         """The green mask without the pixels much less saturated than the carpet's median. ``sampled``:
-        ``carpet_sample(hsv, green)`` where it is at hand."""
+        ``carpet_light(hsv, green)`` where it is at hand."""
         if not green.any():
             return green
         if sampled is None:
-            sampled = carpet_sample(hsv, green)
-        median = byte_median(sampled[:, 1]) if len(sampled) else byte_median(hsv[..., 1][green])
+            sampled = carpet_light(hsv, green)
+        median = sampled.saturation if sampled.count else byte_median(hsv[..., 1][green])
         return green & ~below(hsv, 1, self.parameters.strict_saturation * median)
 
     @staticmethod
