@@ -55,9 +55,10 @@ def highest_field_rows(field: np.ndarray, lines: np.ndarray, max_gap: int) -> np
     since the last field cell below it; a column stops at the first cell whose gap is too long."""
     n_rows, n_cols = field.shape
     up = field[::-1]  # row 0 is the image's bottom row
-    step = np.cumsum(~up & ~lines[::-1], axis=0)  # gap cells from the bottom up to each cell
-    rows = np.arange(n_rows)[:, None]
-    last_field = np.maximum.accumulate(np.where(up, rows, -1), axis=0)  # the last field cell at or below
+    # int32 (the counts are at most the rows): half the memory numpy's default int64 moves, twice as fast
+    step = np.cumsum(~up & ~lines[::-1], axis=0, dtype=np.int32)  # gap cells from the bottom up to each cell
+    rows = np.arange(n_rows, dtype=np.int32)[:, None]
+    last_field = np.maximum.accumulate(np.where(up, rows, np.int32(-1)), axis=0)  # the last field cell at or below
     started = last_field >= 0
     gap = step - np.take_along_axis(step, np.maximum(last_field, 0), axis=0)
     alive = ~np.logical_or.accumulate(started & (gap > max_gap), axis=0)

@@ -281,9 +281,9 @@ class GoalPostDetector(Module):
             return []
         white_min = p.white_share * self.segmented_image.white(camera)
 
-        def white(rows: slice) -> np.ndarray:
-            """The white pixels (unsaturated, bright, not green) of those rows: only where they are looked at."""
-            return np.asarray(white_pixels(hsv[rows], p.saturation_max, white_min) & ~green[rows])
+        def white(rows: slice, columns: slice) -> np.ndarray:
+            """The white pixels (unsaturated, bright, not green) of those rows and columns: only where they are looked at."""
+            return np.asarray(white_pixels(hsv[rows, columns], p.saturation_max, white_min) & ~green[rows, columns])
 
         band = max(3, int(round(p.band * height)))
         top = np.round(boundary).astype(int)
@@ -303,7 +303,7 @@ class GoalPostDetector(Module):
         distance = row_norms(np.column_stack([ground, np.zeros(len(edges))]) - projection.translation)
         least = np.where(hit, p.width_low * projection.fx * GOAL_POST_DIAMETER / np.maximum(distance, 1.0) - 1.0, 0.0)
         self.band_colour = band_means(colour, low, high)
-        self.band_white = band_means(cv2.integral(white(slice(first_row, last_row)).view(np.uint8), sdepth=cv2.CV_32S), low, high)
+        self.band_white = band_means(cv2.integral(white(slice(first_row, last_row), slice(None)).view(np.uint8), sdepth=cv2.CV_32S), low, high)
         # each edge with one of the next edges (stickers, dents and shadows on a post make more)
         lefts, rights = (np.concatenate(ends).astype(int) for ends in
                          zip(*((np.arange(len(edges) - k), np.arange(k, len(edges))) for k in range(1, 5))))
@@ -334,10 +334,10 @@ class GoalPostDetector(Module):
                 self.draw.canvas(Canvas.ROBOT).circle(post.x, post.y, GOAL_POST_DIAMETER / 2, color="yellow", width=2)
         return found
 
-    def ycrcb(self, rows: slice) -> np.ndarray:
-        """Those rows of the image in YCrCb (a pixel's conversion depends on it alone: only the rows looked at are
-        converted, the band's and the posts')."""
-        return cv2.cvtColor(np.ascontiguousarray(self.image[rows]), cv2.COLOR_RGB2YCrCb)
+    def ycrcb(self, rows: slice, columns: slice = slice(None)) -> np.ndarray:
+        """Those rows and columns of the image in YCrCb (a pixel's conversion depends on it alone: only the pixels
+        looked at are converted, the band's and the posts')."""
+        return cv2.cvtColor(np.ascontiguousarray(self.image[rows, columns]), cv2.COLOR_RGB2YCrCb)
 
     def possible(self, left: np.ndarray, right: np.ndarray, top: np.ndarray, green: np.ndarray,
                  projection: ImageProjection) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -444,11 +444,12 @@ class GoalPostDetector(Module):
         down = post_rows(*runs_of_rows(np.maximum(upper, foot - 3 * line), foot - line + 1), centre, summit, foot, post_width)
         return posts, rising, down
 
-    def upright(self, rows: Rows, white: Callable[[slice], np.ndarray]) -> np.ndarray:
+    def upright(self, rows: Rows, white: Callable[[slice, slice], np.ndarray]) -> np.ndarray:
         """For each post's ``rows``: the share of them in which its middle is white, of the post's colour (the
         median along those rows) and unlike at least one side (nan for a post without rows). All posts'
-        rows at once: the strips' means from the image's integral (their sums are exact integers, so the
-        means are the ones the strips' pixels give)."""
+        rows at once: the strips' means from the integral of the block of rows and columns they lie in (their
+        sums are exact integers, so the means are the ones the strips' pixels give; a strip reaches out of the
+        block only where it reaches out of the image)."""
         p = self.parameters
         ys, xs, post_width, lengths = rows
         shares = np.full(len(lengths), np.nan)
@@ -457,14 +458,19 @@ class GoalPostDetector(Module):
         half, side, edge = np.maximum(1, post_width // 4), np.maximum(2, post_width // 2), (post_width + 1) // 2
         first_row = int(ys.min())
         block = slice(first_row, int(ys.max()) + 1)
-        pixels = self.ycrcb(block)
+        width = self.image.shape[1]
+        first, last = max(0, int((xs - edge - side).min())), min(width, int((xs + edge + side).max()) + 1)
+        if first >= last:  # every strip beyond the image's sides: its whole width, as the strips clip to it
+            first, last = 0, width
+        columns, xs = slice(first, last), xs - first
+        pixels = self.ycrcb(block, columns)
         colour = cv2.integral(pixels, sdepth=cv2.CV_32S)
         inside = strip_means(colour, pixels, ys - first_row, xs - half, xs + half)
         left, right = (strip_means(colour, pixels, ys - first_row, xs + a, xs + b) for a, b in ((-edge - side, -edge - 1), (edge + 1, edge + side)))
         unlike = np.maximum(row_norms(inside - left), row_norms(inside - right)) >= p.contrast_min
         some = lengths[lengths > 0]
         same = row_norms(inside - segment_medians(inside, some).repeat(some, axis=0)) <= p.uniform_max
-        bright = white(block)
+        bright = white(block, columns)
         whites = strip_sums(cv2.integral(bright.view(np.uint8), sdepth=cv2.CV_32S), bright, ys - first_row, xs - half, xs + half)
         judged = (2 * whites >= 2 * half + 1) & unlike & same  # white: at least half the middle's pixels
         shares[lengths > 0] = np.add.reduceat(judged.astype(np.int64), some.cumsum() - some) / some
