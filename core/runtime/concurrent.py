@@ -32,7 +32,7 @@ from tafel.core.runtime.context import (
 )
 from tafel.core.runtime.handover import SharedChannel
 from tafel.core.runtime.platform import Platform, PlatformError
-from tafel.core.runtime.processes import DUMP_SIGNAL, SHUTDOWN_GRACE_S, _watch_parent, try_realtime
+from tafel.core.runtime.processes import DUMP_SIGNAL, SHUTDOWN_GRACE_S, _watch_parent, keep_freed_memory, try_realtime
 from tafel.core.runtime.program import ContextPlan
 from tafel.core.runtime.watchdog import STUCK_TIMEOUT_S
 
@@ -107,6 +107,7 @@ def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the supervisor decides when to stop
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     faulthandler.register(DUMP_SIGNAL, all_threads=True)
+    keep_freed_memory()  # the frames' large arrays reuse the heap instead of faulting in fresh pages
     threading.Thread(target=_watch_parent, args=(stop, os.getppid(), spec.record_queue), name="tafel-parent-watch",
                      daemon=True).start()
     clock.set_origin(spec.clock_origin_ns)

@@ -12,6 +12,7 @@ from tafel.core.logs.recording import Recorder
 from tafel.core.runtime.context import MAIN_CONTEXT_ORDER, ContextRunner, ContextStats, Limits, StopFlag, recorder_hook, state_digest
 from tafel.core.runtime.handover import LocalChannel
 from tafel.core.runtime.platform import EndOfData, Platform, PlatformError
+from tafel.core.runtime.processes import keep_freed_memory
 from tafel.core.runtime.program import ContextPlan
 from tafel.core.runtime.status import CognitionStatus
 from tafel.core.runtime.watchdog import STUCK_TIMEOUT_S, ContextStuck, Watchdog
@@ -29,6 +30,7 @@ class LockstepRuntime:
     def __init__(self, plans: Mapping[str, ContextPlan], platform: Platform, *, strict: bool = False,
                  recorder: Recorder | None = None, stuck_timeout_s: float = STUCK_TIMEOUT_S) -> None:
         self.platform = platform
+        keep_freed_memory()  # the frames' large arrays reuse the heap instead of faulting in fresh pages
         #: s a module may run without returning before ``run`` ends the program (0: no watchdog)
         self.stuck_timeout_s = stuck_timeout_s
         #: context -> why it failed (a stuck module)
