@@ -119,7 +119,8 @@ def green_mask(color: FieldColor, hsv: np.ndarray) -> np.ndarray:
     if low < 0 or high > 179:  # the range wraps round red
         wrapped = (low + 180, 179.0) if low < 0 else (0.0, high - 180)
         mask = cv2.bitwise_or(mask, cv2.inRange(hsv, (wrapped[0], color.saturation_min, color.value_min), (wrapped[1], 255, 255)))
-    return mask > 0
+    np.bitwise_and(mask, 1, out=mask)  # 255 -> 1: a bool mask, without a second array
+    return mask.view(bool)
 
 
 @requires(CameraImageTop, CameraImageBottom)

@@ -369,8 +369,9 @@ class GoalPostDetector(Module):
         # (a row is carpet where at least half the columns between the edges are green)
         start = np.maximum(0, top[(left + right) // 2] - 1)
         below = int(start.min())  # the rows from here down
-        rows = cv2.integral(green[below:].view(np.uint8), sdepth=cv2.CV_32S)
-        between = rows.take(stop, axis=1) - rows.take(first, axis=1)  # green from the top to each row, between the edges
+        columns = int(first.min())  # only the columns between the edges: their differences are the whole rows' (exact counts)
+        rows = cv2.integral(green[below:, columns : int(stop.max())].view(np.uint8), sdepth=cv2.CV_32S)
+        between = rows.take(stop - columns, axis=1) - rows.take(first - columns, axis=1)  # green from the top to each row, between the edges
         counts = (between[1:] - between[:-1]).T  # pairs x rows
         row = np.arange(below, height)[None, :]
         carpet = (2 * counts >= (stop - first)[:, None]) & (row >= start[:, None])

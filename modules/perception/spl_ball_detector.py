@@ -371,7 +371,12 @@ class SPLBallDetector(Module):
         if sampled is None:
             sampled = carpet_light(hsv, green)
         median = sampled.saturation if sampled.count else byte_median(hsv[..., 1][green])
-        return green & ~below(hsv, 1, self.parameters.strict_saturation * median)
+        threshold = self.parameters.strict_saturation * median
+        limit = math.ceil(threshold) - 1 if math.isfinite(threshold) else -1  # for bytes, not below t is above ceil(t) - 1
+        if hsv.size and 0 <= limit < 255:  # by OpenCV in one pass each, without numpy's negation and its arrays
+            saturated = cv2.threshold(cv2.extractChannel(hsv, 1), limit, 1, cv2.THRESH_BINARY)[1]
+            return cv2.bitwise_and(np.ascontiguousarray(green).view(np.uint8), saturated).view(bool)
+        return green & ~below(hsv, 1, threshold)
 
     @staticmethod
     def dark_share(dark: np.ndarray, xs: np.ndarray, ys: np.ndarray, radii: np.ndarray) -> np.ndarray:
@@ -582,14 +587,13 @@ class SPLBallDetector(Module):
         # white on both sides, not white beside black (a pair of shoes, a white box with a dark one)
         whites = white_halves(value, cx, cy - top, expected, left) >= p.edge_white_halves
         chosen: list[Spot] = []
-        for i in range(len(best)):
+        for i in np.flatnonzero(on_carpet & whites):  # in their order; the others are never chosen
             x, y, e = float(xs[i]), float(ys[i]), float(expected[i])
             if any((x - s.x) ** 2 + (y - s.y) ** 2 <= (max(s.expected, e) * 1.5) ** 2 for s in (*taken, *chosen)):
                 continue
-            if on_carpet[i] and whites[i]:
-                chosen.append(Spot(float(cx[i]), float(cy[i]), max(float(radii[i]), e), e, edge=True))
-                if len(chosen) >= p.edge_max_spots:
-                    break
+            chosen.append(Spot(float(cx[i]), float(cy[i]), max(float(radii[i]), e), e, edge=True))
+            if len(chosen) >= p.edge_max_spots:
+                break
         return chosen
 
     def edge_window(self, boundary: np.ndarray, projection: ImageProjection, bottom: int) -> tuple[int, int, int]:
