@@ -21,6 +21,8 @@ processes on a shared machine disturb far less than the wall-clock figures: comp
 ``cpu_best_ms``: after the measured frames, each frame pair once more, its cognition run ``--repeats`` times on the
 same images, the least of its CPU times kept, averaged over the pairs: on a heavily loaded machine (contention
 slows even a thread's CPU time, by whatever else runs on its core) the steadiest figure, for revisions side by side.
+``faults_per_frame``: the cognition thread's minor page faults per measured frame (memory the frame's arrays touch
+for the first time: the C allocator's handling of large arrays shows here).
 Targets (issue 34): mean <= 10 ms, p95 <= 16 ms, ratio <= 3. Prints one JSON line.
 """
 
@@ -31,6 +33,7 @@ import csv
 import json
 import math
 import os
+import resource
 import statistics
 import sys
 import time
@@ -52,6 +55,7 @@ from tafel.tools.simulation.stepped_program import SteppedProgram  # noqa: E402
 
 DEFAULT_FOLDER = REPO.parent / "shared" / "real-images"
 FRAME_NS = 33_333_333  # 30 Hz
+RUSAGE_THREAD = getattr(resource, "RUSAGE_THREAD", resource.RUSAGE_SELF)  # Linux: the calling thread's
 
 
 class Shot:
@@ -122,10 +126,10 @@ def floor_ms(pairs: list[tuple[Shot, Shot]], rounds: int) -> float:
 
 
 def cognition(source: Path | None, pairs: list[tuple[Shot, Shot]], frames: int, repeats: int = 0
-              ) -> tuple[list[float], list[float], dict[str, list[float]], list[float]]:
+              ) -> tuple[list[float], list[float], dict[str, list[float]], list[float], float]:
     """Run the default cognition over ``frames`` frames of ``pairs`` (cycling); (whole-frame s, whole-frame s of the
-    cognition thread's CPU time, per-module ms, and with ``repeats``: for each pair once more, the least CPU time (s)
-    of ``repeats`` runs of the cognition on it)."""
+    cognition thread's CPU time, per-module ms, with ``repeats``: for each pair once more, the least CPU time (s)
+    of ``repeats`` runs of the cognition on it, and the minor page faults per measured frame)."""
     options: dict[str, Any] = {"source": str(source), "fps": 1000.0, "loop": True, "ball_color": "spl"}
     program = SteppedProgram("video", options)
     try:
@@ -163,8 +167,10 @@ def cognition(source: Path | None, pairs: list[tuple[Shot, Shot]], frames: int, 
         whole.clear()
         cpu.clear()
         modules.clear()
+        faults = resource.getrusage(RUSAGE_THREAD).ru_minflt
         for _ in range(frames):
             runner.step(0)
+        faults = resource.getrusage(RUSAGE_THREAD).ru_minflt - faults
         best: list[float] = []
         manager.execute = execute  # type: ignore[method-assign]
         for _ in range(len(pairs) if repeats > 0 else 0):
@@ -178,7 +184,7 @@ def cognition(source: Path | None, pairs: list[tuple[Shot, Shot]], frames: int, 
         errors = manager.errors()
         if errors:
             print(f"cognition_budget: modules failed: {errors}", file=sys.stderr)
-        return whole, cpu, modules, best
+        return whole, cpu, modules, best, faults / max(frames, 1)
     finally:
         program.close()
 
@@ -212,7 +218,7 @@ def main() -> None:
         cv2.imwrite(str(cache), cv2.cvtColor(pairs[0][0].image, cv2.COLOR_RGB2BGR))
         source = cache
     floor_before = floor_ms(pairs, 3)
-    whole, cpu, modules, best = cognition(source, pairs, args.frames, args.repeats)
+    whole, cpu, modules, best, faults = cognition(source, pairs, args.frames, args.repeats)
     floor_after = floor_ms(pairs, 3)
     floor = min(floor_before, floor_after)  # the machine is shared: the less disturbed of the two
     mean = statistics.fmean(whole) * 1e3
@@ -221,7 +227,7 @@ def main() -> None:
     print(json.dumps({
         "frames": kind, "top": f"{top_w}x{top_h}", "bottom": f"{width}x{height}", "measured_frames": len(whole),
         "mean_ms": round(mean, 2), "p95_ms": round(p95, 2), "cpu_mean_ms": round(statistics.fmean(cpu) * 1e3, 2),
-        "cpu_best_ms": round(statistics.fmean(best) * 1e3, 2) if best else None,
+        "cpu_best_ms": round(statistics.fmean(best) * 1e3, 2) if best else None, "faults_per_frame": round(faults),
         "per_module_ms": {name: round(statistics.fmean(times), 3) for name, times in sorted(modules.items(), key=lambda kv: -sum(kv[1]))},
         "floor_ms": round(floor, 2), "ratio_to_floor": round(mean / floor, 1),
         "targets": {"mean_ms_max": 10.0, "p95_ms_max": 16.0, "ratio_to_floor_max": 3.0},
