@@ -615,6 +615,21 @@ def test_the_carpets_light_from_histograms_is_the_samples(painted: tuple[np.ndar
 
 
 @settings(max_examples=300)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 60), st.integers(1, 60), st.integers(0, 12), st.floats(0.0, 1.0))
+def test_dark_shares_from_the_part_the_squares_cover_are_the_whole_masks(seed: int, rows: int, columns: int, count: int, share: float) -> None:
+    """The dark shares round spots anywhere (squares reaching out of the mask too), from the integral of only the part
+    the squares cover: those of the whole mask's integral, to the last bit."""
+    rng = np.random.default_rng(seed)
+    dark = rng.random((rows, columns)) < share
+    xs, ys = rng.integers(-5, columns + 5, count), rng.integers(-5, rows + 5, count)
+    radii = rng.uniform(0.5, 12.0, count)
+    shares = SPLBallDetector.dark_share(dark, xs, ys, radii)
+    expected = reference_dark_share(dark, xs, ys, radii)
+    assert shares.dtype == expected.dtype
+    np.testing.assert_array_equal(shares, expected)
+
+
+@settings(max_examples=300)
 @given(st.integers(0, 2**32 - 1), st.integers(1, 170), st.sampled_from(["noise", "flat", "ridge", "steps"]))
 def test_the_lower_hull_over_opencvs_hull_is_the_chain_over_every_point(seed: int, count: int, kind: str) -> None:
     """The boundary's lower hull from the vertices of OpenCV's convex hull: the monotone chain over every point,

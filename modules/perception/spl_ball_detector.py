@@ -380,12 +380,18 @@ class SPLBallDetector(Module):
 
     @staticmethod
     def dark_share(dark: np.ndarray, xs: np.ndarray, ys: np.ndarray, radii: np.ndarray) -> np.ndarray:
-        """Share of dark pixels in the square of half side ``radii`` round each (x, y), by an integral image."""
+        """Share of dark pixels in the square of half side ``radii`` round each (x, y), by an integral image (of the
+        part of the mask the squares cover: the same counts)."""
         height, width = dark.shape
-        integral = cv2.integral(dark.view(np.uint8) if dark.dtype == np.bool_ else dark.astype(np.uint8))
         x0, x1 = np.clip((xs - radii).astype(int), 0, width), np.clip((xs + radii).astype(int) + 1, 0, width)
         y0, y1 = np.clip((ys - radii).astype(int), 0, height), np.clip((ys + radii).astype(int) + 1, 0, height)
         area = np.maximum((x1 - x0) * (y1 - y0), 1)
+        if not len(area):
+            return np.zeros(0)
+        left, top = int(x0.min()), int(y0.min())
+        part = dark[top : int(y1.max()), left : int(x1.max())]
+        integral = cv2.integral(part.view(np.uint8) if part.dtype == np.bool_ else part.astype(np.uint8))
+        x0, x1, y0, y1 = x0 - left, x1 - left, y0 - top, y1 - top
         return (integral[y1, x1] - integral[y0, x1] - integral[y1, x0] + integral[y0, x0]) / area
 
     @staticmethod
