@@ -580,6 +580,8 @@ def test_every_is_numpys_strided_copy(seed: int, rows: int, columns: int, step: 
     shape = (rows, columns, channels) if channels else (rows, columns)
     image = rng.random(shape) < 0.5 if boolean else rng.integers(0, 256, shape).astype(np.uint8)
     image = image[min(start, rows - 1) :]
+    for strided in (image[:, ::2], image.swapaxes(0, 1)):  # pixels not side by side: numpy's copy
+        np.testing.assert_array_equal(every(strided, step), strided[::step, ::step])
     sampled = every(image, step)
     assert sampled.dtype == image.dtype and sampled.flags.c_contiguous
     np.testing.assert_array_equal(sampled, image[::step, ::step])

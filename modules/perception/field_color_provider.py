@@ -88,8 +88,9 @@ def every(image: np.ndarray, step: int) -> np.ndarray:
     same pixels, a fraction of the time numpy takes for the strided copy), the last part-block's row and column by numpy."""
     height, width = image.shape[:2]
     rows, columns = height - height % step, width - width % step  # the whole blocks
-    if step <= 1 or not rows or not columns or image.dtype not in (np.uint8, np.bool_) or image.ndim not in (2, 3):
-        return np.ascontiguousarray(image[::step, ::step])
+    pixels_contiguous = image.ndim in (2, 3) and image.strides[-1] == 1 and (image.ndim == 2 or image.strides[1] == image.shape[2])
+    if step <= 1 or not rows or not columns or image.dtype not in (np.uint8, np.bool_) or not pixels_contiguous:
+        return np.ascontiguousarray(image[::step, ::step])  # OpenCV takes rows of contiguous pixels only
     core = cv2.resize(image[:rows, :columns].view(np.uint8), (columns // step, rows // step), interpolation=cv2.INTER_NEAREST)
     core = core.reshape(rows // step, columns // step, *image.shape[2:]).view(image.dtype)
     if rows == height and columns == width:
