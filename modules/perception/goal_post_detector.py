@@ -293,8 +293,8 @@ class GoalPostDetector(Module):
         self.image = image
         first_row, last_row = int(top[room].min()) - band, int(top[room].max())
         # each column's band: its rows from high up to low (in the rows from first_row on)
-        low = np.clip(top - first_row, 0, last_row - first_row)
-        high = np.clip(top - band - first_row, 0, last_row - first_row)
+        low = np.minimum(np.maximum(top - first_row, 0), last_row - first_row)  # np.clip's, without its checks
+        high = np.minimum(np.maximum(top - band - first_row, 0), last_row - first_row)
         colour = cv2.integral(self.ycrcb(slice(first_row, last_row)), sdepth=cv2.CV_32S)
         profile = np.where(room, edge_profile(colour, low, high, max(1, width // 320)), 0.0)
         edges = edge_peaks(profile, p.edge_min)

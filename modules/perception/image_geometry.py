@@ -123,7 +123,7 @@ def paint_own_body(projection: ImageProjection, mask: np.ndarray) -> None:
     for points in BODY_POINTS:
         pixels, front = projection.to_image(points)
         if front.sum() >= 3:  # the part of the box in front of the camera (a grid of points: boxes reach behind it)
-            cv2.fillConvexPoly(mask, cv2.convexHull(np.clip(pixels[front], -1e4, 1e4).astype(np.int32)), 1)
+            cv2.fillConvexPoly(mask, cv2.convexHull(np.minimum(np.maximum(pixels[front], -1e4), 1e4).astype(np.int32)), 1)
 
 
 #: each box of ``BODY_BOXES`` as a grid of points, so that the part in front of a camera can be projected

@@ -96,7 +96,7 @@ def windows(xs: np.ndarray, ys: np.ndarray, columns: range, rows: range, shape: 
     cols = xs[:, None] + np.asarray(columns)[None, :]
     rws = ys[:, None] + np.asarray(rows)[None, :]
     inside = ((rws >= 0) & (rws < height))[:, :, None] & ((cols >= left) & (cols < left + width))[:, None, :]
-    flat = np.clip(rws, 0, height - 1)[:, :, None] * width + np.clip(cols - left, 0, width - 1)[:, None, :]
+    flat = np.minimum(np.maximum(rws, 0), height - 1)[:, :, None] * width + np.minimum(np.maximum(cols - left, 0), width - 1)[:, None, :]
     return cols, rws, inside, flat
 
 
@@ -383,8 +383,8 @@ class SPLBallDetector(Module):
         """Share of dark pixels in the square of half side ``radii`` round each (x, y), by an integral image (of the
         part of the mask the squares cover: the same counts)."""
         height, width = dark.shape
-        x0, x1 = np.clip((xs - radii).astype(int), 0, width), np.clip((xs + radii).astype(int) + 1, 0, width)
-        y0, y1 = np.clip((ys - radii).astype(int), 0, height), np.clip((ys + radii).astype(int) + 1, 0, height)
+        x0, x1 = np.minimum(np.maximum((xs - radii).astype(int), 0), width), np.minimum(np.maximum((xs + radii).astype(int) + 1, 0), width)
+        y0, y1 = np.minimum(np.maximum((ys - radii).astype(int), 0), height), np.minimum(np.maximum((ys + radii).astype(int) + 1, 0), height)
         area = np.maximum((x1 - x0) * (y1 - y0), 1)
         if not len(area):
             return np.zeros(0)
@@ -502,7 +502,7 @@ class SPLBallDetector(Module):
         xs, ys, radii, expected = xs[fits], ys[fits], radii[fits], expected[fits]
         if dark is not None:  # a ball has black patches: spots without dark pixels near their centre are none
             # (a field without any green leaves the distance transform unbounded: radii beyond the image are none)
-            reach = np.clip(radii, 1.0, max(height, width))
+            reach = np.minimum(np.maximum(radii, 1.0), max(height, width))
             if len(xs):  # only the rows the squares reach: the image's integral costs by its rows
                 first, last = max(0, int((ys - reach).min())), min(height, int((ys + reach).max()) + 1)
                 patched = self.dark_share(dark[first:last], xs, ys - first, reach) >= p.dark_spot_min
@@ -612,7 +612,7 @@ class SPLBallDetector(Module):
         width = boundary.size
         xs = np.arange(width)
         levels = (-p.edge_above, (p.edge_below - p.edge_above) // 2, p.edge_below)  # px from the boundary
-        rows = np.concatenate([np.clip(boundary + level, 0, projection.height - 1) for level in levels])
+        rows = np.concatenate([np.minimum(np.maximum(boundary + level, 0), projection.height - 1) for level in levels])
         centres, hits = projection.to_ground(np.tile(xs, len(levels)), rows, BALL_RADIUS)
         offset = centres - projection.translation[:2]
         reach2 = np.einsum("ij,ij->i", offset, offset) + (BALL_RADIUS - projection.translation[2]) ** 2
