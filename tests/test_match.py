@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from tafel.core.logs import LogReader
-from tafel.tools.logs.log_tools import decoded_messages
+from tafel.tools.logs.decoding import decoded_messages
 
 REPO = Path(__file__).resolve().parent.parent
 pytestmark = pytest.mark.slow

@@ -18,7 +18,7 @@ import pytest
 from tafel.core.logs import LogReader
 from tafel.platforms.realism import LEVELS
 from tafel.tools.cli.arguments import REALISM_LEVELS, build_parser
-from tafel.tools.logs.log_tools import decoded_messages
+from tafel.tools.logs.decoding import decoded_messages
 from tafel.tools.simulation.match import Match
 
 REPO = Path(__file__).resolve().parent.parent

@@ -21,7 +21,7 @@ import numpy as np
 
 from tafel.core.framework.naming import did_you_mean
 from tafel.core.logs import LogError, LogMessage, LogReader
-from tafel.tools.logs.log_tools import message_class, to_python
+from tafel.tools.logs.decoding import message_class, to_python
 
 
 @dataclass

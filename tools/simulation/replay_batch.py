@@ -26,8 +26,8 @@ from typing import Any
 
 from tafel.core.framework.naming import did_you_mean
 from tafel.core.logs import LogError, LogReader
+from tafel.tools.logs.decoding import decoded_messages
 from tafel.tools.logs.log_compare import compare_logs
-from tafel.tools.logs.log_tools import decoded_messages
 from tafel.tools.simulation.batch import BatchError, BatchInfo, run_jobs
 from tafel.tools.simulation.scenarios import plural, warm_up
 
