@@ -40,7 +40,7 @@ from tafel.modules.perception.goal_post_detector import (
     strip_means,
     strip_sums,
 )
-from tafel.modules.perception.image_geometry import ImageProjection, camera_views, own_body_mask
+from tafel.modules.perception.image_geometry import ImageProjection, camera_views, own_body_mask, rows_times
 from tafel.modules.perception.line_detector import CIRCLE_RADIUS, LineDetector, green_on_both_sides, longest_arc, white_runs
 from tafel.modules.perception.spl_ball_detector import (
     LOOSER_TESTS,
@@ -614,6 +614,22 @@ def test_the_carpets_light_from_histograms_is_the_samples(painted: tuple[np.ndar
     assert light.count == len(sampled)
     if len(sampled):
         assert (light.value, light.saturation) == (float(np.median(sampled[:, 2])), float(np.median(sampled[:, 1])))
+
+
+@settings(max_examples=200)
+@given(st.integers(0, 2**32 - 1), st.floats(-1.5, 1.5), st.floats(-0.6, 1.2), st.integers(0, 300), st.sampled_from([(640, 480), (320, 240)]),
+       st.booleans())
+def test_rays_filled_in_place_are_the_stacked_ones(seed: int, yaw: float, pitch: float, count: int, size: tuple[int, int], exact: bool) -> None:
+    """The pixels' rays from a camera array filled in place: those of the stacked columns, to the last bit."""
+    rng = np.random.default_rng(seed)
+    c, s, cp, sp = math.cos(yaw), math.sin(yaw), math.cos(pitch), math.sin(pitch)
+    rotation = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]) @ np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    projection = ImageProjection(CameraMatrix(rotation, np.array([0.0, 0.0, 503.0]), True), *size, math.radians(56.3), math.radians(43.7))
+    xs = rng.uniform(-10, size[0] + 10, count) if count % 2 else rng.integers(0, size[0], count)
+    ys = rng.uniform(-10, size[1] + 10, count) if count % 2 else rng.integers(0, size[1], count)
+    camera = np.stack([np.ones_like(xs, dtype=float), -(np.asarray(xs, float) - size[0] / 2) / projection.fx,
+                       -(np.asarray(ys, float) - size[1] / 2) / projection.fy], axis=-1)
+    np.testing.assert_array_equal(projection.rays(xs, ys, exact), rows_times(camera, projection.rotation.T, exact))
 
 
 @settings(max_examples=300)

@@ -65,8 +65,13 @@ class ImageProjection:
         """Directions (N x 3, robot frame, not normalized) of the pixels (xs, ys). ``exact``: each row as a
         call for that pixel alone gives it, to the last bit (numpy's product of many rows at once rounds
         differently; a stack of 1 x 3 products does not)."""
-        camera = np.stack([np.ones_like(xs, dtype=float), -(np.asarray(xs, float) - self.width / 2) / self.fx,
-                           -(np.asarray(ys, float) - self.height / 2) / self.fy], axis=-1)
+        xs, ys = np.asarray(xs, float), np.asarray(ys, float)
+        if xs.shape != ys.shape:
+            raise ValueError(f"pixels' columns and rows differ in shape: {xs.shape} and {ys.shape}")
+        camera = np.empty((*xs.shape, 3))  # filled in place: np.stack's Python around three small arrays cost more than they
+        camera[..., 0] = 1.0
+        np.divide(self.width / 2 - xs, self.fx, out=camera[..., 1])  # -(x - w/2) / fx: negation and subtraction round alike
+        np.divide(self.height / 2 - ys, self.fy, out=camera[..., 2])
         return rows_times(camera, self.rotation.T, exact)
 
     def to_ground(self, xs: np.ndarray, ys: np.ndarray, z: float = 0.0, exact: bool = False) -> tuple[np.ndarray, np.ndarray]:
