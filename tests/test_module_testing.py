@@ -105,6 +105,16 @@ def test_sequences_feed_one_value_per_frame_and_the_history_keeps_every_output()
         harness.history(MtSpeed)
 
 
+def test_setting_a_fed_representation_ends_its_feed_and_the_value_holds() -> None:
+    harness = ModuleHarness(MtIntegrator)
+    harness.feed({MtSpeed: [MtSpeed(value=30.0)] * 2})
+    harness.execute()
+    harness.set(MtSpeed(value=0.0))  # the test takes the input over: no "ran out" from here on
+    harness.execute(frames=3)
+    assert_close([p.x for p in harness.history(MtPosition)], [0.0, 1.0, 1.0, 1.0, 1.0], rel=1e-6)  # it stopped at the set 0
+    assert harness.fed_frames_left == 0
+
+
 def test_sequences_of_different_lengths_or_types_are_errors_naming_the_representation() -> None:
     harness = ModuleHarness(MtIntegrator)
     with pytest.raises(ValueError, match="MtSpeed: 2, MtUnread: 3"):

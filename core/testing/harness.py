@@ -93,7 +93,13 @@ class ModuleHarness:
             raise TypeError(f"{self.module_class.__name__} does not require, use or provide {rep.__name__}; it declares {names}")
 
     def set(self, *inputs: Any) -> ModuleHarness:
-        """Put representation values on the blackboard (copied, so the test's objects stay its own)."""
+        """Put representation values on the blackboard (copied, so the test's objects stay its own). A value for a
+        representation being fed (``feed``) ends that feed: from now on the test's value holds."""
+        for value in inputs:
+            self._fed.pop(type(value), None)
+        return self._put(*inputs)
+
+    def _put(self, *inputs: Any) -> ModuleHarness:
         for value in inputs:
             if not is_representation(type(value)):
                 raise TypeError(f"inputs are representation instances, got {value!r}")
@@ -126,7 +132,7 @@ class ModuleHarness:
 
     @property
     def fed_frames_left(self) -> int:
-        return max((len(v) for v in self._fed.values()), default=0) - self._fed_position
+        return max(0, max((len(v) for v in self._fed.values()), default=0) - self._fed_position)
 
     def execute(self, frames: int | None = None) -> Blackboard:
         """Run ``frames`` frames (default: what is left of a ``feed``, else one) and return the blackboard."""
@@ -150,7 +156,7 @@ class ModuleHarness:
                 names = ", ".join(rep.__name__ for rep in self._fed)
                 raise IndexError(f"the fed sequence of {names} ran out after {self._fed_position} frames; "
                                  "feed more values or execute fewer frames")
-            self.set(*(values[self._fed_position] for values in self._fed.values()))
+            self._put(*(values[self._fed_position] for values in self._fed.values()))
             self._fed_position += 1
         self.frame_number += 1
         if recorded_clock is not None:  # a replayed frame keeps its recorded number and time
