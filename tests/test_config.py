@@ -132,6 +132,19 @@ def test_layers_add_and_remove_modules_without_restating_the_list(layered: Path)
     assert "add" not in config["cognition"] and "remove" not in config["cognition"]  # applied, not left for later layers
 
 
+def test_disable_and_enable_edit_the_disabled_list_a_layer_inherits(layered: Path) -> None:
+    write(layered / "platform" / "sim.toml", '[cognition]\ndisabled = ["C", "D"]\n')
+    write(layered / "private" / "private.toml", '[cognition]\ndisable = ["A", "C"]\nenable = ["D", "X"]\n')
+    config = load_config(layered, "sim")
+    assert config["cognition"]["disabled"] == ["C", "A"]  # D enabled again; enabling what is not disabled is no error
+    assert "disable" not in config["cognition"] and "enable" not in config["cognition"]
+    write(layered / "platform" / "sim.toml", "")
+    assert load_config(layered, "sim")["cognition"]["disabled"] == ["A", "C"]  # another platform: only the own choices
+    write(layered / "private" / "private.toml", '[cognition]\ndisable = "A"\n')
+    with pytest.raises(ConfigError, match=r'disable takes a list of module names, e.g. disable = \["GoalPostDetector"\]'):
+        load_config(layered, "sim")
+
+
 def test_a_layer_that_restates_the_list_starts_over_and_its_own_edits_apply_to_it(layered: Path) -> None:
     write(layered / "robot" / "nao1.toml", '[cognition]\nmodules = ["X", "Y"]\nadd = ["Z"]\nremove = ["X"]\n')
     write(layered / "private" / "private.toml", "")

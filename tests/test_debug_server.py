@@ -19,6 +19,7 @@ from pathlib import Path
 
 import pytest
 
+from tafel.core.framework.config import load_config
 from tafel.core.logs import read_log
 from tafel.core.logs.serialization import deserialize
 from tafel.debug.client import DebugClient
@@ -136,6 +137,25 @@ def test_modules_store_writes_the_private_layer(program: Program, config_dir: Pa
     private = (config_dir / "private" / "private.toml").read_text()
     assert 'BallModel = "SimpleBallModeler"' in private
     program.ask("modules:provider -representation BallModel -module KalmanBallModeler")
+
+
+def test_modules_store_keeps_only_the_choices_made_at_run_time(tmp_path: Path) -> None:
+    """On dummy, whose layer disables the perception, the stored layer holds only what the user switched:
+    the next start on another platform keeps its perception (a new user's report)."""
+    config = tmp_path / "config"
+    shutil.copytree(REPO / "config", config, ignore=shutil.ignore_patterns("private"))
+    running = Program("--config", str(config), cwd=tmp_path)
+    try:
+        assert running.ask("modules:store").startswith("nothing to store")
+        assert running.ask("modules:set -module GameControllerReporter -enabled false").startswith("GameControllerReporter disabled")
+        assert "cognition.disable=['GameControllerReporter']" in running.ask("modules:store")
+        assert load_config(config, "mujoco")["cognition"]["disabled"] == ["GameControllerReporter"]  # no SelfLocator
+        assert {"SelfLocator", "GameControllerReporter"} <= set(load_config(config, "dummy")["cognition"]["disabled"])
+        running.ask("modules:set -module GameControllerReporter -enabled true")
+        running.ask("modules:store")  # switched back: the layer is as it was
+        assert load_config(config, "mujoco")["cognition"]["disabled"] == []
+    finally:
+        running.stop()
 
 
 def test_modules_graph_is_dot_with_the_hand_over(program: Program) -> None:

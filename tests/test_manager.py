@@ -143,6 +143,7 @@ def test_two_providers_need_a_choice() -> None:
     message = str(info.value)
     assert "MgrModel is provided by MgrFilterModel and MgrPlainModel" in message
     assert 'providers={"MgrModel": "MgrFilterModel"}' in message
+    assert 'MgrModel = "MgrFilterModel" under [cognition.providers] or [motion.providers]' in message  # the sections configuration has
 
 
 def test_unknown_module_in_providers_suggests_close_names() -> None:

@@ -264,12 +264,14 @@ def check_runtime(config: Mapping[str, Any]) -> None:
 
 
 #: the settings of a ``[cognition]`` or ``[motion]`` table
-CONTEXT_KEYS = ("modules", "disabled", "providers", "add", "remove")
+CONTEXT_KEYS = ("modules", "disabled", "providers", "add", "remove", "disable", "enable")
 
 
 def apply_module_edits(config: dict[str, Any], where: str) -> dict[str, Any]:
-    """Each context's ``add`` and ``remove`` applied to its module list, and dropped: the layer ``where``
-    (a file, or ``--set``) edits the list it inherits, and the next layer sees the edited list."""
+    """Each context's ``add`` and ``remove`` applied to its module list, and ``disable`` and ``enable`` to its
+    ``disabled`` list, and dropped: the layer ``where`` (a file, or ``--set``) edits the lists it inherits, and the
+    next layer sees the edited lists. (``modules:store`` writes ``disable`` and ``enable``: the private layer then
+    keeps what a platform's layer disables there, on every platform.)"""
     for context in CONTEXTS:
         section = config.get(context)
         if not isinstance(section, dict):
@@ -278,6 +280,18 @@ def apply_module_edits(config: dict[str, Any], where: str) -> dict[str, Any]:
             if key not in CONTEXT_KEYS:
                 raise ConfigError(f"{where}: [{context}] {key} is not a setting; {did_you_mean(key, CONTEXT_KEYS)}; "
                                   f"the settings are {', '.join(CONTEXT_KEYS)}")
+        switches = {key: section.pop(key) for key in ("disable", "enable") if key in section}  # enable wins
+        if switches:
+            disabled = convert(section.get("disabled", []), list[Any], where=f"{where}: [{context}] disabled", text=False,
+                               expected="a list of module names", error=ConfigError)
+            for key, names in switches.items():
+                for name in convert(names, list[str], where=f"{where}: [{context}] {key}", text=False, error=ConfigError,
+                                    expected=f'a list of module names, e.g. {key} = ["GoalPostDetector"]'):
+                    if key == "disable" and name not in disabled:
+                        disabled.append(name)
+                    elif key == "enable" and name in disabled:
+                        disabled.remove(name)
+            section["disabled"] = disabled
         edits = {key: section.pop(key) for key in ("remove", "add") if key in section}
         if not edits:
             continue
@@ -330,6 +344,13 @@ def context_section(config: Mapping[str, Any], context: str) -> dict[str, Any]:
     providers = convert(section.get("providers", {}), dict[str, str], where=f"{context}.providers", text=False, error=ConfigError,
                         expected="a table of representation names to module names")
     return {"modules": modules, "disabled": disabled, "providers": providers}
+
+
+def private_section(config_dir: Path, context: str) -> dict[str, Any]:
+    """The ``[context]`` table of the private layer as it is on disk (empty where there is none)."""
+    target = config_dir / PRIVATE_FILE
+    section = read_toml(target).get(context, {}) if target.is_file() else {}
+    return dict(section) if isinstance(section, Mapping) else {}
 
 
 def store_private(config_dir: Path, path: list[str], value: Any) -> Path:

@@ -137,7 +137,7 @@ def _choose_providers(
             raise ConflictingProvidersError(
                 f"{rep.__name__} is provided by {' and '.join(names)}; choose one with "
                 f'providers={{"{rep.__name__}": "{names[0]}"}} (in configuration: '
-                f'[providers] {rep.__name__} = "{names[0]}"), or disable the others'
+                f'{rep.__name__} = "{names[0]}" under [cognition.providers] or [motion.providers]), or disable the others'
             )
     return chosen
 

@@ -11,7 +11,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Literal
 
-from tafel.core.framework.config import store_private
+from tafel.core.framework.config import PRIVATE_FILE, private_section, store_private
 from tafel.core.framework.contexts import Context
 from tafel.core.framework.dot import contexts_dot
 from tafel.core.framework.errors import TafelError
@@ -57,6 +57,9 @@ class ProgramDebug:
         self.config_dir = config_dir
         self.recorder = recorder
         self.executors: dict[str, Any] = {}
+        #: context -> the plan it started with: what the configuration chose (``modules:store`` stores the rest)
+        self.plans: dict[str, ContextPlan] = {}
+        self.private_at_start: dict[str, dict[str, Any]] = {}
         self.record_default = record_path_default or Path("tafel.mcap")
         #: the only folder clients may record into (``--record-dir``)
         self.record_dir = record_dir
@@ -119,6 +122,12 @@ class ProgramDebug:
 
     def add_context(self, name: str, executor: Any, plan: ContextPlan | None = None) -> None:
         self.executors[name] = executor
+        if plan is not None:
+            self.plans[name] = plan
+        try:  # what the private layer said when the program started: modules:store edits from there
+            self.private_at_start[name] = private_section(self.config_dir, name)
+        except TafelError:
+            self.private_at_start[name] = {}
         names = None
         if plan is not None:
             names = {m.__name__ for m in plan.modules} | {r.__name__ for r in plan.representations()}
@@ -158,14 +167,31 @@ class ProgramDebug:
         return contexts_dot(graphs, self.handovers)
 
     def _store_modules(self, command: Command) -> str:
+        """The choices made while the program runs, not what its configuration's layers chose: a platform's
+        layer (dummy disables the perception) must not reach every platform through the private layer. Modules
+        switched off or on since the start go to the private layer's ``disable`` and ``enable``, which edit the
+        layers' ``disabled`` lists wherever they are read."""
         stored = []
+        path = self.config_dir / PRIVATE_FILE
         for context, executor in self.executors.items():
-            choices = executor.internal("choices")
+            choices, plan = executor.internal("choices"), self.plans.get(context)
+            chosen = plan.effective_providers() if plan is not None else {}
             for rep, module in choices["providers"].items():
-                store_private(self.config_dir, [context, "providers", rep], module)
-                stored.append(f"{context}.providers.{rep}={module}")
-            path = store_private(self.config_dir, [context, "disabled"], choices["disabled"])
-            stored.append(f"{context}.disabled={choices['disabled']}")
+                if chosen.get(rep) != module:
+                    path = store_private(self.config_dir, [context, "providers", rep], module)
+                    stored.append(f"{context}.providers.{rep}={module}")
+            started = set(plan.effective_disabled()) if plan is not None else set()
+            now = set(choices["disabled"])
+            private = self.private_at_start.get(context, {})
+            disable = sorted((set(private.get("disable", [])) | (now - started)) - (started - now))
+            enable = sorted((set(private.get("enable", [])) | (started - now)) - (now - started))
+            on_disk = private_section(self.config_dir, context)
+            for key, names in (("disable", disable), ("enable", enable)):
+                if sorted(on_disk.get(key, [])) != names:
+                    path = store_private(self.config_dir, [context, key], names)
+                    stored.append(f"{context}.{key}={names}")
+        if not stored:
+            return "nothing to store: the providers and modules are as the configuration chose them"
         return f"stored in {path}: " + ", ".join(stored)
 
     def _store_parameters(self, command: Command) -> str:
