@@ -359,7 +359,12 @@ class ContextDebug:
 
     def cmd_modify_set(self, command: Command) -> str:
         found = self._named(command, self.state.modifies, "modify")
-        found.pinned_value = _coerce_like(found.value, argument(command, "value", positional=False), found.name)
+        value = _coerce_like(found.value, argument(command, "value", positional=False), found.name)
+        if found.bounds is not None and isinstance(value, (int, float)) and not found.bounds[0] <= value <= found.bounds[1]:
+            low, high = found.bounds
+            raise CommandError(f"{found.name} takes a number from {low:g} to {high:g} (the parameter's declared range), got {value:g}; "
+                               "nothing pinned")
+        found.pinned_value = value
         found.pinned = True
         return f"{found.name} pinned to {_short(found.pinned_value)}"
 

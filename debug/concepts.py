@@ -131,11 +131,13 @@ class ModifyEntry:
     ``self.gain()`` is the declared (or last published) value, or the pinned one; ``self.gain(x)``
     publishes ``x`` and returns it, or the pinned value."""
 
-    __slots__ = ("name", "description", "value", "pinned", "pinned_value")
+    __slots__ = ("name", "description", "value", "pinned", "pinned_value", "bounds")
 
     def __init__(self, name: str, description: str = "", value: Any = None) -> None:
         self.name, self.description, self.value = name, description, value
         self.pinned, self.pinned_value = False, None
+        #: (low, high) a pinned number must lie within (a parameter's declared range), or None
+        self.bounds: tuple[float, float] | None = None
 
     def __call__(self, value: Any = _KEEP) -> Any:
         if value is not _KEEP:

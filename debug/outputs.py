@@ -25,8 +25,10 @@ declarations without running anything (``tafel modules``).
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any, Generic, Self, TypeVar, overload
 
+from tafel.core.framework.representation import RANGE_META
 from tafel.debug.concepts import DebugState, ModifyEntry, PlotSeries, RequestSwitch, StopwatchTimes, TunedParameters
 
 E = TypeVar("E")
@@ -133,9 +135,12 @@ class ModifyParameters(Declaration[TunedParameters]):
 
     def entry(self, state: DebugState, owner: str, parameters: Any = None) -> TunedParameters:
         entries: dict[str, ModifyEntry] = {}
+        declared = {f.name: f for f in dataclasses.fields(parameters)} if dataclasses.is_dataclass(parameters) else {}
         for name in self.fields:
             value = getattr(parameters, name, None)
             entries[name] = state.modify(f"{self.prefix}:{name}", value, self.description, owner)
+            if name in declared and RANGE_META in declared[name].metadata:  # modify:set refuses what the field does not take
+                entries[name].bounds = declared[name].metadata[RANGE_META]
         return TunedParameters(entries)
 
     def describe(self) -> str:

@@ -100,6 +100,18 @@ def test_modules_sharing_a_prefix_share_the_modify_values_of_their_context() -> 
     assert soccer.kick_tuning.apply(soccer.parameters).behind == 300.0
 
 
+def test_a_parameter_tried_live_outside_its_declared_range_is_refused_not_clamped() -> None:
+    reads = {rep for rep in Striker.requirements().reads()} - set(Striker.requirements().provides)
+    manager = ModuleManager([Striker], name="cognition", external=reads)
+    debug = ContextDebug("cognition", manager)
+    entry = manager.debug.modifies["Kick:behind"]
+    low, high = entry.bounds
+    status, answer = debug.execute(parse(f"modify:set -name Kick:behind -value {high * 10:g}"))
+    assert status == "error" and answer == f"Kick:behind takes a number from {low:g} to {high:g} (the parameter's declared range), got {high * 10:g}; nothing pinned"
+    assert not entry.pinned
+    assert ask(debug, f"modify:set -name Kick:behind -value {high:g}") == f"Kick:behind pinned to {high:g}"
+
+
 def test_a_module_without_a_manager_has_outputs_of_its_own() -> None:
     @representation
     class DoLoneOutput:
