@@ -88,6 +88,32 @@ def test_new_code_runs_from_the_next_frame_with_the_blackboard_and_parameters_ke
     assert tally(manager) == 6 + 50  # the state stayed, the new code and the running parameter value apply
 
 
+def test_a_module_annotated_with_a_representation_of_its_own_file_reloads(tmp_path: Path) -> None:
+    """As the README's tutorial writes modules: the representation beside the module, ``tally: Tally`` in the class
+    body, no ``from __future__ import annotations``. The new class's annotation names the file's new Tally; it must
+    name the one on the blackboard (a new user's report: refused with a message that contradicted itself)."""
+    name = "reload_annotated_counter"
+    annotated = COUNTER.replace("class Counter(Module):\n", "class Counter(Module):\n    tally: Tally\n")
+    assert "    tally: Tally" in annotated
+    (tmp_path / f"{name}.py").write_text(annotated)
+    sys.path.insert(0, str(tmp_path))
+    try:
+        module = importlib.import_module(name)
+        manager = ModuleManager([module.Counter], external=[FrameInfo])
+        reloader = ModuleReloader(manager, probation_frames=3)
+        manager.execute()
+        edit(tmp_path / f"{name}.py", "+= self.parameters.step", "+= self.parameters.step * 10")
+        assert "reloaded Counter" in reloader.reload("Counter")
+        manager.execute()
+        assert tally(manager) == 1 + 10
+    finally:
+        sys.path.remove(str(tmp_path))
+        sys.modules.pop(name, None)
+        _KNOWN.pop("Counter", None)
+        for rep in [n for n, c in _REGISTRY.items() if c.__module__ == name]:
+            del _REGISTRY[rep]
+
+
 def test_a_parameter_the_new_code_no_longer_declares_is_named(counting) -> None:
     path, manager, reloader = counting
     edit(path, "        spare: float = 0.5\n", "")

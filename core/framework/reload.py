@@ -179,8 +179,14 @@ def _shape(cls: type) -> list[tuple[str, str]]:
 
 
 def _rebind(cls: type, reps: dict[str, type]) -> None:
-    """Point the module's declarations at the representation classes already on the blackboards."""
+    """Point the module's declarations, and its class-level annotations (made from the file's new classes where
+    the file defines a representation and has no ``from __future__ import annotations``), at the representation
+    classes already on the blackboards."""
     for kind in ("requires", "uses", "provides"):
         attribute = f"__tafel_{kind}__"
         if attribute in cls.__dict__:
             setattr(cls, attribute, tuple(reps.get(r.__name__, r) for r in cls.__dict__[attribute]))
+    annotations = cls.__dict__.get("__annotations__", {})
+    for name, hint in annotations.items():
+        if isinstance(hint, type) and is_representation(hint) and hint.__name__ in reps:
+            annotations[name] = reps[hint.__name__]
