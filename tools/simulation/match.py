@@ -362,6 +362,6 @@ def command_match(args: argparse.Namespace, extra: Sequence[str]) -> int:
     decided = "" if shoot_out is None else (f", shoot-out {shoot_out['score']} ("
                                             + (f"team {shoot_out['winner']} wins)" if shoot_out["winner"] else "undecided: a coin toss)"))
     realism = "" if match.realism == "off" else f", realism {match.realism}"
-    print(f"[match] {reason}; score {TEAM_NUMBERS[0]}:{TEAM_NUMBERS[1]} {result['score']}{decided}, fouls {fouls}, passes {passes}{realism}", flush=True)
+    print(f"[match] {reason}; score {result['score']} (team {TEAM_NUMBERS[0]} : team {TEAM_NUMBERS[1]}){decided}, fouls {fouls}, passes {passes}{realism}", flush=True)
     print(line, flush=True)
     return 0 if reason == "the game is over" else 1
