@@ -344,7 +344,7 @@ def test_replay_commands(tmp_path: Path) -> None:
         frame = frame_of(replay, "motion")
         time.sleep(0.3)
         assert frame_of(replay, "motion") == frame  # paused
-        assert replay.ask("log:goto -frame 100") == "paused at frame 100"
+        assert replay.ask("log:goto -frame 100") == "seeking frame 100: replay pauses there (log:position says when)"
         time.sleep(0.3)
         assert frame_of(replay, "motion") == 100  # a seek shows the frame
         assert json.loads(replay.ask("log:position"))["frame"] == 100

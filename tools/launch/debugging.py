@@ -160,7 +160,7 @@ class ProgramDebug:
             platform.goto(frame)
         except TafelError as exc:
             raise CommandError(str(exc)) from None
-        return f"paused at frame {frame}"
+        return f"seeking frame {frame}: replay pauses there (log:position says when)"
 
     def _graph(self, command: Command) -> str:
         graphs = [executor.internal("graph") for executor in self.executors.values()]
