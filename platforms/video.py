@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import multiprocessing
 import os
 import sys
 import time
@@ -42,6 +43,10 @@ IMAGES_FPS = 2.0
 
 #: what ``--fov`` takes
 FOV = "a finite number of degrees above 0 and below 180 (the horizontal field of view)"
+
+
+#: what ``check`` has said in this process
+TOLD: set[str] = set()
 
 
 class VideoPlatform(Platform):
@@ -136,7 +141,11 @@ class VideoPlatform(Platform):
                 first = self.posed(0)
             except ImageSourceError as error:
                 raise PlatformError(str(error)) from error
-            print(f"video: {len(self.images)} image(s) from {self.source}; camera pose of the first: {first.pose_source}", file=sys.stderr)
+            line = f"video: {len(self.images)} image(s) from {self.source}; camera pose of the first: {first.pose_source}"
+            # start-up makes the platform more than once, and each context's process again: say it once
+            if line not in TOLD and multiprocessing.parent_process() is None:
+                TOLD.add(line)
+                print(line, file=sys.stderr)
             return
         if self.device is None and not os.path.isfile(self.source):
             raise PlatformError(f"video file {self.source} does not exist")
