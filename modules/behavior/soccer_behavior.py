@@ -35,6 +35,32 @@ POST_SEEN = 300.0  # mm round a goal post within which ObstacleModeler takes wha
 KICK_HELD_BACK = 30.0  # mm a walk's target may be held back from a robot (``keep_from_pushing``) and the walk kick still be asked for
 
 
+#: mm from the field's centre line a ball that went out over a goal line counts as on one side: nearer, the rules'
+#: corner of either side may hold it (both are kept away from)
+SIDE_UNSURE = 500.0
+
+
+def placed_ball(set_play: SetPlay, last: tuple[float, float] | None) -> list[tuple[float, float]]:
+    """Where the rules put the ball at the opponents' ``set_play`` (field mm, the own goal at -x), the ball last
+    known at ``last`` (where it went out): a goal kick on the corner of their goal area, a corner kick in the own
+    field corner, each on the side it went out (both corners while that is unsure), a kick-in on the touchline beside
+    where it went out, a penalty kick on the own penalty mark, a pushing free kick where the ball is. Empty when
+    that cannot be told (no ball known)."""
+    if set_play is SetPlay.penalty_kick:
+        return [(-OPPONENT_PENALTY_MARK_X, 0.0)]
+    if last is None:
+        return []
+    x, y = last
+    sides = [math.copysign(1.0, y)] if abs(y) > SIDE_UNSURE else [1.0, -1.0]
+    if set_play is SetPlay.goal_kick:
+        return [(pitch.LENGTH / 2 - pitch.GOAL_AREA_LENGTH, side * pitch.GOAL_AREA_WIDTH / 2) for side in sides]
+    if set_play is SetPlay.corner_kick:
+        return [(-pitch.LENGTH / 2, side * pitch.WIDTH / 2) for side in sides]
+    if set_play is SetPlay.kick_in:
+        return [(max(-pitch.LENGTH / 2, min(pitch.LENGTH / 2, x)), math.copysign(pitch.WIDTH / 2, y))]
+    return [last]
+
+
 @requires(GameState, PlayerRole, BallModel, Odometry, MotionInfo, FrameInfo)
 @uses(RobotPose, TeamMates, Obstacles, RobotsPercept)
 @provides(MotionRequest, ActivationGraph, OptionGraph)
@@ -176,6 +202,11 @@ class SoccerBehavior(Module):
         """which way a search for the ball turns: towards the side it was last seen on"""
         self.support_side = 0.0
         """the side of the ball the supporter waits on (+1: +y, -1: -y, 0: none yet), kept while open to a pass"""
+        self.set_play: tuple[SetPlay, int] | None = None
+        self.set_play_s = -math.inf
+        self.set_play_spots: list[tuple[float, float]] = []
+        """the opponents' set play going on (set play, kicking team), when this robot heard of it (s), and where the
+        rules put its ball (field mm; ``placed_ball``), from where it was last known before"""
 
     def execute(self) -> None:
         out = self.motion_request
@@ -184,6 +215,7 @@ class SoccerBehavior(Module):
             self.option_graph.root, self.option_graph.options = graph.root, graph.options
         busy = {info.name: getattr(out, info.name) for info in fields_of(MotionRequest)} if self.motion_info.busy else None
         self.keep_out, self.indirect = [], False
+        self.note_set_play()
         self.last_ball = self.ball_on_field() or self.last_ball
         if self.ball_model.valid:
             self.ball_search.found()
@@ -298,12 +330,43 @@ class SoccerBehavior(Module):
         ball, pose = self.ball_model, self.robot_pose
         return ball.field_position(pose) if ball.valid and pose.valid else self.team_ball()
 
+    def note_set_play(self) -> None:
+        """An opponents' set play that begins: when, and where the rules put the ball (``placed_ball``), from where
+        it was last known (before this frame: where it went out)."""
+        game = self.game_state
+        now = (game.set_play, game.kicking_team) if self.opponents_set_play() else None
+        if now != self.set_play:
+            self.set_play, self.set_play_s = now, self.frame_info.time_s
+            self.set_play_spots = placed_ball(game.set_play, self.last_ball) if now is not None else []
+
+    def set_play_balls(self) -> list[tuple[float, float]]:
+        """Where the ball of the opponents' set play is (field mm), to keep away from: the own sighting or a
+        teammate's, if made since the set play began; else where the rules put it (``set_play_spots``: a ball that
+        went out is put back by the referee, often beside the robot that chased it there, which may not see it
+        then, and its model still shows it where it went out); else where it was last known."""
+        ball, since = self.ball_model, self.frame_info.time_s - self.set_play_s
+        if self.set_play is None:
+            known = self.ball_on_field()
+            return [known] if known is not None else []
+        if ball.valid and ball.time_since_seen < since and self.robot_pose.valid:
+            return [ball.field_position(self.robot_pose)]
+        heard = [m for m in self.team_mates.mates if m.message.ball_seen and m.message.pose_valid and 0.0 <= m.message.ball_age]
+        heard = [m for m in heard if m.age + m.message.ball_age < min(since, self.parameters.team_ball_age)]
+        if heard:
+            best = min(heard, key=lambda m: m.age + m.message.ball_age).message
+            return [(best.ball_x, best.ball_y)]
+        if self.set_play_spots:
+            return list(self.set_play_spots)
+        return [self.last_ball] if self.last_ball is not None else []
+
     def set_play_ball(self) -> tuple[float, float] | None:
-        """The ball to keep away from (field mm): where it is known; at the opponents' set play, else where it
-        was last known (a ball that went out is put back about where it left the field, beside the robot
-        that chased it there, which may not see it then)."""
-        known = self.ball_on_field()
-        return known if known is not None or not self.opponents_set_play() else self.last_ball
+        """The ball to keep away from (field mm): where it is known; at the opponents' set play ``set_play_balls``,
+        the one nearest this robot (the rules may put it on either side)."""
+        balls = self.set_play_balls()
+        if len(balls) > 1 and self.robot_pose.valid:
+            pose = self.robot_pose
+            return min(balls, key=lambda b: math.hypot(b[0] - pose.x, b[1] - pose.y))
+        return balls[0] if balls else None
 
     def facing_ball(self, x: float, y: float) -> float:
         """rad (field) from (x, y) towards the ball (the centre spot when nobody knows where it is)."""

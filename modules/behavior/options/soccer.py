@@ -295,8 +295,7 @@ class Play(Option["SoccerBehavior"]):
             return "play"
         if self.time_in_state >= FREE_KICK_S:
             return "set_play_over"
-        ball = b.set_play_ball()
-        if ball is not None:
+        for ball in b.set_play_balls():  # where it is, or where the rules put it (either side while unsure)
             b.keep_out.append((*ball, FREE_KICK_DISTANCE + b.parameters.keep_out_margin))
         self.call(ROLES[self.args.role])
         return None
