@@ -19,16 +19,6 @@ from hypothesis import strategies as st
 
 from tafel.core.framework.manager import make_module
 from tafel.modules.perception.field_boundary_detector import cell_shares, chain, lower_hull
-from tafel.modules.perception.field_color_provider import (
-    below,
-    byte_median,
-    byte_percentile,
-    channel_histogram,
-    every,
-    histogram_median,
-    histogram_percentile,
-    white_pixels,
-)
 from tafel.modules.perception.goal_post_detector import (
     GoalPostDetector,
     band_passes,
@@ -42,6 +32,16 @@ from tafel.modules.perception.goal_post_detector import (
 )
 from tafel.modules.perception.image_geometry import ImageProjection, camera_views, own_body_mask, rows_times
 from tafel.modules.perception.line_detector import CIRCLE_RADIUS, LineDetector, green_on_both_sides, longest_arc, white_runs
+from tafel.modules.perception.pixel_statistics import (
+    below,
+    byte_median,
+    byte_percentile,
+    channel_histogram,
+    every,
+    histogram_median,
+    histogram_percentile,
+    white_pixels,
+)
 from tafel.modules.perception.spl_ball_detector import (
     LOOSER_TESTS,
     SPLBallDetector,

@@ -9,8 +9,9 @@ import numpy as np
 
 from tafel.core import Module, bounded, provides, requires, uses
 from tafel.debug import Canvas, DebugRequest
-from tafel.modules.perception.field_color_provider import WHITE_SATURATION_MAX, white_pixels
+from tafel.modules.perception.field_color_provider import WHITE_SATURATION_MAX
 from tafel.modules.perception.image_geometry import camera_views
+from tafel.modules.perception.pixel_statistics import white_pixels
 from tafel.representations.motion import CameraMatrixBuffer
 from tafel.representations.perception import CameraImageBottom, CameraImageTop, FieldBoundary, FieldColor, SegmentedImage
 

@@ -17,8 +17,8 @@ import numpy as np
 
 from tafel.core import Module, bounded, provides, requires
 from tafel.debug import Canvas, DebugRequest
-from tafel.modules.perception.field_color_provider import white_pixels
 from tafel.modules.perception.image_geometry import ImageProjection, camera_views
+from tafel.modules.perception.pixel_statistics import white_pixels
 from tafel.representations.field import GOAL_DEPTH, GOAL_HEIGHT, GOAL_POST_DIAMETER
 from tafel.representations.motion import CameraMatrixBuffer
 from tafel.representations.perception import (

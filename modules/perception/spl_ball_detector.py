@@ -11,7 +11,8 @@ import numpy as np
 from tafel.core import Module, bounded, provides, requires
 from tafel.debug import Canvas, DebugRequest, Stopwatch
 from tafel.modules.perception.ball_classifier import BallClassifier, features
-from tafel.modules.perception.field_color_provider import (
+from tafel.modules.perception.image_geometry import ImageProjection, camera_views
+from tafel.modules.perception.pixel_statistics import (
     below,
     byte_median,
     byte_percentile,
@@ -20,7 +21,6 @@ from tafel.modules.perception.field_color_provider import (
     histogram_median,
     white_pixels,
 )
-from tafel.modules.perception.image_geometry import ImageProjection, camera_views
 from tafel.representations.field import BALL_RADIUS
 from tafel.representations.motion import CameraMatrixBuffer
 from tafel.representations.perception import (
