@@ -27,7 +27,7 @@ def ask(debug: ContextDebug, line: str) -> str:
     return str(answer)
 
 
-def test_a_pinned_step_duration_slows_the_walk_and_stays_within_its_range() -> None:
+def test_a_pinned_step_duration_slows_the_walk_and_one_beyond_its_range_is_refused() -> None:
     request = MotionRequest(motion=MotionType.walk, walk_x=200.0)
     harness = ModuleHarness(WalkingEngine, request, MotionSelection(active=MotionType.walk), context="motion")
     debug = client(harness, "motion")
@@ -50,9 +50,10 @@ def test_a_pinned_step_duration_slows_the_walk_and_stays_within_its_range() -> N
     slow = phase_after(10)
     assert slow < 0.6 * normal, (normal, slow)  # the same time is half as far into a step twice as long
     assert "pinned to 0.5" in ask(debug, "modify:list")
-    ask(debug, "modify:set -name WalkingEngine:step_duration -value 9")  # beyond the parameter's range: its end
+    status, answer = debug.execute(parse("modify:set -name WalkingEngine:step_duration -value 9"))  # beyond its range
+    assert status == "error" and "takes a number from 0.15 to 0.6" in answer, answer
     harness.execute(frames=1)
-    assert harness.module.tuned.step_duration == 0.6
+    assert harness.module.tuned.step_duration == 0.5  # refused: the value pinned before stays
     ask(debug, "modify:release -name WalkingEngine:step_duration")
     harness.execute(frames=1)
     assert harness.module.tuned.step_duration == 0.25
