@@ -222,3 +222,87 @@ def test_configuration_removes_a_shipped_module_without_restating_the_list(tmp_p
     assert result.returncode == 2
     assert "did you mean 'GameControllerReporter'" in result.stderr
 
+
+
+# ------------------------------------------------------- the batch commands: scenarios and replay-batch
+#: a module of one's own that replaces a shipped provider: a ball always 1234 mm ahead
+FIXED_BALL = '''
+from tafel.core import Module, provides, requires
+from tafel.representations import BallModel, FrameInfo
+
+
+@requires(FrameInfo)
+@provides(BallModel)
+class FixedBallModeler(Module):
+    def execute(self) -> None:
+        self.ball_model.x, self.ball_model.valid = 1234.0, True
+'''
+
+#: a scenario that succeeds only if the module of one's own runs (its representation counts 20 frames)
+COUNTING_SCENARIO = '''
+name = "counts"
+duration_s = 2.0
+cameras = false
+required_success_rate = 1.0
+
+[[robots]]
+start = [0.0, 0.0, 0.0]
+
+[[success]]
+predicate = "representation"
+name = "BallSightings"
+field = "frames"
+at_least = 20
+'''
+
+
+@pytest.mark.slow  # a simulator in a worker process
+def test_scenarios_run_with_modules_of_ones_own(own: tuple[Path, Path], tmp_path: Path) -> None:
+    modules, _ = own
+    scenario = tmp_path / "counts.toml"
+    scenario.write_text(COUNTING_SCENARIO)
+    unknown = tafel("scenarios", "run", str(scenario), "--repeat", "1", cwd=tmp_path)
+    assert unknown.returncode == 2 and "no representation named 'BallSightings'" in unknown.stderr  # without the folder
+    done = tafel("scenarios", "run", str(scenario), "--repeat", "1", "--workers", "1", "--module-path", str(modules),
+                 "--add-module", "cognition:BallSightingCounter", "--out", str(tmp_path / "runs.jsonl"), cwd=tmp_path)
+    assert done.returncode == 0, done.stdout + done.stderr
+    row = json.loads((tmp_path / "runs.jsonl").read_text().splitlines()[0])
+    assert row["success"] is True, row
+
+
+@pytest.mark.slow  # a recorded run and a worker process
+def test_replay_batch_replays_with_a_module_of_ones_own(tmp_path: Path) -> None:
+    (tmp_path / "mods").mkdir()
+    (tmp_path / "mods" / "fixed_ball.py").write_text(FIXED_BALL)
+    recorded = tafel("run", "--platform", "dummy", "--frames", "100", "--speed", "max", "--no-debug", "--record", str(tmp_path / "g.mcap"),
+                     "--record-reps", "all", cwd=tmp_path)
+    assert recorded.returncode == 0, recorded.stderr
+    done = tafel("replay-batch", str(tmp_path / "g.mcap"), "--module-path", str(tmp_path / "mods"), "--workers", "1",
+                 "--remove-module", "cognition:KalmanBallModeler", "--add-module", "cognition:FixedBallModeler",
+                 "--set", "cognition.providers.BallModel=FixedBallModeler", "--metric", "BallModel.x", "--out", str(tmp_path / "b.csv"),
+                 cwd=tmp_path)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "1234 replayed" in done.stdout  # the mean of BallModel.x over the replay: the module's ball
+
+
+@pytest.mark.parametrize(("command", "arguments", "message"), [
+    ("replay-batch", ["--module-path", "nowhere"], "nowhere: no such folder; give the folder that holds your module files"),
+    ("replay-batch", ["--add-module", "cognition:BallSightingCountr"], "unknown module 'BallSightingCountr': did you mean 'BallSightingCounter'"),
+    ("replay-batch", ["--remove-module", "cognition:Kalman"], "Kalman is not in [cognition] modules; did you mean 'KalmanBallModeler'"),
+    ("scenarios", ["--add-module", "motion:BallSightingCountr"], "unknown module 'BallSightingCountr': did you mean 'BallSightingCounter'"),
+    ("scenarios", ["--add-module", "brain:BallSightingCounter"], "CONTEXT takes cognition or motion"),
+])
+def test_the_batch_commands_refuse_bad_module_options_before_any_run(own: tuple[Path, Path], tmp_path: Path, command: str,
+                                                                     arguments: list[str], message: str) -> None:
+    modules, _ = own
+    target = tmp_path / "any.mcap"
+    target.write_bytes(b"never read: the options are refused first")
+    if command == "scenarios":
+        target = tmp_path / "counts.toml"
+        target.write_text(COUNTING_SCENARIO)
+    found = ["--module-path", str(modules)] if "nowhere" not in arguments else []
+    result = tafel(*(["scenarios", "run"] if command == "scenarios" else [command]), str(target), *found, *arguments,
+                   "--out", str(tmp_path / "rows.csv"), cwd=tmp_path)
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert message in result.stderr, result.stderr
+    assert not (tmp_path / "rows.csv").exists()

@@ -57,6 +57,16 @@ def context_name(text: str) -> str:
     return Context.of(text, "", argparse.ArgumentTypeError).value
 
 
+def add_module_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--add-module``, ``--remove-module`` (``CONTEXT:MODULE``) and ``--module-path``: the program's modules
+    changed on the command line, alike for ``run``, ``scenarios run`` and ``replay-batch``."""
+    parser.add_argument("--add-module", action="append", default=[], metavar="CONTEXT:MODULE",
+                        help="add a module to a context's list, e.g. cognition:SimpleBallModeler (repeatable)")
+    parser.add_argument("--remove-module", action="append", default=[], metavar="CONTEXT:MODULE",
+                        help="remove a module from a context's list (repeatable)")
+    add_module_path_argument(parser)
+
+
 def add_module_path_argument(parser: argparse.ArgumentParser) -> None:
     """``--module-path DIR``: folders of module files of one's own, imported at start (repeatable)."""
     parser.add_argument("--module-path", dest="module_path", action="append", default=[], type=Path, metavar="DIR",
@@ -152,6 +162,7 @@ def add_scenario_commands(commands: Any) -> None:
     run.add_argument("--no-logs", action="store_true", help="do not record failed runs again")
     run.add_argument("--ray", nargs="?", const="local", metavar="ADDRESS",
                      help="run each run as a Ray task: alone, on a local Ray instance; with HOST:PORT, on that cluster")
+    add_module_arguments(run)
     actions.add_parser("predicates", help="the predicates success conditions are built from, with their parameters")
 
 
@@ -167,8 +178,6 @@ def add_replay_batch_command(commands: Any) -> None:
     batch.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                        help="configuration override for every replay (repeatable), as with tafel run")
     batch.add_argument("--replace", default="", metavar="A,B", help="feed these recorded representations instead of running their providers")
-    batch.add_argument("--add-module", action="append", default=[], metavar="CONTEXT:MODULE", help="run this module too (repeatable)")
-    batch.add_argument("--remove-module", action="append", default=[], metavar="CONTEXT:MODULE", help="leave this module out (repeatable)")
     batch.add_argument("--compare", action="store_true", help="compare every replay with its log, as tafel log compare does")
     batch.add_argument("--metric", action="append", default=[], metavar="REP.FIELD",
                        help="report the mean of a representation's field, recorded and replayed (repeatable); tafel log info lists them")
@@ -177,6 +186,7 @@ def add_replay_batch_command(commands: Any) -> None:
     batch.add_argument("--workers", type=int, metavar="K", help=f"logs at a time (default: all cores, here {default_workers()})")
     batch.add_argument("--ray", nargs="?", const="local", metavar="ADDRESS",
                        help="replay each log as a Ray task: alone, on a local Ray instance; with HOST:PORT, on that cluster")
+    add_module_arguments(batch)
 
 
 def add_log_commands(commands: Any) -> None:
@@ -278,11 +288,7 @@ def add_program_arguments(parser: argparse.ArgumentParser) -> None:
                         help="override a configuration value, e.g. runtime.cognition_hz=15 (repeatable)")
     parser.add_argument("--strict", action="store_true",
                         help="modules the platform cannot feed are an error instead of being pruned")
-    parser.add_argument("--add-module", action="append", default=[], metavar="CONTEXT:MODULE",
-                        help="add a module to a context's list, e.g. cognition:SimpleBallModeler (repeatable)")
-    parser.add_argument("--remove-module", action="append", default=[], metavar="CONTEXT:MODULE",
-                        help="remove a module from a context's list (repeatable)")
-    add_module_path_argument(parser)
+    add_module_arguments(parser)
 
 
 def build_parser() -> argparse.ArgumentParser:

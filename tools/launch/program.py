@@ -12,6 +12,7 @@ from typing import Any
 
 from tafel.core.framework.config import check_config, edit_modules, load_config
 from tafel.core.framework.extensions import load_modules
+from tafel.core.framework.module import find_module
 from tafel.core.framework.representation import registered_representations
 from tafel.core.runtime.platform import Platform, load_platform
 from tafel.core.runtime.program import ContextPlan, plan_program
@@ -30,6 +31,17 @@ def discover_modules(module_paths: Sequence[str | Path] = ()) -> None:
     for info in pkgutil.walk_packages(modules.__path__, prefix="tafel.modules."):
         importlib.import_module(info.name)
     load_modules(module_paths)
+
+
+def check_module_edits(add: Sequence[str], remove: Sequence[str], platform: str = "dummy") -> None:
+    """``--add-module`` and ``--remove-module`` checked before anything runs (for the batch commands, whose
+    runs would otherwise each fail alike): ``ConfigError`` for a malformed one or a module that is not in the
+    list, ``UnknownModuleError`` for a module nobody defined, both with the closest names."""
+    if not add and not remove:
+        return
+    edit_modules(load_config(DEFAULT_CONFIG, platform), add, remove)
+    for text in add:
+        find_module(text.partition(":")[2])
 
 
 def config_dirs(args: argparse.Namespace) -> list[Path]:

@@ -2,7 +2,8 @@
 
 Every log is replayed as ``tafel run --platform log`` would (sensor data fed as recorded, the modules
 run again, ``--replace`` feeds recorded representations instead of their providers) with the
-``--set``, ``--add-module`` and ``--remove-module`` changes, recording what the original holds. With
+``--set``, ``--add-module`` and ``--remove-module`` changes (modules of one's own from ``--module-path``
+folders), recording what the original holds. With
 ``--compare`` each replay is compared with its original as ``tafel log compare`` does: channels that
 differ, the first differing frame and field. ``--metric Rep.field`` adds that field's mean over the
 frames of the original and of the replay. One CSV row per log, a summary on the console; the runs go
@@ -24,8 +25,10 @@ from functools import partial
 from pathlib import Path
 from typing import Any
 
+from tafel.core.framework.errors import UnknownModuleError
 from tafel.core.framework.naming import did_you_mean
 from tafel.core.logs import LogError, LogReader
+from tafel.tools.launch.program import check_module_edits, discover_modules
 from tafel.tools.logs.decoding import decoded_messages
 from tafel.tools.logs.log_compare import compare_logs
 from tafel.tools.simulation.batch import BatchError, BatchInfo, run_jobs
@@ -45,6 +48,8 @@ class ReplayJob:
     metrics: tuple[str, ...]
     #: where the replayed log is kept (None: it is thrown away after the comparison)
     keep_in: str | None
+    #: folders of one's own module files (absolute), imported in every worker
+    module_paths: tuple[str, ...] = ()
 
 
 def expand(patterns: Sequence[str]) -> list[Path]:
@@ -79,13 +84,12 @@ def metric_means(path: Path, metrics: Sequence[str]) -> dict[str, float | None]:
 
 
 def check_metrics(metrics: Sequence[str], logs: Sequence[Path]) -> None:
-    """Every ``REP.FIELD`` names a representation some log holds and a field it has; ``ValueError`` otherwise."""
+    """Every ``REP.FIELD`` names a representation some log holds and a field it has; ``ValueError`` otherwise
+    (the modules, one's own too, are discovered before)."""
     from tafel.core.framework.representation import fields_of, get_representation
-    from tafel.tools.launch.program import discover_modules
 
     if not metrics:
         return
-    discover_modules()
     held: set[str] = set()
     for log in logs:
         try:
@@ -116,7 +120,7 @@ def replay_log(job: ReplayJob) -> dict[str, Any]:
             # the program's own channels, not the Foxglove channels made from them
             recorded = sorted({c.representation for c in original.channels.values() if c.context in ("cognition", "motion")})
         program = SteppedProgram("log", {"log": job.log, "replace": job.replace}, job.overrides, record=replayed, record_reps=recorded,
-                                 add_modules=job.add_modules, remove_modules=job.remove_modules)
+                                 add_modules=job.add_modules, remove_modules=job.remove_modules, module_paths=job.module_paths)
         row["ended"] = program.run_to_end()
         row["frames"] = {name: runner.frames for name, runner in program.runtime.runners.items()}
         if job.compare:
@@ -158,15 +162,21 @@ def command_replay_batch(args: argparse.Namespace) -> int:
     if bad:
         print(f"tafel replay-batch: --metric takes REPRESENTATION.FIELD (a representation the logs hold and one of its fields); got {bad[0]!r}", file=sys.stderr)
         return 2
+    module_paths = tuple(str(folder.resolve()) for folder in args.module_path)
     try:
         logs = expand(args.logs)
+        discover_modules(module_paths)  # a folder that cannot be imported is refused here, before any worker starts
+        check_module_edits(args.add_module, args.remove_module, "log")
         check_metrics(args.metric, logs)
+    except UnknownModuleError as exc:
+        print(f"tafel replay-batch: {exc.args[0]}", file=sys.stderr)
+        return 2
     except (ValueError, LogError) as exc:
         print(f"tafel replay-batch: {exc}", file=sys.stderr)
         return 2
     keep = str(args.artifacts.resolve()) if args.artifacts is not None else None
     jobs = [ReplayJob(str(log.resolve()), tuple(args.overrides), args.replace, tuple(args.add_module), tuple(args.remove_module),
-                      args.compare, tuple(args.metric), keep) for log in logs]
+                      args.compare, tuple(args.metric), keep, module_paths) for log in logs]
     print(f"replaying {plural(len(jobs), 'log')}", flush=True)
 
     def progress(index: int, row: dict[str, Any]) -> None:
@@ -180,7 +190,7 @@ def command_replay_batch(args: argparse.Namespace) -> int:
 
     info = BatchInfo()
     try:
-        rows = run_jobs(replay_log, jobs, workers=args.workers, ray=args.ray, on_result=progress, warm_up=partial(warm_up, ("log",)), info=info)
+        rows = run_jobs(replay_log, jobs, workers=args.workers, ray=args.ray, on_result=progress, warm_up=partial(warm_up, ("log",), module_paths), info=info)
     except BatchError as exc:
         print(f"tafel replay-batch: {exc}", file=sys.stderr)
         return 2

@@ -30,12 +30,22 @@ from typing import Any
 import numpy as np
 
 from tafel.tools.simulation.batch import BatchError, BatchInfo, run_jobs
-from tafel.tools.simulation.scenario_file import Scenario, ScenarioError, load_scenario
+from tafel.tools.simulation.scenario_file import Scenario, load_scenario
 from tafel.tools.simulation.scenario_predicates import PREDICATES
 
 #: the columns of every row, in the order CSV files show them
 COLUMNS = ["scenario", "run", "seed", "success", "time_to_success_s", "sim_s", "wall_s", "reason", "robot_x_mm", "robot_y_mm",
            "ball_x_mm", "ball_y_mm", "falls", "start", "ball", "sensor_noise", "log"]
+
+
+@dataclass(frozen=True)
+class ProgramChanges:
+    """What the command line changes in every run's program: folders of one's own module files (absolute,
+    ``--module-path``) and the module lists (``--add-module``, ``--remove-module``, ``CONTEXT:MODULE``)."""
+
+    module_paths: tuple[str, ...] = ()
+    add_modules: tuple[str, ...] = ()
+    remove_modules: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -47,6 +57,7 @@ class Job:
     seed: int
     artifacts: str | None
     keep_logs: bool = True
+    changes: ProgramChanges = ProgramChanges()
 
 
 @dataclass(frozen=True)
@@ -142,13 +153,14 @@ def _options(scenario: Scenario, start: Start, seed: int) -> dict[str, Any]:
             "cameras": "on" if scenario.cameras else "off", "sensor_noise": start.sensor_noise, "realism": scenario.realism}
 
 
-def play(scenario: Scenario, seed: int, record: Path | None = None) -> dict[str, Any]:
+def play(scenario: Scenario, seed: int, record: Path | None = None, changes: ProgramChanges = ProgramChanges()) -> dict[str, Any]:
     """One run of ``scenario`` from ``seed``: success, when, why not, and where things ended."""
     from tafel.tools.simulation.stepped_program import SteppedProgram
 
     start = perturbed_start(scenario, seed)
     began = time.perf_counter()
-    program = SteppedProgram(scenario.platform, _options(scenario, start, seed), scenario.overrides, record=record)
+    program = SteppedProgram(scenario.platform, _options(scenario, start, seed), scenario.overrides, record=record,
+                             add_modules=changes.add_modules, remove_modules=changes.remove_modules, module_paths=changes.module_paths)
     program.platform.tell_pose = scenario.told_pose  # told at the first cognition frame, as sim:move_robot -reset on tells it
     world, judge = _Truth(program), _Judge(scenario)
     pushes = sorted(scenario.events, key=lambda e: e.at_s)
@@ -179,7 +191,7 @@ def play(scenario: Scenario, seed: int, record: Path | None = None) -> dict[str,
 def run_job(job: Job) -> dict[str, Any]:
     """A worker's whole task: the run, and for a failure the same run again, recorded. Never raises."""
     try:
-        row = {"run": job.run, **play(job.scenario, job.seed)}
+        row = {"run": job.run, **play(job.scenario, job.seed, changes=job.changes)}
     except Exception as exc:  # noqa: BLE001 - a broken run is a row that says why, not a dead batch
         return {"scenario": job.scenario.name, "run": job.run, "seed": job.seed, "success": False,
                 "reason": f"error: {type(exc).__name__}: {exc}"}
@@ -194,7 +206,7 @@ def _failure_log(job: Job, row: dict[str, Any]) -> dict[str, Any]:
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / name
     try:
-        again = play(job.scenario, job.seed, record=path)
+        again = play(job.scenario, job.seed, record=path, changes=job.changes)
     except Exception as exc:  # noqa: BLE001
         return {"log": f"not recorded: {type(exc).__name__}: {exc}"}
     found: dict[str, Any] = {"log": str(path)}
@@ -208,12 +220,13 @@ def _failure_log(job: Job, row: dict[str, Any]) -> dict[str, Any]:
     return found
 
 
-def warm_up(platforms: Sequence[str] = ("mujoco",)) -> None:
-    """Imports, module discovery and the simulators' libraries, once per worker, before the clock starts."""
+def warm_up(platforms: Sequence[str] = ("mujoco",), module_paths: Sequence[str] = ()) -> None:
+    """Imports, module discovery (one's own ``module_paths`` too) and the simulators' libraries, once per
+    worker, before the clock starts."""
     from tafel.core.runtime.platform import load_platform
     from tafel.tools.launch.program import discover_modules
 
-    discover_modules()
+    discover_modules(module_paths)
     for name in platforms:
         load_platform(name)
 
@@ -295,9 +308,18 @@ def command_scenarios(args: argparse.Namespace) -> int:
     if args.repeat < 1 or (args.workers is not None and args.workers < 1):
         print("tafel scenarios run: --repeat and --workers take whole numbers of 1 or more", file=sys.stderr)
         return 2
+    from tafel.core.framework.errors import UnknownModuleError
+    from tafel.tools.launch.program import check_module_edits, discover_modules
+
+    changes = ProgramChanges(tuple(str(folder.resolve()) for folder in args.module_path), tuple(args.add_module), tuple(args.remove_module))
     try:
+        discover_modules(changes.module_paths)  # before the files: their predicates may name one's own representations
+        check_module_edits(changes.add_modules, changes.remove_modules)
         scenarios = [load_scenario(path) for path in args.files]
-    except ScenarioError as exc:
+    except UnknownModuleError as exc:
+        print(f"tafel scenarios run: {exc.args[0]}", file=sys.stderr)
+        return 2
+    except ValueError as exc:  # ScenarioError, ModulePathError, ConfigError
         print(f"tafel scenarios run: {exc}", file=sys.stderr)
         return 2
     names = [s.name for s in scenarios]
@@ -308,7 +330,7 @@ def command_scenarios(args: argparse.Namespace) -> int:
     # Logs stay on this machine: locally in the artifacts folder; from a cluster they travel back unless it shares one.
     artifacts = args.artifacts or Path("scenario-logs")
     remote = args.ray not in (None, "local") and args.artifacts is None
-    jobs = [Job(s, run, run_seed(args.seed, s.name, run), None if remote else str(artifacts.resolve()), not args.no_logs)
+    jobs = [Job(s, run, run_seed(args.seed, s.name, run), None if remote else str(artifacts.resolve()), not args.no_logs, changes)
             for s in scenarios for run in range(args.repeat)]
     print(f"{plural(len(jobs), 'run')} of {plural(len(scenarios), 'scenario')}", flush=True)
     info = BatchInfo()
@@ -324,7 +346,7 @@ def command_scenarios(args: argparse.Namespace) -> int:
 
     try:
         rows = run_jobs(run_job, jobs, workers=args.workers, ray=args.ray, on_result=progress, info=info,
-                        warm_up=partial(warm_up, tuple(sorted({s.platform for s in scenarios}))))
+                        warm_up=partial(warm_up, tuple(sorted({s.platform for s in scenarios})), changes.module_paths))
     except BatchError as exc:
         print(f"tafel scenarios run: {exc}", file=sys.stderr)
         return 2

@@ -27,12 +27,14 @@ class SteppedProgram:
 
     With ``record`` the run is recorded into that MCAP file as ``tafel run --record`` would: the
     configuration's ``[recording]`` list, or ``record_reps``. ``add_modules`` and ``remove_modules``
-    edit the module lists as ``--add-module`` and ``--remove-module`` do (``CONTEXT:MODULE``).
+    edit the module lists as ``--add-module`` and ``--remove-module`` do (``CONTEXT:MODULE``);
+    ``module_paths`` are folders of one's own module files, imported first as ``--module-path`` does.
     """
 
     def __init__(self, platform: str, options: Mapping[str, Any], overrides: Sequence[str] = (), record: Path | None = None,
-                 record_reps: list[str] | None = None, add_modules: Sequence[str] = (), remove_modules: Sequence[str] = ()) -> None:
-        discover_modules()
+                 record_reps: list[str] | None = None, add_modules: Sequence[str] = (), remove_modules: Sequence[str] = (),
+                 module_paths: Sequence[str] = ()) -> None:
+        discover_modules(module_paths)
         self.platform = load_platform(platform)(dict(options))
         rates = [f"runtime.{context}_hz={hz}" for context, hz in (self.platform.rates() or {}).items()]
         config = load_config(DEFAULT_CONFIG, self.platform.config_layers(), overrides=[*rates, *overrides])
