@@ -154,6 +154,7 @@ def test_a_new_version_that_raises_in_its_first_frames_is_rolled_back_with_the_o
     assert manager.module("Counter") is old
     manager.execute()
     assert tally(manager) == 4  # frames 1 and 3 by the old instance; frame 2's failed write was undone
+    assert manager.errors() == {"Counter": (1, "RuntimeError: broken")}  # the rolled-back version's failure is still counted
 
 
 def test_a_new_version_that_passes_its_probation_stays(counting) -> None:

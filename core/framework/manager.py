@@ -174,6 +174,9 @@ class ModuleManager:
             resolve_module(module_name, self._by_name)
         self._slots: list[_Slot] = []
         self._marks: list[AccessMark] = []
+        #: module name -> [errors since the start, the last one]: kept when its instance goes (switched off,
+        #: reloaded, rolled back), so a run's summary counts every failure
+        self._error_totals: dict[str, list[Any]] = {}
         effective = {r: m for r, m in self._providers.items() if m not in self._disabled}
         plan = build_plan(self._modules, external=self._external, providers=effective, disabled=self._disabled)
         self._plan = self._apply(plan, {})
@@ -211,6 +214,8 @@ class ModuleManager:
             raise exc
         slot.errors += 1
         slot.last_error = f"{type(exc).__name__}: {exc}"
+        total = self._error_totals.setdefault(slot.name, [0, ""])
+        total[0], total[1] = total[0] + 1, slot.last_error
         # The traceback once; after that at most one line a second with the count, so that a module
         # failing every frame cannot flood the log (or slow the loop down with logging).
         now = time.monotonic()
@@ -306,8 +311,9 @@ class ModuleManager:
         raise KeyError(f"module {name} is not running in {self.name}")
 
     def errors(self) -> dict[str, tuple[int, str]]:
-        """Module name -> (error count, last error) for modules that failed at least once."""
-        return {s.name: (s.errors, s.last_error) for s in self._slots if s.errors}
+        """Module name -> (error count, last error) for modules that failed at least once since the start,
+        counting instances that no longer run (switched off, replaced by a hot reload, rolled back)."""
+        return {name: (count, last) for name, (count, last) in self._error_totals.items()}
 
     def access(self) -> dict[str, dict[str, list[str]]]:
         """Per representation, which modules read it and which wrote it in the last frame."""
