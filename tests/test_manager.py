@@ -291,13 +291,13 @@ def test_exception_is_logged_counted_and_outputs_keep_last_values(caplog) -> Non
     assert manager.blackboard[MgrDecision].value == 1  # the frame went on
     assert manager.errors() == {"Flaky": (1, "ValueError: bad frame")}
     assert manager.timings()["Flaky"].errors == 1
-    manager.set_enabled("MgrBehavior", False)
-    manager.set_enabled("Flaky", False)  # switched off, its instance gone: its failure still counts for the run's summary
-    assert manager.errors() == {"Flaky": (1, "ValueError: bad frame")}
     record = caplog.records[-1].getMessage()
     assert "Flaky failed in frame 2" in record and "Traceback" in record and "bad frame" in record
     manager.execute()
     assert manager.blackboard[MgrModel].value == 3
+    manager.set_enabled("MgrBehavior", False)
+    manager.set_enabled("Flaky", False)  # switched off, its instance gone: its failure still counts for the run's summary
+    assert manager.errors() == {"Flaky": (1, "ValueError: bad frame")}
 
 
 def test_strict_mode_propagates() -> None:
