@@ -158,6 +158,15 @@ def answer_bytes(text: str | bytes, *, base64_answer: bool = False) -> bytes:
     return body.encode("utf-8") + b"\0"
 
 
+def encode_answer(command: Command, is_error: bool, payload: str | bytes) -> bytes:
+    """The bytes of one answer to ``command``: an error line, base64 for ``+name`` commands, text otherwise."""
+    if is_error:
+        return answer_bytes(f"error: {payload}")
+    if isinstance(payload, bytes) and not command.base64_answer:
+        return answer_bytes(f"error: {command.name} answers with bytes; send +{command.name} for base64")
+    return answer_bytes(payload, base64_answer=command.base64_answer)
+
+
 IAC, SB, SE = 255, 250, 240
 MAX_SUBNEGOTIATION = 512  # real ones are a few bytes; a longer one is garbage, and reading goes on
 _NEGOTIATION = {251, 252, 253, 254}  # WILL, WONT, DO, DONT

@@ -25,7 +25,7 @@ from collections import deque
 from typing import Any
 
 from tafel.core.runtime import name_os_thread
-from tafel.debug.protocol import Command, ParseError, answer_bytes, parse
+from tafel.debug.protocol import ParseError, answer_bytes, encode_answer, parse
 from tafel.debug.router import DebugRouter
 from tafel.debug.session import (
     FRAME_WAIT,
@@ -95,7 +95,7 @@ class DebugServer:
             return f"error: {exc}"
         if command.name in DebugRouter.IMMEDIATE:
             ((is_error, payload),) = self.router.handle_batch([command])
-            data = self.encode(command, is_error, payload)
+            data = encode_answer(command, is_error, payload)
         else:
             client = self._local
             future: concurrent.futures.Future[bytes] = concurrent.futures.Future()
@@ -185,6 +185,11 @@ class DebugServer:
             exc = context.get("exception")
             log.error("debug server: %s%s (%d so far; the program goes on)", context.get("message", "error"),
                       f": {exc}" if exc else "", self._resource_errors)
+
+    @property
+    def loop(self) -> asyncio.AbstractEventLoop | None:
+        """The network thread's event loop while the server runs (None before and after)."""
+        return self._loop
 
     async def next_frame_started(self) -> None:
         """Network thread: wait until the next frame starts (or ``FRAME_WAIT``, if none comes)."""
@@ -300,21 +305,12 @@ class DebugServer:
         loop = self._loop
         per_connection: dict[Session, list[tuple[int, bytes]]] = {}
         for request, (is_error, payload) in zip(requests, results):
-            data = self.encode(request.command, is_error, payload)
+            data = encode_answer(request.command, is_error, payload)
             if not request.connection.closed:
                 per_connection.setdefault(request.connection, []).append((request.sequence, data))
         if loop is not None and per_connection:
             loop.call_soon_threadsafe(self._deliver, per_connection)  # one wake-up of the network thread per batch
         self.answered += len(requests)
-
-    @staticmethod
-    def encode(command: Command, is_error: bool, payload: str | bytes) -> bytes:
-        """The bytes of one answer."""
-        if is_error:
-            return answer_bytes(f"error: {payload}")
-        if isinstance(payload, bytes) and not command.base64_answer:
-            return answer_bytes(f"error: {command.name} answers with bytes; send +{command.name} for base64")
-        return answer_bytes(payload, base64_answer=command.base64_answer)
 
     @staticmethod
     def _deliver(per_connection: dict[Session, list[tuple[int, bytes]]]) -> None:

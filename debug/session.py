@@ -9,18 +9,15 @@ import concurrent.futures
 import hmac
 import ipaddress
 import logging
+import queue
 import threading
 import time
 from collections import deque
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
-from tafel.debug.protocol import Command, ParseError, TelnetDecoder, answer_bytes, parse
+from tafel.debug.protocol import Command, ParseError, TelnetDecoder, answer_bytes, encode_answer, parse
 from tafel.debug.router import DebugRouter
-
-if TYPE_CHECKING:  # the server owns its sessions; they only call back
-    from tafel.debug.server import DebugServer
-
 
 #: s between two log lines about the same kind of failure (descriptors running out, say)
 RESOURCE_LOG_INTERVAL = 10.0
@@ -74,6 +71,27 @@ def is_loopback(peer: Any) -> bool:
     return address.is_loopback or (mapped is not None and mapped.is_loopback)
 
 
+class SessionHost(Protocol):
+    """What a session needs of the server that owns it (``DebugServer``): its limits, the router, the queue of
+    commands for the thread that owns the data, and the network thread's loop. Sessions only call back."""
+
+    router: DebugRouter
+    token: str | None
+    max_line: int
+    max_output: int
+    max_bytes_per_frame: int
+    idle_timeout: float | None
+    pending: queue.Queue[_Request]
+    connections: set[Session]
+
+    @property
+    def loop(self) -> asyncio.AbstractEventLoop | None:
+        """The network thread's event loop while the server runs."""
+
+    async def next_frame_started(self) -> None:
+        """Returns when the next frame of the owning thread starts (or after ``FRAME_WAIT``)."""
+
+
 class Session:
     """One client of the debug server, whatever carries its lines (TCP, a WebSocket).
 
@@ -82,7 +100,7 @@ class Session:
     ``_write``, which each transport supplies. Runs in the network thread.
     """
 
-    def __init__(self, server: DebugServer, peer: Any) -> None:
+    def __init__(self, server: SessionHost, peer: Any) -> None:
         self.server = server
         self.peer = peer
         self.authenticated = server.token is None
@@ -146,7 +164,7 @@ class Session:
             return
         if command.name in DebugRouter.IMMEDIATE:  # stateless: answer here, in order, without waiting a frame
             ((is_error, payload),) = self.server.router.handle_batch([command])
-            self.deliver(sequence, self.server.encode(command, is_error, payload))
+            self.deliver(sequence, encode_answer(command, is_error, payload))
             return
         self.outstanding += 1
         self.server.pending.put(_Request(self, sequence, command))
@@ -159,7 +177,7 @@ class Session:
         """Network thread, at connect: close this connection if it has not proven itself (``proven``)
         within the server's ``idle_timeout``. A deadline from connecting, not from its last byte: a
         client trickling bytes keeps no place either."""
-        loop, timeout = self.server._loop, self.server.idle_timeout
+        loop, timeout = self.server.loop, self.server.idle_timeout
         if loop is not None and timeout is not None:
             loop.call_later(timeout, self._idle_check)
 
@@ -241,7 +259,7 @@ class Session:
 class _Connection(Session):
     """A TCP client (telnet, ``tafel console``, tools): lines in, NUL-terminated answers out."""
 
-    def __init__(self, server: DebugServer, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+    def __init__(self, server: SessionHost, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         super().__init__(server, writer.get_extra_info("peername"))
         self.reader, self.writer = reader, writer
         self.frame_bytes = 0  # read in the current frame
