@@ -14,10 +14,12 @@ from typing import Any
 
 import cv2
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tafel.core.framework.manager import make_module
+from tafel.modules.modeling.field_model import FIELD_MODEL
 from tafel.modules.perception.field_boundary_detector import cell_shares, chain, lower_hull
 from tafel.modules.perception.goal_post_detector import (
     GoalPostDetector,
@@ -30,7 +32,7 @@ from tafel.modules.perception.goal_post_detector import (
     strip_means,
     strip_sums,
 )
-from tafel.modules.perception.image_geometry import ImageProjection, camera_views, own_body_mask, rows_times
+from tafel.modules.perception.image_geometry import BODY_POINTS, BODY_POINTS_ALL, ImageProjection, camera_views, own_body_mask, rows_times
 from tafel.modules.perception.line_detector import CIRCLE_RADIUS, LineDetector, green_on_both_sides, longest_arc, white_runs
 from tafel.modules.perception.pixel_statistics import (
     below,
@@ -55,14 +57,17 @@ from tafel.modules.perception.spl_ball_detector import (
 )
 from tafel.platforms.images import posed_image
 from tafel.representations.field import BALL_RADIUS, GOAL_HEIGHT, GOAL_POST_DIAMETER
-from tafel.representations.motion import CameraMatrix
+from tafel.representations.motion import CameraMatrix, CameraMatrixBuffer
 from tafel.representations.perception import (
     BallCandidate,
     BallImagePercept,
+    CameraImageBottom,
+    CameraImageTop,
     FieldBoundary,
     GoalPost,
     GoalPostPercept,
     LinePercept,
+    LineSegment,
     SegmentedImage,
 )
 from tafel.tools.simulation.scene_frames import Perception
@@ -1066,3 +1071,95 @@ def test_the_rows_of_many_posts_at_once_are_numpys(spans: list[tuple[int, int]],
     expected = [np.arange(a, b) for a, b in zip(first, stop, strict=True)]
     assert lengths.tolist() == [len(rows) for rows in expected]
     np.testing.assert_array_equal(ys, np.concatenate([np.zeros(0, int), *expected]))
+
+
+# ------------------------------------------------------------ the projections the detectors share, the own body, fresh poses
+def reference_paint_own_body(projection: ImageProjection, mask: np.ndarray) -> None:
+    for points in BODY_POINTS:
+        pixels, front = projection.to_image(points)
+        if front.sum() >= 3:
+            cv2.fillConvexPoly(mask, cv2.convexHull(np.minimum(np.maximum(pixels[front], -1e4), 1e4).astype(np.int32)), 1)
+
+
+@settings(max_examples=300)
+@given(st.floats(-3.1, 3.1), st.floats(-1.5, 1.5), st.floats(-1.0, 1.0), st.floats(-100.0, 600.0), st.sampled_from([(640, 480), (320, 240), (1280, 960)]))
+def test_the_own_body_projected_at_once_is_each_boxs(yaw: float, pitch: float, roll: float, height: float, size: tuple[int, int]) -> None:
+    """The robot's own body with all its boxes' points projected in one call: the mask of one call per box."""
+    c, s, cp, sp, cr, sr = math.cos(yaw), math.sin(yaw), math.cos(pitch), math.sin(pitch), math.cos(roll), math.sin(roll)
+    rotation = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]) @ np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]]) @ np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    projection = ImageProjection(CameraMatrix(rotation, np.array([20.0, -10.0, height]), True), *size, math.radians(56.3), math.radians(43.7))
+    np.testing.assert_array_equal(projection.to_image(BODY_POINTS_ALL)[0], np.concatenate([projection.to_image(points)[0] for points in BODY_POINTS]))
+    expected = np.zeros(size[::-1], np.uint8)
+    reference_paint_own_body(projection, expected)
+    np.testing.assert_array_equal(own_body_mask(projection, size[::-1]), expected.view(bool))
+
+
+def test_the_frames_projections_are_worked_out_once_and_anew_when_what_they_come_from_changes() -> None:
+    """Six detectors ask for the same frame's projections: the second asker gets the same (read-only) ones; a new
+    matrix in the buffer, a new image time or a new image size gives new ones, as worked out afresh."""
+    pitch = 0.4
+    rotation = np.array([[math.cos(pitch), 0, math.sin(pitch)], [0, 1, 0], [-math.sin(pitch), 0, math.cos(pitch)]])
+    buffer = CameraMatrixBuffer.of(CameraMatrix(rotation, np.array([0.0, 0.0, 503.0]), True), CameraMatrix(rotation, np.array([0.0, 0.0, 450.0]), True), 100)
+    top = CameraImageTop(image=np.zeros((480, 640, 3), np.uint8), horizontal_fov=math.radians(56.3), vertical_fov=math.radians(43.7), time_ns=100)
+    bottom = CameraImageBottom(image=np.zeros((240, 320, 3), np.uint8), horizontal_fov=math.radians(56.3), vertical_fov=math.radians(43.7), time_ns=100)
+
+    def views() -> dict[str, ImageProjection]:
+        return {camera: projection for camera, _, projection in camera_views(top, bottom, buffer)}
+
+    first, again = views(), views()
+    assert first.keys() == {"top", "bottom"} and all(again[camera] is first[camera] for camera in first)
+    with pytest.raises(ValueError):
+        first["top"].translation[2] = 0.0  # shared: nobody changes it
+    buffer.top_translation[0, 2] = 480.0  # the top camera's matrix changed: its projection anew, the bottom one's kept
+    moved = views()
+    assert moved["top"] is not first["top"] and moved["bottom"] is first["bottom"]
+    assert moved["top"].translation[2] == 480.0
+    buffer.time_ns[1], buffer.top_translation[1, 2], buffer.count = 200, 520.0, 2  # an image taken later: between the entries
+    top.time_ns = 150
+    between = views()["top"]
+    assert between.translation[2] == pytest.approx(500.0)
+    top.image = np.zeros((240, 320, 3), np.uint8)
+    smaller = views()["top"]
+    assert (smaller.width, smaller.height) == (320, 240) and smaller.fx == pytest.approx(between.fx / 2)
+
+
+def reference_from_lines(rng: np.random.Generator, count: int, lines: LinePercept) -> np.ndarray:
+    segments = [s for s in lines.segments if s.length >= 300.0]
+    seen = [segments[i] for i in rng.integers(0, len(segments), count)]
+    middle = np.array([((s.x1 + s.x2) / 2, (s.y1 + s.y2) / 2) for s in seen])
+    seen_angle = np.array([math.atan2(s.y2 - s.y1, s.x2 - s.x1) for s in seen])
+    true = FIELD_MODEL.lines[rng.integers(0, len(FIELD_MODEL.lines), count)]
+    along = rng.random(count)[:, None]
+    point = true[:, :2] + along * (true[:, 2:] - true[:, :2])
+    headings = np.arctan2(true[:, 3] - true[:, 1], true[:, 2] - true[:, 0]) - seen_angle + math.pi * rng.integers(0, 2, count)
+    c, s = np.cos(headings), np.sin(headings)
+    positions = point - np.column_stack([c * middle[:, 0] - s * middle[:, 1], s * middle[:, 0] + c * middle[:, 1]])
+    return np.column_stack([positions, np.remainder(headings + math.pi, math.tau) - math.pi])
+
+
+def reference_from_posts(rng: np.random.Generator, count: int, posts: GoalPostPercept) -> np.ndarray:
+    seen = [posts.posts[i] for i in rng.integers(0, len(posts.posts), count)]
+    distance = np.array([math.hypot(p.x, p.y) for p in seen]) * rng.normal(1.0, 0.05, count)
+    bearing = np.array([math.atan2(p.y, p.x) for p in seen])
+    true = FIELD_MODEL.posts[rng.integers(0, len(FIELD_MODEL.posts), count)]
+    around = rng.uniform(-math.pi, math.pi, count)
+    positions = true + distance[:, None] * np.column_stack([np.cos(around), np.sin(around)])
+    headings = np.remainder(around + math.pi - bearing + math.pi, math.tau) - math.pi
+    on_field = (np.abs(positions[:, 0]) < FIELD_MODEL.half_x) & (np.abs(positions[:, 1]) < FIELD_MODEL.half_y)
+    fresh = np.column_stack([positions, headings])[on_field]
+    return np.vstack([fresh, FIELD_MODEL.uniform(rng, count - len(fresh))])
+
+
+@settings(max_examples=100)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 120), st.integers(1, 6), st.integers(1, 4))
+def test_fresh_poses_from_lines_and_posts_are_those_drawn_one_by_one(seed: int, count: int, segments: int, posts: int) -> None:
+    """Sensor resetting's poses from line segments and from posts, each segment's and post's measures worked out once:
+    the poses (and the random numbers after them) of the measures worked out for every pose drawn."""
+    rng = np.random.default_rng(seed)
+    lines = LinePercept(segments=[LineSegment(*(float(v) for v in rng.uniform(-3000, 3000, 4))) for _ in range(segments)])
+    lines.segments.append(LineSegment(0.0, 0.0, 1000.0, 0.0))  # one at least is long enough
+    seen = GoalPostPercept(posts=[GoalPost(*(float(v) for v in rng.uniform(-4000, 4000, 2)), "top") for _ in range(posts)])
+    for make, reference, percept in ((FIELD_MODEL._from_lines, reference_from_lines, lines), (FIELD_MODEL._from_posts, reference_from_posts, seen)):
+        a, b = np.random.default_rng(seed + 1), np.random.default_rng(seed + 1)
+        np.testing.assert_array_equal(make(a, count, lines, seen), reference(b, count, percept))  # type: ignore[operator]
+        assert a.random() == b.random()

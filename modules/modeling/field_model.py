@@ -85,9 +85,9 @@ class FieldModel:
 
     def _from_lines(self, rng: np.random.Generator, count: int, lines: LinePercept, posts: GoalPostPercept) -> np.ndarray:
         segments = [s for s in lines.segments if s.length >= 300.0]
-        seen = [segments[i] for i in rng.integers(0, len(segments), count)]
-        middle = np.array([((s.x1 + s.x2) / 2, (s.y1 + s.y2) / 2) for s in seen])
-        seen_angle = np.array([math.atan2(s.y2 - s.y1, s.x2 - s.x1) for s in seen])
+        seen = rng.integers(0, len(segments), count)  # each segment's middle and direction once, then the ones drawn
+        middle = np.array([((s.x1 + s.x2) / 2, (s.y1 + s.y2) / 2) for s in segments])[seen]
+        seen_angle = np.array([math.atan2(s.y2 - s.y1, s.x2 - s.x1) for s in segments])[seen]
         true = self.lines[rng.integers(0, len(self.lines), count)]
         along = rng.random(count)[:, None]
         point = true[:, :2] + along * (true[:, 2:] - true[:, :2])
@@ -109,9 +109,10 @@ class FieldModel:
         return np.column_stack([positions + rng.normal(0.0, 50.0, (count, 2)), np.remainder(headings + math.pi, math.tau) - math.pi])
 
     def _from_posts(self, rng: np.random.Generator, count: int, lines: LinePercept, posts: GoalPostPercept) -> np.ndarray:
-        seen = [posts.posts[i] for i in rng.integers(0, len(posts.posts), count)]
-        distance = np.array([math.hypot(p.x, p.y) for p in seen]) * rng.normal(1.0, 0.05, count)
-        bearing = np.array([math.atan2(p.y, p.x) for p in seen])
+        every = list(posts.posts)
+        seen = rng.integers(0, len(every), count)  # each post's distance and bearing once, then the ones drawn
+        distance = np.array([math.hypot(p.x, p.y) for p in every])[seen] * rng.normal(1.0, 0.05, count)
+        bearing = np.array([math.atan2(p.y, p.x) for p in every])[seen]
         true = self.posts[rng.integers(0, len(self.posts), count)]
         around = rng.uniform(-math.pi, math.pi, count)
         positions = true + distance[:, None] * np.column_stack([np.cos(around), np.sin(around)])

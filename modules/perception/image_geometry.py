@@ -124,24 +124,52 @@ def own_body_mask(projection: ImageProjection, shape: tuple[int, int]) -> np.nda
 
 
 def paint_own_body(projection: ImageProjection, mask: np.ndarray) -> None:
-    """Set the pixels of ``own_body_mask`` to 1 in ``mask`` (h x w uint8), among other things drawn there."""
-    for points in BODY_POINTS:
-        pixels, front = projection.to_image(points)
-        if front.sum() >= 3:  # the part of the box in front of the camera (a grid of points: boxes reach behind it)
-            cv2.fillConvexPoly(mask, cv2.convexHull(np.minimum(np.maximum(pixels[front], -1e4), 1e4).astype(np.int32)), 1)
+    """Set the pixels of ``own_body_mask`` to 1 in ``mask`` (h x w uint8), among other things drawn there. Every box's
+    points projected at once."""
+    pixels, front = projection.to_image(BODY_POINTS_ALL)
+    for box in BODY_SLICES:
+        box_front = front[box]
+        if np.count_nonzero(box_front) >= 3:  # the part of the box in front of the camera (a grid of points: boxes reach behind it)
+            cv2.fillConvexPoly(mask, cv2.convexHull(np.minimum(np.maximum(pixels[box][box_front], -1e4), 1e4).astype(np.int32)), 1)
 
 
 #: each box of ``BODY_BOXES`` as a grid of points, so that the part in front of a camera can be projected
 BODY_POINTS = [np.array(np.meshgrid(*(np.linspace(low, high, 6) for low, high in box))).reshape(3, -1).T for box in BODY_BOXES]
+#: ``BODY_POINTS`` in one array, and each box's part of it
+BODY_POINTS_ALL = np.concatenate(BODY_POINTS)
+BODY_SLICES = [slice(start, start + len(points)) for start, points in zip(np.cumsum([0, *map(len, BODY_POINTS)]).tolist(), BODY_POINTS)]
+
+
+#: the last projection worked out per camera, with what it was worked out from (``camera_views``)
+_PROJECTIONS: dict[str, tuple[tuple[object, ...], ImageProjection]] = {}
+
+
+def matrix_source(buffer: CameraMatrixBuffer, camera: str) -> tuple[object, ...]:
+    """Everything ``buffer.at(camera, t)`` reads: its count and the filled entries' times and ``camera``'s matrices."""
+    count = int(buffer.count)
+    rotation, translation = (buffer.top_rotation, buffer.top_translation) if camera == "top" else (buffer.bottom_rotation, buffer.bottom_translation)
+    return (count, *(np.asarray(values)[:count].tobytes() for values in (buffer.time_ns, rotation, translation)))
 
 
 def camera_views(top: CameraImage, bottom: CameraImage, buffer: CameraMatrixBuffer) -> Iterator[tuple[str, CameraImage, ImageProjection]]:
     """(camera, image, projection) for each camera whose image is there and whose matrix at the image's
-    time is known: what every detector that works on the ground loops over."""
+    time is known: what every detector that works on the ground loops over.
+
+    Six modules ask for the same frame's projections: each camera's is worked out once and kept with everything it
+    comes from (the image's size, fields of view and time, and the buffer's entries), and given again while those are
+    the same (the same projection: read-only, none of its users changes it)."""
     for camera, image in (("top", top), ("bottom", bottom)):
         pixels = np.asarray(image.image)
         if pixels.ndim != 3 or pixels.size == 0 or not projectable(image.horizontal_fov, image.vertical_fov):
             continue  # no image, or its field of view is not known
+        source = (pixels.shape[1], pixels.shape[0], image.horizontal_fov, image.vertical_fov, image.time_ns, *matrix_source(buffer, camera))
+        kept = _PROJECTIONS.get(camera)
+        if kept is not None and kept[0] == source:
+            yield camera, image, kept[1]
+            continue
         matrix = buffer.at(camera, image.time_ns)
         if matrix.valid and np.isfinite(matrix.rotation).all() and np.isfinite(matrix.translation).all():
-            yield camera, image, ImageProjection(matrix, pixels.shape[1], pixels.shape[0], image.horizontal_fov, image.vertical_fov)
+            projection = ImageProjection(matrix, pixels.shape[1], pixels.shape[0], image.horizontal_fov, image.vertical_fov)
+            projection.rotation.flags.writeable = projection.translation.flags.writeable = False
+            _PROJECTIONS[camera] = (source, projection)
+            yield camera, image, projection
