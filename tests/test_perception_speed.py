@@ -48,6 +48,7 @@ from tafel.modules.perception.spl_ball_detector import (
     LOOSER_TESTS,
     SPLBallDetector,
     Spot,
+    ball_ranges,
     carpet,
     carpet_light,
     carpet_sample,
@@ -1163,3 +1164,31 @@ def test_fresh_poses_from_lines_and_posts_are_those_drawn_one_by_one(seed: int, 
         a, b = np.random.default_rng(seed + 1), np.random.default_rng(seed + 1)
         np.testing.assert_array_equal(make(a, count, lines, seen), reference(b, count, percept))  # type: ignore[operator]
         assert a.random() == b.random()
+
+
+@settings(max_examples=200)
+@given(st.integers(0, 2**32 - 1), st.floats(-3.1, 3.1), st.floats(-1.5, 1.5), st.floats(-100.0, 600.0), st.floats(0.0, 200.0), st.booleans())
+def test_ground_points_with_one_division_are_the_masked_ones(seed: int, yaw: float, pitch: float, height: float, z: float, exact: bool) -> None:
+    """Pixels to the ground dividing only where the rays meet the plane: the points of the division by the masked rays
+    (0 for the others), to the last bit."""
+    rng = np.random.default_rng(seed)
+    c, s, cp, sp = math.cos(yaw), math.sin(yaw), math.cos(pitch), math.sin(pitch)
+    rotation = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]) @ np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    projection = ImageProjection(CameraMatrix(rotation, np.array([10.0, -5.0, height]), True), 640, 480, math.radians(56.3), math.radians(43.7))
+    xs, ys = rng.uniform(-50, 700, 40), rng.uniform(-50, 530, 40)
+    rays = projection.rays(xs, ys, exact)
+    hits = rays[:, 2] < -1e-6
+    scale = np.where(hits, (z - projection.translation[2]) / np.where(hits, rays[:, 2], -1.0), 0.0)
+    points, found = projection.to_ground(xs, ys, z, exact)
+    np.testing.assert_array_equal(found, hits)
+    np.testing.assert_array_equal(points, projection.translation[:2] + scale[:, None] * rays[:, :2])
+
+
+@settings(max_examples=200)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 40), st.floats(0.0, 5.0))
+def test_ball_ranges_are_the_norms_of_the_stacked_points(seed: int, count: int, scale: float) -> None:
+    """The camera's range to balls on the ground: ``np.linalg.norm`` of the stacked points' offsets, to the last bit."""
+    rng = np.random.default_rng(seed)
+    centres, eye = rng.normal(0.0, 10**scale, (count, 2)), rng.normal(0.0, 500.0, 3)
+    np.testing.assert_array_equal(ball_ranges(centres, eye),
+                                  np.linalg.norm(np.column_stack([centres, np.full(count, BALL_RADIUS)]) - eye, axis=1))

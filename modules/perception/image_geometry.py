@@ -78,8 +78,9 @@ class ImageProjection:
         """The points (N x 2, mm, robot frame) where the pixels' rays meet the plane at height ``z``, and
         which of them do (rays at or above the horizon do not). ``exact``: as for ``rays``."""
         rays = self.rays(xs, ys, exact)
-        hits = rays[:, 2] < -1e-6
-        scale = np.where(hits, (z - self.translation[2]) / np.where(hits, rays[:, 2], -1.0), 0.0)
+        down = rays[:, 2]
+        hits = down < -1e-6
+        scale = np.divide(z - self.translation[2], down, out=np.zeros(len(down)), where=hits)  # 0 where a ray misses the plane
         return self.translation[:2] + scale[:, None] * rays[:, :2], hits
 
     def to_image(self, points: np.ndarray, exact: bool = False) -> tuple[np.ndarray, np.ndarray]:

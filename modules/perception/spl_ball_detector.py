@@ -69,6 +69,14 @@ def carpet_light(hsv: np.ndarray, green: np.ndarray) -> CarpetLight:
     return CarpetLight(count, histogram_median(values), histogram_median(saturations))
 
 
+def ball_ranges(centres: np.ndarray, eye: np.ndarray) -> np.ndarray:
+    """mm from the camera at ``eye`` (x, y, z) to balls lying at ``centres`` (N x 2, their centres ``BALL_RADIUS`` up):
+    ``np.linalg.norm`` of the offsets (N x 3) along their rows, the same sums of squares in the same order, without
+    building the points."""
+    dx, dy, dz = centres[:, 0] - eye[0], centres[:, 1] - eye[1], BALL_RADIUS - eye[2]
+    return np.sqrt(dx * dx + dy * dy + dz * dz)
+
+
 def square_inside(spot: Spot, shape: tuple[int, ...]) -> bool:
     """Whether the classifier's square round ``spot`` (1.1 radii either side) lies within an image of ``shape``."""
     height, width = shape[:2]
@@ -503,8 +511,7 @@ class SPLBallDetector(Module):
             patched = self.dark_share(dark[first:last], xs, ys - first, reach) >= p.dark_spot_min
             xs, ys, radii = xs[patched], ys[patched], radii[patched]
         centres, hits = projection.to_ground(xs, ys, BALL_RADIUS)
-        points = np.column_stack([centres, np.full(len(xs), BALL_RADIUS)])
-        distance = np.linalg.norm(points - projection.translation, axis=1)
+        distance = ball_ranges(centres, projection.translation)
         expected = np.where(hits, projection.fx * BALL_RADIUS / np.maximum(distance, 1.0), 0.0)
         fits = hits & (radii >= p.size_low * expected) & (radii <= p.size_high * expected + 1.0)
         xs, ys, radii, expected = xs[fits], ys[fits], radii[fits], expected[fits]
@@ -543,7 +550,7 @@ class SPLBallDetector(Module):
             return []
         columns = np.linspace(0, width - 1, 9).astype(int)  # a ball on the edge would be too large for the band here?
         centres, hits = projection.to_ground(columns, np.minimum(boundary[columns], height - 1), BALL_RADIUS)
-        ranges = np.linalg.norm(np.column_stack([centres, np.full(len(columns), BALL_RADIUS)]) - projection.translation, axis=1)
+        ranges = ball_ranges(centres, projection.translation)
         if not (hits & (projection.fx * BALL_RADIUS / np.maximum(ranges, 1.0) <= p.edge_max_radius)).any():
             return []  # the bottom camera, or the top one looking down: the edge is near, its balls stand out on the green
         top = max(0, int(boundary.min()) - p.edge_above)
@@ -573,8 +580,7 @@ class SPLBallDetector(Module):
         patched = self.dark_share(black, xs, ys, np.maximum(radii, 1.0)) >= p.dark_spot_min  # the cheaper test first
         xs, ys, radii = xs[patched], ys[patched], radii[patched]
         centres, hits = projection.to_ground(xs + left, ys + top, BALL_RADIUS)
-        points = np.column_stack([centres, np.full(len(xs), BALL_RADIUS)])
-        distance = np.linalg.norm(points - projection.translation, axis=1)
+        distance = ball_ranges(centres, projection.translation)
         expected = np.where(hits, projection.fx * BALL_RADIUS / np.maximum(distance, 1.0), 0.0)
         fits = hits & (expected <= p.edge_max_radius) & (radii >= p.size_low * expected) & (radii <= p.size_high * expected + 1.0)
         if not fits.any():
