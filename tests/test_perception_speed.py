@@ -20,6 +20,7 @@ from hypothesis import strategies as st
 
 from tafel.core.framework.manager import make_module
 from tafel.modules.modeling.field_model import FIELD_MODEL
+from tafel.modules.perception import spl_ball_detector
 from tafel.modules.perception.field_boundary_detector import cell_shares, chain, lower_hull
 from tafel.modules.perception.goal_post_detector import (
     GoalPostDetector,
@@ -382,6 +383,12 @@ def test_spl_candidates_are_the_loops(painted: tuple[np.ndarray, np.ndarray, np.
     for rows in (boundary, np.zeros(0, np.float32)):
         spots = self.spots(strict, rows, projection, dark)
         same_spots(spots, reference_spots(self, strict, rows, projection, old_dark))
+        few = spl_ball_detector.FEW_PEAKS
+        try:  # the greedy choice over many peaks (numpy's) as over few (a Python loop)
+            spl_ball_detector.FEW_PEAKS = -1
+            same_spots(self.spots(strict, rows, projection, dark), spots)
+        finally:
+            spl_ball_detector.FEW_PEAKS = few
     for spot in spots:
         for beside in (False, True):
             assert self.check(hsv, green, spot, white, beside) == reference_check(self, hsv, green, spot, white, beside)

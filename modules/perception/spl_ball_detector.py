@@ -39,6 +39,10 @@ from tafel.representations.perception import (
 #: moved twice by up to a radius (9 px), then its disc (9 px); beyond them, the band's pixels change nothing
 EDGE_REACH = 30
 
+#: candidates after ``SPLBallDetector.spots``' tests up to which the greedy choice among them runs as a Python loop
+#: (a frame mostly leaves a few dozen; beyond, numpy's calls on arrays cost less than the loop)
+FEW_PEAKS = 64
+
 #: the tests of ``SPLBallDetector.verdict`` whose thresholds the second look loosens: a spot that failed another one
 #: (too few pixels, under a post, too much green round it) fails it again with the looser thresholds
 LOOSER_TESTS = ("saturation", "dark", "black")
@@ -403,13 +407,15 @@ class SPLBallDetector(Module):
         return (integral[y1, x1] - integral[y0, x1] - integral[y1, x0] + integral[y0, x0]) / area
 
     @staticmethod
-    def inside_image(spot: Spot, solid: np.ndarray) -> Spot:
+    def inside_image(spot: Spot, solid: np.ndarray, negated: bool = False) -> Spot:
         """A spot at the image's edge moved to where the ball's centre is: the peak of a ball cut by the
-        edge lies on the edge, and the ball's far side is one expected radius from its centre."""
+        edge lies on the edge, and the ball's far side is one expected radius from its centre. ``negated``:
+        ``solid`` is the green mask, whose negation is the solid (only the row and column read are negated)."""
         height, width = solid.shape
         x, y, e = int(spot.x), int(spot.y), spot.expected
         if x < e or x > width - 1 - e:
             row = solid[min(max(y, 0), height - 1)]
+            row = ~row if negated else row
             step = 1 if x < e else -1
             far = x
             while 0 <= far + step < width and row[far + step]:
@@ -417,6 +423,7 @@ class SPLBallDetector(Module):
             spot.x = float(far - step * e)
         if y > height - 1 - e:  # a close ball cut by the image's bottom edge (its top is always in view)
             column = solid[:, min(max(int(spot.x), 0), width - 1)]
+            column = ~column if negated else column
             far = min(y, height - 1)
             while far - 1 >= 0 and column[far - 1]:
                 far -= 1
@@ -518,7 +525,38 @@ class SPLBallDetector(Module):
         # the spots most like a ball's size first: lines are thinner, robots and the border thicker
         order = np.argsort(np.abs(np.log(np.maximum(radii, 0.5) / np.maximum(expected, 0.5))))
         xs, ys, radii, expected = xs[order], ys[order], radii[order], expected[order]
-        # greedily, each spot taken keeps the ones after it that are too close to it out (all at once)
+        # greedily, each spot taken keeps the ones after it that are too close to it out
+        if len(xs) > FEW_PEAKS:
+            return self.chosen_spots(green, xs, ys, radii, expected)
+        # the few peaks a frame mostly leaves as Python numbers: a loop over them is cheaper than numpy's calls on
+        # arrays of a few elements (the same arithmetic: x * x is numpy's square of the offsets)
+        xl, yl, rl, el = xs.tolist(), ys.tolist(), radii.tolist(), expected.tolist()
+        free = [True] * len(xl)
+        chosen: list[Spot] = []
+        for i in range(len(xl)):
+            if len(chosen) >= p.max_spots:
+                break
+            if not free[i]:
+                continue
+            r, e = rl[i], el[i]
+            spot = Spot(float(xl[i]), float(yl[i]), max(r, 0.5 * (r + e)), e)
+            if spot.x < e or spot.x > width - 1 - e or spot.y > height - 1 - e:
+                spot = self.inside_image(spot, green, negated=True)  # moved: it may now be a spot chosen already
+                if any((spot.x - s.x) ** 2 + (spot.y - s.y) ** 2 <= (s.expected * 1.5) ** 2 for s in chosen):
+                    continue
+            chosen.append(spot)
+            x, y, reach = spot.x, spot.y, (spot.expected * 1.5) ** 2
+            for j in range(i + 1, len(xl)):
+                if free[j]:
+                    dx, dy = xl[j] - x, yl[j] - y
+                    free[j] = dx * dx + dy * dy > reach
+        return chosen
+
+    def chosen_spots(self, green: np.ndarray, xs: np.ndarray, ys: np.ndarray, radii: np.ndarray, expected: np.ndarray) -> list[Spot]:
+        """``spots``' greedy choice over many peaks (each spot taken keeps the ones after it that are too close to it
+        out, all at once)."""
+        p = self.parameters
+        height, width = green.shape
         free = np.ones(len(xs), bool)
         chosen: list[Spot] = []
         start = 0
@@ -530,7 +568,7 @@ class SPLBallDetector(Module):
             start += 1
             spot = Spot(float(x), float(y), float(max(r, 0.5 * (r + e))), float(e))
             if spot.x < e or spot.x > width - 1 - e or spot.y > height - 1 - e:
-                spot = self.inside_image(spot, ~green)  # moved: it may now be a spot chosen already
+                spot = self.inside_image(spot, green, negated=True)  # moved: it may now be a spot chosen already
                 if any((spot.x - s.x) ** 2 + (spot.y - s.y) ** 2 <= (s.expected * 1.5) ** 2 for s in chosen):
                     continue
             chosen.append(spot)
