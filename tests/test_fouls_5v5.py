@@ -11,8 +11,8 @@ from tafel.modules.behavior.soccer_behavior import SoccerBehavior, placed_ball
 from tafel.representations import field as pitch
 from tafel.representations.game import GameState, RobotInfo, SetPlay, State, TeamInfo
 from tafel.representations.modeling import BallModel, RobotPose
-from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType
-from tafel.representations.obstacles import Obstacles
+from tafel.representations.motion_control import MotionInfo, MotionRequest, MotionType, WalkKick
+from tafel.representations.obstacles import Obstacle, Obstacles
 from tafel.representations.team import PlayerRole, Role, TeamMates
 
 
@@ -61,3 +61,26 @@ def test_a_ball_seen_since_the_set_play_began_is_where_it_is() -> None:
     assert placed_ball(SetPlay.corner_kick, (-4600.0, 900.0)) == [(-4500.0, 3000.0)]
     assert placed_ball(SetPlay.kick_in, (1200.0, -3100.0)) == [(1200.0, -3000.0)]
     assert FREE_KICK_DISTANCE == 750.0
+
+
+def test_no_keyframe_kick_while_a_robot_stands_close_behind_the_kicker() -> None:
+    """5v5 seed 1 (2218338): a keyframe kick started with an opponent 340 mm behind-right of the kicker, out of its view;
+    the kick's sway over the standing foot walked into it (pushing). ``keep_from_pushing`` holds back walks only. Now
+    a robot within ``kick_clearance`` beside or behind the kicker allows only the walk kick, which leads away from it;
+    ahead of the kicker (the ball between) or farther it does not matter."""
+    pose = RobotPose(valid=True, x=1000.0, y=0.0, rotation=0.0)
+
+    def request(*robots: tuple[float, float]) -> MotionRequest:
+        obstacles = Obstacles(obstacles=[Obstacle(x, y) for x, y in robots])
+        harness = ModuleHarness(SoccerBehavior, playing(), PlayerRole(role=Role.striker), pose,
+                                BallModel(valid=True, seen=True, x=190.0, y=50.0), TeamMates(), MotionInfo(), obstacles)
+        return harness.execute(3)[MotionRequest]
+
+    assert request().motion is MotionType.kick  # alone: the keyframe kick, as before
+    assert request((700.0, 0.0)).motion is MotionType.kick  # ahead, beyond the ball
+    assert request((-300.0, -600.0)).motion is MotionType.kick  # behind, but beyond kick_clearance
+    for rx, ry in ((-240.0, -240.0), (0.0, 360.0), (-440.0, 0.0)):  # behind-right (the match's), beside, behind
+        out = request((rx, ry))
+        assert out.motion is MotionType.walk_to, (rx, ry)
+        assert out.target_x * rx + out.target_y * ry <= 0.0, (rx, ry)  # the walk leads away from it (or past it)
+    assert request((-440.0, 0.0)).walk_kick is not WalkKick.none  # beyond push_distance: the walk kick, a step forward

@@ -4,7 +4,9 @@ With ``walk_kick`` (``Striker``'s default) the kick comes out of the walk: the r
 ``walk_kick_distance`` ahead of the kicking foot along the kick direction, turned only as far as the
 walk kick cannot turn the ball itself (``walk_kick_max_angle`` either side), and asks for the kick while
 it walks; the kicking foot is the one on the side the ball goes (the foot swings outwards, never across
-the other), or for a straight kick the one on the ball's side. Without it: the keyframe kick, standing.
+the other), or for a straight kick the one on the ball's side. Without it: the keyframe kick, standing, unless
+a robot stands near beside or behind the kicker (``kick_clearance``): the keyframe kick shifts the torso over the
+standing foot, into a robot it does not see (5v5: pushing); then the walk kick, which leads away from it.
 
 Shared by the behaviours that kick (``Striker``, ``SoccerBehavior``); not a module.
 """
@@ -21,6 +23,7 @@ from tafel.representations import field
 from tafel.representations.geometry import Pose2D
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.motion_control import Foot, MotionRequest, MotionType, Odometry, WalkKick
+from tafel.representations.obstacles import Obstacles
 
 
 @dataclass
@@ -56,6 +59,12 @@ class KickParameters:
     ball's centre than this walks round the ball (straight on, it would push the ball back, towards its own goal)"""
     round_ball_beside: float = bounded(150.0, 800.0, 300.0)
     """mm beside the ball's centre the way round the ball leads"""
+    kick_clearance: float = bounded(0.0, 1000.0, 450.0)
+    """mm from the robot's centre within which a robot beside or behind (beyond ``kick_ahead``) allows no keyframe
+    kick, only the walk kick: the keyframe kick shifts the torso over the standing foot, and the referee calls
+    contact at 330 mm (5v5: an opponent 340 mm behind the kicker, unseen, was pushed)"""
+    kick_ahead: float = bounded(0.0, 3.2, 0.6)
+    """rad either side of the heading within which a robot is ahead of the kicker, the ball between (no push)"""
 
 
 #: the kick's parameters tried live: modify values Kick:NAME, declared by the modules that kick
@@ -76,17 +85,27 @@ def goal_direction(ball: BallModel, pose: RobotPose, odometry: Odometry) -> floa
     return math.atan2(goal_y - ball.y, goal_x - ball.x)
 
 
+def crowded(obstacles: Obstacles | None, p: KickParameters) -> bool:
+    """Whether a robot (a teammate too: its place is only what it said, and an opponent near it may be taken for
+    it) stands within ``kick_clearance`` mm of the robot's centre beside or behind it (beyond ``kick_ahead`` of
+    the heading), where a keyframe kick's sway would walk into it."""
+    if obstacles is None:
+        return False
+    return any(math.hypot(o.x, o.y) < p.kick_clearance and abs(math.atan2(o.y, o.x)) > p.kick_ahead for o in obstacles.obstacles)
+
+
 def approach_and_kick(ball: BallModel, kick_direction: float, p: KickParameters, out: MotionRequest,
-                      strength: WalkKick = WalkKick.long) -> tuple[float, float, float]:
+                      strength: WalkKick = WalkKick.long, obstacles: Obstacles | None = None) -> tuple[float, float, float]:
     """Fill ``out``: kick towards ``kick_direction`` (rad, robot frame) when the ball lies right in front
     of the kicking foot, else walk to the point ``behind`` mm behind the ball on the kick's line, the
     kicking foot in line with the ball. Returns that point and direction (mm, mm, rad; robot frame).
-    With ``p.walk_kick``: the walk kick of ``strength`` (``walk_kick_approach``).
+    With ``p.walk_kick``, or while a robot of ``obstacles`` stands near beside or behind (``crowded``): the walk
+    kick of ``strength`` (``walk_kick_approach``).
 
     The caller passes ``p`` with its modify values ``Kick:NAME`` applied (``kick_tuning``), so a value pinned
     by a debug client is tried live."""
     out.walk_kick = WalkKick.none
-    if p.walk_kick:
+    if p.walk_kick or crowded(obstacles, p):
         return walk_kick_approach(ball, kick_direction, p, out, strength)
     foot = Foot.left if ball.y >= 0 else Foot.right
     side = p.foot_offset if foot is Foot.left else -p.foot_offset
