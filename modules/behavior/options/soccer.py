@@ -141,7 +141,7 @@ class Striker(Option["SoccerBehavior"]):
         backwards to a spot behind it (``BACKWARDS``): it faces that way too."""
         ball, p, out = b.ball_model, b.parameters, b.motion_request
         direction, kick, strength = b.kick_plan()  # a shot, or a pass by the pass rule (``passing.py``)
-        approach_and_kick(ball, direction, kick, out, strength)
+        approach_and_kick(ball, direction, kick, out, strength, b.obstacles)  # no keyframe kick with a robot close behind
         if out.motion is MotionType.walk_to and math.hypot(ball.x, ball.y) > p.near_ball:  # near it a duel is no push
             x, y, detoured = b.avoid(out.target_x, out.target_y)
             if detoured or math.hypot(x, y) > p.face_the_way:
