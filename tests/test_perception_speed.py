@@ -20,6 +20,7 @@ from hypothesis import strategies as st
 
 from tafel.core.framework.manager import make_module
 from tafel.modules.modeling.field_model import FIELD_MODEL
+from tafel.modules.modeling.self_locator import robust, seen_from
 from tafel.modules.perception import spl_ball_detector
 from tafel.modules.perception.field_boundary_detector import cell_shares, chain, lower_hull
 from tafel.modules.perception.goal_post_detector import (
@@ -1199,3 +1200,40 @@ def test_ball_ranges_are_the_norms_of_the_stacked_points(seed: int, count: int, 
     centres, eye = rng.normal(0.0, 10**scale, (count, 2)), rng.normal(0.0, 500.0, 3)
     np.testing.assert_array_equal(ball_ranges(centres, eye),
                                   np.linalg.norm(np.column_stack([centres, np.full(count, BALL_RADIUS)]) - eye, axis=1))
+
+
+def reference_line_distance(points: np.ndarray) -> np.ndarray:
+    """``FieldModel.line_distance`` before issue 34: range tests, clips and a choice over the map."""
+    column = np.round((points[..., 0] + FIELD_MODEL.half_x) / 20.0).astype(int)
+    row = np.round((points[..., 1] + FIELD_MODEL.half_y) / 20.0).astype(int)
+    rows, columns = FIELD_MODEL.distance.shape
+    inside = (column >= 0) & (column < columns) & (row >= 0) & (row < rows)
+    return np.where(inside, FIELD_MODEL.distance[np.clip(row, 0, rows - 1), np.clip(column, 0, columns - 1)], 2000.0)
+
+
+@settings(max_examples=200)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 500), st.integers(1, 60), st.floats(0.5, 4.0), st.booleans())
+def test_line_distances_seen_from_every_particle_are_the_stacked_ones(seed: int, count: int, points: int, spread: float,
+                                                                      broken: bool) -> None:
+    """The particle filter's line distances worked out in place from the poses and points: the distances of the stacked
+    field positions (``seen_from``), to the last bit, also off the map and for positions that are not finite."""
+    rng = np.random.default_rng(seed)
+    poses = np.column_stack([rng.normal(0.0, 10**spread, count), rng.normal(0.0, 10**spread, count), rng.uniform(-7.0, 7.0, count)])
+    seen = rng.normal(0.0, 10**spread, (points, 2))
+    if broken:  # a NaN pose and an infinite point
+        poses[rng.integers(count), rng.integers(3)] = np.nan
+        seen[rng.integers(points), rng.integers(2)] = np.inf
+    with np.errstate(invalid="ignore"):
+        expected = reference_line_distance(seen_from(poses, seen))
+    got = FIELD_MODEL.line_distance_seen(poses, seen)
+    assert got.dtype == expected.dtype
+    np.testing.assert_array_equal(got, expected)
+
+
+@given(st.lists(st.floats(allow_nan=True, allow_infinity=True), max_size=30), st.booleans())
+def test_robust_log_likelihoods_in_place_are_the_formulas(values: list[float], scalar: bool) -> None:
+    """``robust`` in place: -0.5 * min(x, 2.5) ** 2, to the last bit, for arrays and for a number."""
+    if scalar and values:
+        assert np.array_equal(robust(values[0]), -0.5 * np.minimum(values[0], 2.5) ** 2, equal_nan=True)
+    array = np.array(values, float)
+    np.testing.assert_array_equal(robust(array), -0.5 * np.minimum(array, 2.5) ** 2)

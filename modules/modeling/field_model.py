@@ -26,6 +26,10 @@ class FieldModel:
         for x1, y1, x2, y2 in field.all_markings():
             cv2.line(painted, self.cell(x1, y1), self.cell(x2, y2), 0, 1)
         self.distance = cv2.distanceTransform(painted, cv2.DIST_L2, 5) * CELL
+        # the map with a border of FAR round it, flat: ``line_distance_seen`` clamps cells off the map onto the border
+        bordered = np.full((height + 2, width + 2), FAR, self.distance.dtype)
+        bordered[1:-1, 1:-1] = self.distance
+        self._bordered = bordered.ravel()
         self.posts = np.array(field.goal_post_positions())
         self.lines = np.array(field.line_segments())
 
@@ -39,6 +43,37 @@ class FieldModel:
         rows, columns = self.distance.shape
         inside = (column >= 0) & (column < columns) & (row >= 0) & (row < rows)
         return np.where(inside, self.distance[np.clip(row, 0, rows - 1), np.clip(column, 0, columns - 1)], FAR)
+
+    def line_distance_seen(self, poses: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """``line_distance`` of robot-frame ``points`` (M x 2, mm) as seen from each of the field ``poses`` (N x 3: mm,
+        mm, rad): N x M mm, the same values to the last bit. The field positions' x and y are worked out apart (no
+        N x M x 2 stack), in place, and each cell off the map (or not finite) is clamped onto the map's border of
+        ``FAR``: one gather instead of the range tests, clips and choice (the particle filter's largest arrays)."""
+        x, y, heading = poses[:, 0:1], poses[:, 1:2], poses[:, 2:3]
+        c, s = np.cos(heading), np.sin(heading)
+        px, py = points[:, 0], points[:, 1]
+        rows, columns = self.distance.shape
+        fx = x + c * px  # seen_from's x + c * px - s * py and y + s * px + c * py, in its order
+        fx -= s * py
+        fy = y + s * px
+        fy += c * py
+        # with sane inputs (finite, far below overflow) no position is NaN, and clipping keeps it; else NaN goes
+        # to -1 (off the map, as its integer was) by the slower fmax
+        sane = bool(np.abs(poses).max(initial=0.0) < 1e200) and bool(np.abs(points).max(initial=0.0) < 1e200)
+        for value, half, last in ((fx, self.half_x, columns), (fy, self.half_y, rows)):
+            value += half
+            value /= CELL
+            np.rint(value, out=value)  # np.round's for no decimals
+            if sane:
+                np.clip(value, -1.0, float(last), out=value)
+            else:
+                np.fmin(np.fmax(value, -1.0, out=value), float(last), out=value)
+        row = fy.astype(np.intp)
+        row += 1
+        row *= columns + 2
+        row += fx.astype(np.intp)
+        row += 1
+        return self._bordered.take(row)
 
     def post_distance(self, points: np.ndarray) -> np.ndarray:
         """mm from each field point (N x 2) to the nearest goal post."""

@@ -259,7 +259,7 @@ class SelfLocator(Module):
             if len(points) > p.max_points:
                 points = points[np.linspace(0, len(points) - 1, p.max_points).astype(int)]
             std = self.point_std(points)
-            distance = FIELD_MODEL.line_distance(self.to_field(points))
+            distance = FIELD_MODEL.line_distance_seen(self.particles, points)  # line_distance(self.to_field(points))'s
             log_weight += p.point_weight * robust(distance / std).sum(axis=1)
             measurements += p.point_weight * len(points)
         posts = [(post.x, post.y) for post in self.goal_post_percept.posts if math.isfinite(post.x) and math.isfinite(post.y)]
@@ -496,7 +496,12 @@ def moved(pose: np.ndarray, forward: float, left: float, turn: float) -> np.ndar
 def robust(normalized: np.ndarray) -> np.ndarray:
     """Log-likelihood of normalized errors, Gaussian near zero and flat beyond 2.5 standard deviations,
     so that one wrong percept cannot wipe out the right particles."""
-    return -0.5 * np.minimum(normalized, 2.5) ** 2
+    log = np.minimum(normalized, 2.5)  # -0.5 * min(...) ** 2, in place for arrays: the particles' largest
+    if not isinstance(log, np.ndarray):
+        return -0.5 * log**2
+    np.square(log, out=log)
+    log *= -0.5
+    return log
 
 
 def low_variance_indices(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
