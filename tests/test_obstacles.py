@@ -141,3 +141,22 @@ def test_each_place_said_is_one_robot_seen_the_nearest_and_a_robot_beside_it_sta
     # two teammates near one seen robot: it is only one of them
     assert same_robots([(0.0, 0.0), (100.0, 0.0)], [(60.0, 0.0)], 400.0) == {0}
     assert same_robots([(0.0, 0.0)], [(400.0, 0.0)], 400.0) == set()  # not nearer than within
+
+
+def test_a_teammate_said_to_be_out_of_view_is_never_a_robot_seen_in_view() -> None:
+    """5v5 (issue 32): a teammate 300 mm behind the robot, where it sees nothing, and an opponent beside it, seen, within
+    ``same_robot`` of the teammate's place: the opponent was taken for the teammate, and no walk was kept from it. Now
+    it stays a robot; a robot remembered out of view near the teammate's place is still the teammate."""
+    mates = TeamMates(mates=[mate(2, -250.0, 200.0)])  # behind-left, beyond view_angle (100 degrees)
+    harness = ModuleHarness(ObstacleModeler, RobotPose(valid=True), mates, RobotsPercept(robots=[SeenRobot(0.0, 420.0)]))
+    found = harness.execute()[Obstacles].obstacles
+    assert sorted(o.kind.name for o in found) == ["robot", "teammate"]
+    # the same teammate said to be in view (ahead-left) is the robot seen there: counted once
+    harness = ModuleHarness(ObstacleModeler, RobotPose(valid=True), TeamMates(mates=[mate(2, 250.0, 200.0)]),
+                            RobotsPercept(robots=[SeenRobot(100.0, 420.0)]))
+    assert [o.kind for o in harness.execute()[Obstacles].obstacles] == [ObstacleKind.teammate]
+    # a robot seen ahead, then turned away from (remembered behind): the teammate said to be there is that robot
+    harness = ModuleHarness(ObstacleModeler, RobotPose(valid=True), TeamMates(), RobotsPercept(robots=[SeenRobot(300.0, 0.0)]))
+    harness.execute()
+    harness.set(RobotPose(valid=True, rotation=math.pi), RobotsPercept(robots=[]), TeamMates(mates=[mate(2, 350.0, 0.0)]))
+    assert [o.kind for o in harness.execute()[Obstacles].obstacles] == [ObstacleKind.teammate]

@@ -18,6 +18,11 @@ from tafel.representations.team import TeamMates
 GOAL_POSTS = [(sx * LENGTH / 2, sy * (GOAL_INNER_WIDTH + GOAL_POST_DIAMETER) / 2) for sx in (-1, 1) for sy in (-1, 1)]
 
 
+def bearing(x: float, y: float) -> float:
+    """rad from the heading to (x, y) (robot frame mm)."""
+    return math.atan2(y, x)
+
+
 @requires(FrameInfo)
 @uses(RobotsPercept, SonarPercept, TeamMates, RobotPose, Odometry)
 @provides(Obstacles)
@@ -30,7 +35,8 @@ class ObstacleModeler(Module):
     where it is within ``mate_timeout`` s and is not penalized (a penalized robot is off the field).
     A teammate's radius grows with the age of its message (``mate_spread`` mm/s: it may have walked
     meanwhile); the seen robot nearest a teammate, if within ``same_robot`` mm, is that teammate (another one
-    beside it, say an opponent in a duel with it, stays a robot), and one seen
+    beside it, say an opponent in a duel with it, stays a robot; a teammate said to be beyond ``view_angle`` is
+    only a robot remembered there, never one seen this frame), and one seen
     again within two robot radii of where it was remembered replaces that memory. Something seen within
     ``post_radius`` mm of a goal post (where the pose puts them) is that post, not a robot. While the
     pose is not valid, seen robots are remembered as long where ``Odometry`` puts them (no teammates then)."""
@@ -84,7 +90,7 @@ class ObstacleModeler(Module):
             for mate in mates:
                 x, y = pose.to_robot(mate.message.x, mate.message.y)
                 obstacles.append(Obstacle(x, y, ROBOT_RADIUS + p.mate_spread * mate.age, ObstacleKind.teammate, mate.age))
-            claimed = same_robots([(m.message.x, m.message.y) for m in mates], [(fx, fy) for fx, fy, _ in self.seen], p.same_robot)
+            claimed = self.claimed([(m.message.x, m.message.y) for m in mates], now)
             for k, (fx, fy, when) in enumerate(self.seen):
                 if k in claimed:
                     continue
@@ -105,6 +111,19 @@ class ObstacleModeler(Module):
         obstacles = sorted((o for o in obstacles if math.hypot(o.x, o.y) <= p.max_distance), key=lambda o: math.hypot(o.x, o.y))
         out.obstacles = obstacles
         out.clearance = max(0.0, min((math.hypot(o.x, o.y) - o.radius for o in obstacles), default=0.0))
+
+    def claimed(self, places: list[tuple[float, float]], now: float) -> set[int]:
+        """Which of ``self.seen`` are the teammates said to be at ``places`` (field mm; ``same_robots``). A teammate
+        said to be beyond ``view_angle`` (where this robot sees nothing) may be a robot remembered there, never one
+        seen this frame: that one is in view, and the teammate is not (5v5: an opponent seen beside the robot,
+        within ``same_robot`` of a teammate behind it, was taken for the teammate and not kept from)."""
+        p, pose = self.parameters, self.robot_pose
+        seen = [(fx, fy) for fx, fy, _ in self.seen]
+        in_view = [place for place in places if abs(bearing(*pose.to_robot(*place))) <= p.view_angle]
+        claimed = same_robots(in_view, seen, p.same_robot)
+        remembered = [k for k, (_, _, when) in enumerate(self.seen) if when < now and k not in claimed]
+        beyond = [place for place in places if place not in in_view]
+        return claimed | {remembered[j] for j in same_robots(beyond, [seen[k] for k in remembered], p.same_robot)}
 
     def memory(self, x: float, y: float) -> float:
         """s a robot remembered at (x, y) (robot frame mm) is kept: longer beyond ``view_angle``, where it is not looked for."""
