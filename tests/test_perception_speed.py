@@ -1237,3 +1237,68 @@ def test_robust_log_likelihoods_in_place_are_the_formulas(values: list[float], s
         assert np.array_equal(robust(values[0]), -0.5 * np.minimum(values[0], 2.5) ** 2, equal_nan=True)
     array = np.array(values, float)
     np.testing.assert_array_equal(robust(array), -0.5 * np.minimum(array, 2.5) ** 2)
+
+
+def reference_verdict(self: SPLBallDetector, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, beside_post: bool = False,
+                      parameters: SPLBallDetector.Parameters | None = None) -> tuple[float, bool, str]:
+    """``SPLBallDetector.verdict`` before its dark pixels were counted from the histogram: the own pixels gathered,
+    compared and averaged."""
+    p = parameters or self.parameters
+    height, width = green.shape
+    r = spot.radius
+    reach = int(math.ceil(r * 1.7)) + 1
+    x0, x1 = max(0, int(spot.x) - reach), min(width, int(spot.x) + reach + 1)
+    y0, y1 = max(0, int(spot.y) - reach), min(height, int(spot.y) + reach + 1)
+    d = np.hypot(np.arange(x0, x1)[None, :] - spot.x, np.arange(y0, y1)[:, None] - spot.y)
+    inside, around = d <= 0.9 * r, (d >= 1.2 * r) & (d <= 1.7 * r)
+    n_inside, n_around = np.count_nonzero(inside), np.count_nonzero(around)
+    if n_inside < 3 or n_around < 3:
+        return 0.0, False, "size"
+    patch_green, patch = green[y0:y1, x0:x1], hsv[y0:y1, x0:x1]
+    solid = inside & ~patch_green
+    if np.count_nonzero(solid) < 3:
+        return 0.0, False, "size"
+    if not beside_post and self.under_post(hsv, green, spot, white):
+        return 0.0, True, "post"
+    green_inside = np.count_nonzero(patch_green & inside) / n_inside
+    green_around = np.count_nonzero(patch_green & around) / n_around
+    if green_inside > p.green_inside_max or green_around < p.green_around_min:
+        return 0.0, False, "green"
+    saturation = float(patch[..., 1][inside].mean())
+    if saturation > p.saturation_max:
+        return 0.0, False, "saturation"
+    own = patch[..., 2][solid]
+    bright = byte_percentile(own, 90)
+    value = own.astype(float)
+    is_dark = value < p.dark_ratio * bright
+    dark = np.count_nonzero(is_dark) / len(value)
+    if not p.dark_share_min <= dark <= p.dark_share_max:
+        return 0.0, False, "dark"
+    carpet = patch[..., 2][around & patch_green]
+    field_value = byte_median(carpet if carpet.size >= 3 else patch[..., 2][around])
+    black = value[is_dark]
+    darkest = float(black.mean()) if black.size else math.inf
+    if darkest > p.black_contrast * field_value:
+        return 0.0, False, "black"
+    return float(min(1.0, 0.5 + dark + 0.3 * green_around - green_inside)), False, ""
+
+
+@settings(max_examples=200)
+@given(scenes, st.data())
+def test_spl_verdicts_from_the_histogram_are_the_gathered_pixels(painted: tuple[np.ndarray, np.ndarray, np.ndarray, float],
+                                                                 data: st.DataObject) -> None:
+    """The checks' verdict (score, under a post, the test failed) with the dark pixels counted and summed from the own
+    pixels' histogram: the verdict of the gathered pixels, to the last bit, for spots anywhere, with the module's
+    thresholds, the second look's, and thresholds drawn (every test's branch)."""
+    hsv, green, _, white = painted
+    height, width = green.shape
+    self = detector()
+    drawn = SPLBallDetector.Parameters(dark_ratio=data.draw(st.floats(0.0, 1.5)), dark_share_min=data.draw(st.floats(0.0, 0.5)),
+                                       dark_share_max=data.draw(st.floats(0.3, 1.0)), black_contrast=data.draw(st.floats(0.0, 2.0)),
+                                       green_inside_max=1.0, green_around_min=0.0, saturation_max=255.0)
+    for _ in range(5):
+        x, y = data.draw(st.floats(-3.0, width + 2.0)), data.draw(st.floats(-3.0, height + 2.0))
+        spot = Spot(x, y, data.draw(st.floats(0.5, 25.0)), data.draw(st.floats(0.5, 25.0)))
+        for parameters in (None, self.looser(), drawn):
+            for beside in (False, True):
+                assert self.verdict(hsv, green, spot, white, beside, parameters) == reference_verdict(self, hsv, green, spot, white, beside, parameters)

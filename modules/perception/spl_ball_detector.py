@@ -15,10 +15,10 @@ from tafel.modules.perception.image_geometry import ImageProjection, camera_view
 from tafel.modules.perception.pixel_statistics import (
     below,
     byte_median,
-    byte_percentile,
     channel_histogram,
     every,
     histogram_median,
+    histogram_percentile,
     white_pixels,
 )
 from tafel.representations.field import BALL_RADIUS
@@ -42,6 +42,8 @@ EDGE_REACH = 30
 #: candidates after ``SPLBallDetector.spots``' tests up to which the greedy choice among them runs as a Python loop
 #: (a frame mostly leaves a few dozen; beyond, numpy's calls on arrays cost less than the loop)
 FEW_PEAKS = 64
+#: every byte's value (int64), to sum bytes from their histogram
+BYTE_VALUES = np.arange(256, dtype=np.int64)
 
 #: the tests of ``SPLBallDetector.verdict`` whose thresholds the second look loosens: a spot that failed another one
 #: (too few pixels, under a post, too much green round it) fails it again with the looser thresholds
@@ -701,30 +703,32 @@ class SPLBallDetector(Module):
         if n_inside < 3 or n_around < 3:
             return 0.0, False, "size"
         patch_green, patch = green[y0:y1, x0:x1], hsv[y0:y1, x0:x1]
-        solid = inside & ~patch_green  # the ball's own pixels: green ones would count as dark next to white
-        if np.count_nonzero(solid) < 3:
+        solid = np.greater(inside, patch_green)  # inside & ~patch_green: the ball's own pixels (green ones would count as dark)
+        n_solid = np.count_nonzero(solid)
+        if n_solid < 3:
             return 0.0, False, "size"
         if not beside_post and self.under_post(hsv, green, spot, white):
             return 0.0, True, "post"
         # the tests one by one, the cheapest first: most spots fail one of the first
-        green_inside = np.count_nonzero(patch_green & inside) / n_inside
+        green_inside = (n_inside - n_solid) / n_inside  # the inside's green pixels are those not solid
         green_around = np.count_nonzero(patch_green & around) / n_around
         if green_inside > p.green_inside_max or green_around < p.green_around_min:
             return 0.0, False, "green"
-        saturation = float(patch[..., 1][inside].mean())
+        saturation = int(np.add.reduce(patch[..., 1][inside], dtype=np.int64)) / n_inside  # the mean: an exact sum, divided
         if saturation > p.saturation_max:
             return 0.0, False, "saturation"
-        own = patch[..., 2][solid]
-        bright = byte_percentile(own, 90)  # np.percentile's, from the bytes' histogram
-        value = own.astype(float)
-        is_dark = value < p.dark_ratio * bright
-        dark = np.count_nonzero(is_dark) / len(value)
+        # the own pixels' values by their histogram: the 90th percentile (np.percentile's), and the dark ones (below
+        # dark_ratio of it: the bytes below its ceiling) counted and summed from it, not gathered
+        counts = np.bincount(patch[..., 2][solid], minlength=256)
+        bright = histogram_percentile(counts, 90)
+        dark_bytes = min(256, max(0, math.ceil(p.dark_ratio * bright)))
+        n_dark = int(np.add.reduce(counts[:dark_bytes]))
+        dark = n_dark / n_solid
         if not p.dark_share_min <= dark <= p.dark_share_max:
             return 0.0, False, "dark"
         carpet = patch[..., 2][around & patch_green]
         field_value = byte_median(carpet if carpet.size >= 3 else patch[..., 2][around])
-        black = value[is_dark]
-        darkest = float(black.mean()) if black.size else math.inf  # the black patches' value
+        darkest = int(counts[:dark_bytes] @ BYTE_VALUES[:dark_bytes]) / n_dark if n_dark else math.inf  # the black patches' mean
         if darkest > p.black_contrast * field_value:
             return 0.0, False, "black"
         return float(min(1.0, 0.5 + dark + 0.3 * green_around - green_inside)), False, ""
