@@ -1302,3 +1302,25 @@ def test_spl_verdicts_from_the_histogram_are_the_gathered_pixels(painted: tuple[
         for parameters in (None, self.looser(), drawn):
             for beside in (False, True):
                 assert self.verdict(hsv, green, spot, white, beside, parameters) == reference_verdict(self, hsv, green, spot, white, beside, parameters)
+
+
+@settings(max_examples=300)
+@given(st.integers(-200, 900), st.integers(-200, 700), st.integers(0, 140), st.integers(0, 140), st.integers(-2, 2), st.integers(-2, 2),
+       st.sampled_from([0.0, 0.5, 0.25, 1e-9]), st.sampled_from([0.0, 0.5, 0.75]))
+def test_distances_from_a_whole_pixel_are_numpys_hypot(x: int, y: int, reach_x: int, reach_y: int, skew_x: int, skew_y: int,
+                                                       fraction_x: float, fraction_y: float) -> None:
+    """The pixels' distances from a spot, looked up for spots on whole pixels (up to the table's reach and beyond it,
+    windows not centred on the spot), computed by hypot for the others: ``np.hypot`` of the offsets, to the last bit."""
+    sx, sy = x + fraction_x, y + fraction_y
+    x0, x1, y0, y1 = x - reach_x + skew_x, x + reach_x + 1 + skew_x, y - reach_y + skew_y, y + reach_y + 1 + skew_y
+    expected = np.hypot(np.arange(x0, x1)[None, :] - sx, np.arange(y0, y1)[:, None] - sy)
+    got = spl_ball_detector.distances(x0, x1, y0, y1, sx, sy)
+    assert got.shape == expected.shape
+    np.testing.assert_array_equal(got, expected)
+
+
+def test_the_distance_table_is_numpys_hypot_of_signed_offsets() -> None:
+    """Every offset of the table with either sign: its value (hypot does not depend on the signs)."""
+    offsets = np.arange(-spl_ball_detector.HYPOT_REACH + 1, spl_ball_detector.HYPOT_REACH, dtype=float)
+    index = np.abs(offsets).astype(int)
+    np.testing.assert_array_equal(np.hypot(offsets[None, :], offsets[:, None]), spl_ball_detector.HYPOT[index][:, index])

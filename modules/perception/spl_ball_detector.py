@@ -44,10 +44,25 @@ EDGE_REACH = 30
 FEW_PEAKS = 64
 #: every byte's value (int64), to sum bytes from their histogram
 BYTE_VALUES = np.arange(256, dtype=np.int64)
+#: ``HYPOT[i, j]``: ``np.hypot(j, i)`` (px), for the pixels' distances from a spot on a whole pixel (``distances``)
+HYPOT_REACH = 128
+HYPOT = np.hypot(np.arange(HYPOT_REACH, dtype=float)[None, :], np.arange(HYPOT_REACH, dtype=float)[:, None])
 
 #: the tests of ``SPLBallDetector.verdict`` whose thresholds the second look loosens: a spot that failed another one
 #: (too few pixels, under a post, too much green round it) fails it again with the looser thresholds
 LOOSER_TESTS = ("saturation", "dark", "black")
+
+
+def distances(x0: int, x1: int, y0: int, y1: int, x: float, y: float) -> np.ndarray:
+    """The distance (px) of each pixel of columns ``x0:x1`` and rows ``y0:y1`` from (x, y): ``np.hypot`` of the offsets.
+    From a whole pixel (the distance transform's peaks mostly are), within ``HYPOT_REACH``, the offsets are whole and
+    the distances are looked up in ``HYPOT`` (hypot's value does not depend on the offsets' signs): the same numbers,
+    a fraction of the time."""
+    if float(x).is_integer() and float(y).is_integer():
+        dx0, dx1, dy0, dy1 = x0 - int(x), x1 - int(x), y0 - int(y), y1 - int(y)  # the offsets of the first and after the last
+        if max(-dx0, dx1 - 1, -dy0, dy1 - 1) < HYPOT_REACH:
+            return HYPOT.take(np.abs(np.arange(dy0, dy1)), axis=0).take(np.abs(np.arange(dx0, dx1)), axis=1)
+    return np.hypot(np.arange(x0, x1)[None, :] - x, np.arange(y0, y1)[:, None] - y)
 
 
 def carpet_sample(hsv: np.ndarray, green: np.ndarray) -> np.ndarray:
@@ -697,7 +712,7 @@ class SPLBallDetector(Module):
         reach = int(math.ceil(r * 1.7)) + 1
         x0, x1 = max(0, int(spot.x) - reach), min(width, int(spot.x) + reach + 1)
         y0, y1 = max(0, int(spot.y) - reach), min(height, int(spot.y) + reach + 1)
-        d = np.hypot(np.arange(x0, x1)[None, :] - spot.x, np.arange(y0, y1)[:, None] - spot.y)
+        d = distances(x0, x1, y0, y1, spot.x, spot.y)
         inside, around = d <= 0.9 * r, (d >= 1.2 * r) & (d <= 1.7 * r)
         n_inside, n_around = np.count_nonzero(inside), np.count_nonzero(around)
         if n_inside < 3 or n_around < 3:
