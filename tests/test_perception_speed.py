@@ -529,12 +529,19 @@ def test_line_runs_and_their_green_borders_are_the_loops(seed: int, rows: int, c
 
 
 @settings(max_examples=100)
-@given(st.integers(0, 2**32 - 1), st.sampled_from([(320, 240), (64, 48), (50, 37)]), st.floats(0.05, 0.9), st.integers(1, 7))
-def test_line_detectors_ignored_pixels_are_the_full_masks(seed: int, size: tuple[int, int], pitch: float, step: int) -> None:
-    """The pixels ignored on the scan lines are the full mask's there: off the field, the own body, posts, balls."""
+@given(st.integers(0, 2**32 - 1), st.sampled_from([(320, 240), (64, 48), (50, 37)]), st.floats(0.05, 0.9), st.integers(1, 7),
+       st.sampled_from(["any", "whole", "nan", "inf"]))
+def test_line_detectors_ignored_pixels_are_the_full_masks(seed: int, size: tuple[int, int], pitch: float, step: int, rows: str) -> None:
+    """The pixels ignored on the scan lines are the full mask's there: off the field, the own body, posts, balls; the
+    boundary anywhere, on whole rows (where a row's comparison with the limit's ceiling differs from one with the next),
+    or not finite in places."""
     rng = np.random.default_rng(seed)
     width, height = size
     boundary = np.clip(rng.normal(height / 3, height / 6, width), 0, height).astype(np.float32)
+    if rows == "whole":
+        boundary = np.round(boundary)
+    elif rows in ("nan", "inf"):
+        boundary[rng.integers(0, width, 3)] = np.nan if rows == "nan" else rng.choice([np.inf, -np.inf])
     posts = [GoalPost(0.0, 0.0, str(rng.choice(["top", "bottom"])), float(rng.uniform(0, width)), float(rng.uniform(1, 20)),
                       float(rng.uniform(0, height))) for _ in range(int(rng.integers(0, 3)))]
     balls = [BallCandidate(str(rng.choice(["top", "bottom"])), float(rng.uniform(-5, width + 5)), float(rng.uniform(-5, height + 5)),

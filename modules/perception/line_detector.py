@@ -196,7 +196,10 @@ class LineDetector(Module):
             # off the field: above the boundary; only the rows above its lowest point are compared
             above = int(np.searchsorted(rows, highest)) if math.isfinite(highest) else len(rows)
             ignored = ignored.copy()
-            ignored[:above] |= rows[:above, None] < limits[None, :]
+            if math.isfinite(highest) and math.isfinite(float(limits.min())):  # a whole row lies above a limit where it
+                ignored[:above] |= rows[:above, None] < np.ceil(limits).astype(rows.dtype)[None, :]  # lies above its ceiling
+            else:
+                ignored[:above] |= rows[:above, None] < limits[None, :]
         return ignored
 
     def obstacles(self, camera: str, projection: ImageProjection) -> np.ndarray:
