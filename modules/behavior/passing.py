@@ -6,9 +6,11 @@ The pass rule: the player with the ball passes to a teammate when all of these h
 
 1. the teammate is better placed to score: at least ``pass_gain`` mm nearer the opponent goal's centre than
    the ball; or, when every lane of the own shot is blocked, it has an open shot itself (a lane to the goal
-   mouth clear by ``lane_width``, from within ``shot_range`` of the goal) and is at least ``blocked_gain`` mm
-   nearer the goal than the ball (in a 2v2 the opponent striker holds back 0.65 m before the ball, on its
-   way to the goal, and the supporter, 45 degrees off that way, could not be 1 m nearer within the field);
+   mouth clear by ``lane_width``, from within ``shot_range`` of the goal) and is at most ``-blocked_gain`` mm
+   farther from the goal than the ball (in a 2v2 the opponent striker holds back 0.65 m before the ball, on its
+   way to the goal, and the supporter, 45 degrees off that way, could not be 1 m nearer within the field; by
+   the opponent goal the supporter waits 1.2 m before the goal line, often a little farther from the goal than
+   a ball the keeper blocks: the pass back to its open shot is the better chance);
 2. it is within a kick's reach: ``pass_min`` to ``pass_max`` mm from the ball;
 3. it is open: no opponent within ``pass_open`` mm of it;
 4. the lane is clear: no opponent within ``lane_width`` mm of the ball's way to it;
@@ -57,9 +59,9 @@ class PassParameters:
     """mm ahead of the teammate (towards the opponent goal) the pass is aimed"""
     shot_aims: int = bounded(1, 9, 5)
     """points across the goal mouth a shot may aim at (the most open is taken)"""
-    blocked_gain: float = bounded(-5000.0, 5000.0, 0.0)
+    blocked_gain: float = bounded(-5000.0, 5000.0, -1000.0)
     """mm a teammate with an open shot must be nearer the opponent goal than the ball to be passed to when the own
-    shot is blocked"""
+    shot is blocked (negative: it may be that much farther)"""
 
 
 def lane_clearance(start: Point, end: Point, others: Sequence[Point]) -> float:

@@ -13,8 +13,8 @@ from tafel.debug import Canvas, DebugRequest
 from tafel.modules.behavior.ball_search import SearchTurn
 from tafel.modules.behavior.kicking import KickParameters, goal_direction, kick_tuning
 from tafel.modules.behavior.options import OptionRunner
-from tafel.modules.behavior.options.soccer import FREE_KICKS, OWN_GOAL_X, PlaySoccer
-from tafel.modules.behavior.passing import PassParameters, best_shot, choose_pass, pass_kick
+from tafel.modules.behavior.options.soccer import FREE_KICKS, OWN_GOAL_X, SUPPORT_TOUCHLINE_GAP, PlaySoccer
+from tafel.modules.behavior.passing import PassParameters, best_shot, choose_pass, lane_clearance, pass_kick
 from tafel.modules.behavior.paths import Disc, clear, detour, free_direction, outside
 from tafel.representations import field as pitch
 from tafel.representations.behavior import ActivationGraph, OptionGraph
@@ -161,6 +161,11 @@ class SoccerBehavior(Module):
         opponent is no nearer: two robots at about the same distance do not both wait)"""
         hold_distance: float = bounded(300.0, 2000.0, 700.0)
         """mm from the ball the striker waits while an opponent plays it"""
+        keeper_pass_offset: list[float] = field(default_factory=lambda: [1200.0, 1200.0])
+        """mm ahead of (towards the opponent goal) and beside the ball (beside: towards the field's long axis, or the
+        other side when an opponent marks that spot or its lane) where the striker waits while its own goalkeeper
+        plays the ball (``keeper_plays``): open to the keeper's pass, within the pass rule's reach and gain (at
+        0.7 m straight ahead it was too near, and behind the opponent holding back 0.7 m before the ball)"""
         hold_max_s: float = bounded(0.0, 60.0, 8.0)
         """s the striker holds back at most; then it challenges for the ball"""
         challenge_s: float = bounded(0.0, 60.0, 5.0)
@@ -202,6 +207,8 @@ class SoccerBehavior(Module):
         """which way a search for the ball turns: towards the side it was last seen on"""
         self.support_side = 0.0
         """the side of the ball the supporter waits on (+1: +y, -1: -y, 0: none yet), kept while open to a pass"""
+        self.keeper_pass_side = 0.0
+        """the side of the ball the striker waits on while its goalkeeper plays the ball (as ``support_side``)"""
         self.set_play: tuple[SetPlay, int] | None = None
         self.set_play_s = -math.inf
         self.set_play_spots: list[tuple[float, float]] = []
@@ -492,10 +499,13 @@ class SoccerBehavior(Module):
     def hold_point(self) -> tuple[float, float, float]:
         """Where the striker waits while an opponent plays the ball: ``hold_distance`` from the ball towards
         the own goal's centre (towards this robot without a pose), facing the ball; while the own goalkeeper
-        plays it (``keeper_plays``), towards the opponent goal instead, out of its way; robot frame mm, mm, rad."""
+        plays it (``keeper_plays``), at ``keeper_pass_spot`` instead, out of its way and open to its pass;
+        robot frame mm, mm, rad."""
         ball, pose = self.ball_model, self.robot_pose
-        goal_x = -OWN_GOAL_X if self.keeper_plays() else OWN_GOAL_X
-        gx, gy = pose.to_robot(goal_x, 0.0) if pose.valid else (0.0, 0.0)
+        if pose.valid and self.keeper_plays():
+            x, y = pose.to_robot(*self.keeper_pass_spot())
+            return x, y, math.atan2(ball.y - y, ball.x - x)
+        gx, gy = pose.to_robot(OWN_GOAL_X, 0.0) if pose.valid else (0.0, 0.0)
         dx, dy = gx - ball.x, gy - ball.y
         distance = math.hypot(dx, dy)
         if distance < 1.0:
@@ -503,3 +513,27 @@ class SoccerBehavior(Module):
         reach = min(self.parameters.hold_distance, distance)
         x, y = ball.x + dx / distance * reach, ball.y + dy / distance * reach
         return x, y, math.atan2(ball.y - y, ball.x - x)
+
+    def keeper_pass_spot(self) -> tuple[float, float]:
+        """Where the striker waits while its goalkeeper plays the ball (field mm; needs a valid pose):
+        ``keeper_pass_offset`` ahead of and beside the ball, beside towards the field's long axis, or the other
+        side when an opponent stands within ``pass_open`` of that spot or ``lane_width`` of the ball's way to it
+        and not of the other; the side chosen last is kept while open; ``SUPPORT_TOUCHLINE_GAP`` inside the
+        touchlines. So the keeper's clearance can be a pass by the pass rule (``passing.py``)."""
+        pose, p = self.robot_pose, self.parameters
+        bx, by = self.ball_model.field_position(pose)
+        ahead, beside = p.keeper_pass_offset
+        limit = pitch.WIDTH / 2 - SUPPORT_TOUCHLINE_GAP
+        inward = -math.copysign(1.0, by) if abs(by) > 100.0 else 1.0
+        first = self.keeper_pass_side if self.keeper_pass_side and abs(by + self.keeper_pass_side * beside) <= limit else inward
+        spots = [(bx + ahead, max(-limit, min(limit, by + side * beside))) for side in (first, -first)]
+        seen = [pose.to_field(o.x, o.y) for o in self.obstacles.obstacles if o.kind is ObstacleKind.robot]
+        keeper = same_robots([(m.message.x, m.message.y) for m in self.team_mates.fresh(p.pass_mate_age)], seen, p.pass_mate_seen)
+        opponents = [robot for k, robot in enumerate(seen) if k not in keeper]  # the keeper seen at the ball marks nothing
+
+        def open_to_pass(spot: tuple[float, float]) -> bool:
+            return all(math.dist(spot, o) >= p.pass_open for o in opponents) and lane_clearance((bx, by), spot, opponents) >= p.lane_width
+
+        kept = open_to_pass(spots[0]) or not open_to_pass(spots[1])
+        self.keeper_pass_side = first if kept else -first
+        return spots[0] if kept else spots[1]

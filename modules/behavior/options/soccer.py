@@ -157,8 +157,12 @@ class Striker(Option["SoccerBehavior"]):
     @state
     def hold_back(self, b: SoccerBehavior) -> None:
         """An opponent nearer the ball plays it: wait ``hold_distance`` from the ball, between it and the own
-        goal, facing it (round the robots on the way)."""
+        goal, facing it (round the robots on the way); while the own goalkeeper plays it, where the keeper can pass
+        to (``hold_point``), facing the way there while it is farther than ``face_the_way`` (that way is mostly
+        sideways, where the robot sees nothing: it walked into an opponent unseen)."""
         x, y, rotation = b.hold_point()
+        if b.robot_pose.valid and math.hypot(x, y) > b.parameters.face_the_way and b.keeper_plays():
+            rotation = math.atan2(y, x)
         if b.robot_pose.valid:
             fx, fy = b.robot_pose.to_field(x, y)
             self.call(GoTo, x=fx, y=fy, rotation=math.remainder(b.robot_pose.rotation + rotation, math.tau))
