@@ -174,3 +174,30 @@ def test_blackbox_save_in_the_concurrent_runtime_holds_both_contexts(tmp_path: P
     path = max(logs.glob("blackbox-*.mcap"))
     contexts = {m.topic.split("/")[0] for m in read_log(path).messages}
     assert contexts == {"cognition", "motion"}
+
+
+def test_the_concurrent_runtimes_black_box_drain_ends_quietly_when_its_queue_fails() -> None:
+    """At a run's end the queue may be torn down under the drain thread (CI saw a thread traceback on stderr after
+    a stop for malformed LoLA packets): any failure to read ends the drain, after what it drained is written."""
+    from tafel.core.runtime.concurrent import ConcurrentRuntime
+
+    written: list[tuple] = []
+
+    class Sink:
+        def write(self, *item: object) -> None:
+            written.append(item)
+
+    class Source:
+        def __init__(self, failure: Exception) -> None:
+            self.items: list = [("motion", 1), ("motion", 2)]
+            self.failure = failure
+
+        def get(self) -> object:
+            if self.items:
+                return self.items.pop(0)
+            raise self.failure
+
+    for failure in (EOFError(), OSError("handle is closed"), ValueError("closed"), TypeError("'NoneType' object cannot be interpreted as an integer")):
+        written.clear()
+        ConcurrentRuntime._drain_into(Source(failure), Sink())  # returns, raises nothing
+        assert written == [("motion", 1), ("motion", 2)]

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import faulthandler
 import importlib
 import logging
 import multiprocessing
 import os
+import queue
 import signal
 import sys
 import threading
@@ -225,9 +227,10 @@ class ConcurrentRuntime:
         if drain:
             drain.start()
         box_queue = self._mp.Queue(maxsize=8192) if self.blackbox is not None else None
-        if box_queue is not None:
-            threading.Thread(target=self._drain_into, args=(box_queue, self.blackbox), name="tafel-blackbox-drain",
-                             daemon=True).start()
+        box_drain = threading.Thread(target=self._drain_into, args=(box_queue, self.blackbox), name="tafel-blackbox-drain",
+                                     daemon=True) if box_queue is not None else None
+        if box_drain is not None:
+            box_drain.start()
         try:
             for name, plan in self.plans.items():
                 other = "motion" if name == "cognition" else "cognition"
@@ -259,9 +262,13 @@ class ConcurrentRuntime:
             if drain is not None and record_queue is not None:
                 record_queue.put(None)
                 drain.join(timeout=30)
-            if box_queue is not None:
+            if box_queue is not None and box_drain is not None:
                 box_queue.cancel_join_thread()
-                box_queue.put(None)
+                with contextlib.suppress(queue.Full):  # a drain that ended early leaves the queue full
+                    box_queue.put(None, timeout=1.0)
+                # the black box holds the last records before the run's end is reported (and dumped), and the
+                # thread never reads from a queue the interpreter's exit is tearing down
+                box_drain.join(timeout=5.0)
             if self.recorder is not None:
                 self.recorder.forward_dropped += sum(s.record_dropped for s in self.stats.values())
                 self.recorder.stop()
@@ -273,7 +280,7 @@ class ConcurrentRuntime:
         while True:
             try:
                 item = source.get()
-            except (EOFError, OSError, ValueError):
+            except Exception:  # noqa: BLE001 - a queue closed or torn down under it (EOFError, OSError, ValueError, TypeError): done
                 return
             if item is None:
                 return
