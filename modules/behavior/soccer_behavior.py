@@ -411,12 +411,9 @@ class SoccerBehavior(Module):
         bx, by = ball.field_position(pose)
         now = self.frame_info.time_s
         if self.aim is None or now - self.aim_s >= p.pass_decide_s or now < self.aim_s:
-            seen = [pose.to_field(o.x, o.y) for o in self.obstacles.obstacles if o.kind is ObstacleKind.robot]
             mates = [(m.message.x, m.message.y) for m in self.team_mates.fresh(p.pass_mate_age)
                      if m.message.pose_valid and not (m.message.fallen or m.message.penalized)]
-            # the robot seen nearest where a teammate said it was is that teammate, walked on since
-            mates_seen = same_robots([(m.message.x, m.message.y) for m in self.team_mates.fresh(p.pass_mate_age)], seen, p.pass_mate_seen)
-            opponents = [robot for k, robot in enumerate(seen) if k not in mates_seen]
+            opponents = self.seen_opponents()
             target = choose_pass((bx, by), mates, opponents, p)
             self.aim, self.aim_is_pass, self.aim_s = target or best_shot((bx, by), opponents, p)[0], target is not None, now
         ax, ay = pose.to_robot(*self.aim)
@@ -527,9 +524,7 @@ class SoccerBehavior(Module):
         inward = -math.copysign(1.0, by) if abs(by) > 100.0 else 1.0
         first = self.keeper_pass_side if self.keeper_pass_side and abs(by + self.keeper_pass_side * beside) <= limit else inward
         spots = [(bx + ahead, max(-limit, min(limit, by + side * beside))) for side in (first, -first)]
-        seen = [pose.to_field(o.x, o.y) for o in self.obstacles.obstacles if o.kind is ObstacleKind.robot]
-        keeper = same_robots([(m.message.x, m.message.y) for m in self.team_mates.fresh(p.pass_mate_age)], seen, p.pass_mate_seen)
-        opponents = [robot for k, robot in enumerate(seen) if k not in keeper]  # the keeper seen at the ball marks nothing
+        opponents = self.seen_opponents()  # the keeper seen at the ball marks nothing
 
         def open_to_pass(spot: tuple[float, float]) -> bool:
             return all(math.dist(spot, o) >= p.pass_open for o in opponents) and lane_clearance((bx, by), spot, opponents) >= p.lane_width
@@ -537,3 +532,11 @@ class SoccerBehavior(Module):
         kept = open_to_pass(spots[0]) or not open_to_pass(spots[1])
         self.keeper_pass_side = first if kept else -first
         return spots[0] if kept else spots[1]
+
+    def seen_opponents(self) -> list[tuple[float, float]]:
+        """The robots seen (field mm; needs a valid pose) but those that are teammates: the robot seen nearest where a
+        teammate said it was (within ``pass_mate_seen``) is that teammate, walked on since."""
+        pose, p = self.robot_pose, self.parameters
+        seen = [pose.to_field(o.x, o.y) for o in self.obstacles.obstacles if o.kind is ObstacleKind.robot]
+        mates_seen = same_robots([(m.message.x, m.message.y) for m in self.team_mates.fresh(p.pass_mate_age)], seen, p.pass_mate_seen)
+        return [robot for k, robot in enumerate(seen) if k not in mates_seen]
