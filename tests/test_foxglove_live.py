@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 from websockets.exceptions import InvalidStatus
 
+from tests.support.attack import skip_without_headroom
 from tests.support.foxglove_client import FoxgloveClient, ServiceCallFailure
 from tests.test_cli_runtime import tafel
 from tests.test_debug_server import Program
@@ -102,7 +103,8 @@ def test_the_command_service_answers_as_the_console_would(clients: tuple[Foxglov
 def test_with_everything_subscribed_the_loops_keep_their_rates(clients: tuple[FoxgloveClient, Any]) -> None:
     """Streaming every channel must not slow the loops: their rates with everything subscribed are
     compared with their rates, measured just before in the same program, with nothing subscribed (the
-    simulator's own pace on this machine is the baseline, not a fixed 100 Hz)."""
+    simulator's own pace on this machine is the baseline, not a fixed 100 Hz). Judged where the program keeps its
+    beat alone: where it uses up the machine's cores already, the server's work takes its share whatever it does."""
     client, debug = clients
 
     def frames() -> tuple[float, dict[str, int]]:
@@ -121,9 +123,10 @@ def test_with_everything_subscribed_the_loops_keep_their_rates(clients: tuple[Fo
     streaming = rates(6.0)
     print("rates alone", alone, "streaming", streaming)
     assert alone["motion"] > 60 and alone["cognition"] > 18, alone  # the program runs at all (both loops near their beat)
+    assert len(client.received["/camera/top"]) >= 5 * streaming["cognition"]  # about one image a cognition frame arrived
+    skip_without_headroom(alone, "streaming")
     for context in ("motion", "cognition"):
         assert streaming[context] >= 0.9 * alone[context], (alone, streaming)
-    assert len(client.received["/camera/top"]) >= 5 * streaming["cognition"]  # about one image a cognition frame arrived
 
 
 @pytest.mark.slow

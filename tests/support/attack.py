@@ -20,6 +20,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import pytest
+
 #: commands the pipelining clients send, round and round
 PIPELINED = ("ping", "modules:list", "representation:print FrameInfo", "stopwatch:list", "debug_request:list", "help")
 
@@ -248,3 +250,18 @@ def rates_during(errors: list[str], seconds: float, forgive: int = 0) -> dict[st
     time.sleep(seconds)
     rates = status_rates(errors[start:])
     return {name: sorted(values[1:])[forgive] if len(values) > 1 + forgive else float("nan") for name, values in rates.items()}
+
+
+#: Hz each loop keeps on a machine with room for the program: the beats (100 and 30 Hz) less a little slack
+BEATS = {"motion": 95.0, "cognition": 28.0}
+
+
+def skip_without_headroom(unloaded: dict[str, float], load: str) -> None:
+    """Skip what is left of a test that judges whether ``load`` slows the loops when the program missed its beat
+    without it (``unloaded``: rates measured just before, in the same run): the machine's cores are used up
+    already, and anything more that runs (a streaming server, a log read beside it) slows a program paced by its
+    own computing, whatever ``load`` does. The reason gives the rates."""
+    short = {name: round(rate, 1) for name, rate in unloaded.items() if rate < BEATS.get(name, 0.0)}
+    if short:
+        pytest.skip(f"this machine misses the loops' beat without {load} ({short} Hz, beats {BEATS}): "
+                    f"whether {load} slows them cannot be judged here")
