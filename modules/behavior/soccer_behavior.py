@@ -29,7 +29,8 @@ OPPONENT_PENALTY_MARK_X = pitch.LENGTH / 2 - pitch.PENALTY_MARK_DISTANCE
 KEEPER_AREA_MARGIN = 150.0  # mm inside its penalty area's lines a goalkeeper is sure to be in it (the pose's error)
 #: rad beside the heading beyond which the robot sees nothing (robots are seen within 100 degrees); mm a walk's target
 #: lies that way at most (with the walk's target_gain, 1.5/s: no faster than 70 mm/s, below the rules' pushing) when it
-#: is nearer than BLIND_TURN mm; farther, the robot turns to face its way
+#: is nearer than BLIND_TURN mm; farther, the robot is to face its way (the walk turns to it first, nearly in place:
+#: ``WalkingEngine``'s turn_first)
 BLIND, BLIND_STEP, BLIND_TURN = math.radians(100.0), 45.0, 400.0
 POST_SEEN = 300.0  # mm round a goal post within which ObstacleModeler takes what is seen for the post (its post_radius)
 KICK_HELD_BACK = 30.0  # mm a walk's target may be held back from a robot (``keep_from_pushing``) and the walk kick still be asked for
@@ -293,7 +294,7 @@ class SoccerBehavior(Module):
                     x, y = x - (towards - limit) * ux, y - (towards - limit) * uy
         length, way = math.hypot(x, y), math.atan2(y, x)
         if abs(way) > BLIND and length > BLIND_STEP and self.game_state.state is State.playing:  # backwards, blind
-            if length > BLIND_TURN:  # far: turn and walk there facing the way
+            if length > BLIND_TURN:  # far: turn (the walk turns first) and walk there facing the way
                 out.target_rotation = way
             else:  # near: slowly
                 x, y = x * BLIND_STEP / length, y * BLIND_STEP / length
