@@ -2,7 +2,7 @@
 through the perception modules on their blackboard (``tools.simulation.scene_frames.Perception``).
 
 A far ball on the field's edge reaches over the carpet into the hall behind it, whose non-green merged with it in the
-detector's candidate search: ``SPLBallDetector.edge_spots`` looks for ball-coloured blobs in a band round the field
+detector's candidate search: ``far_ball_spots.edge_spots`` looks for ball-coloured blobs in a band round the field
 boundary. The scenes are posed; the truth comes from the renderer.
 """
 

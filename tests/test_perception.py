@@ -377,7 +377,7 @@ def painted_candidates(rng: np.random.Generator, count: int) -> tuple[np.ndarray
     """Rows of classifier features from painted 160x120 scenes: half an SPL-like ball (white, black
     patches round its centre) on the carpet, half a thing of the same size that is none (a joint, a foot)."""
     from tafel.modules.perception.ball_classifier import features
-    from tafel.modules.perception.spl_ball_detector import carpet
+    from tafel.modules.perception.ball_spots import carpet
     from tafel.tools.simulation.train_ball_classifier import camera_like, distractors
 
     rows, labels = [], []
@@ -502,7 +502,8 @@ def test_a_real_goals_rear_frame_is_not_taken_for_its_post() -> None:
 def test_a_ball_cut_by_the_image_edge_is_centred_on_what_is_seen() -> None:
     """A ball cut by the image's left edge, its dark shadow beside it: the distance transform's peak lies
     between the ball and the shadow; the circle fitted to the ball's visible outline is the ball."""
-    from tafel.modules.perception.spl_ball_detector import SPLBallDetector, Spot
+    from tafel.modules.perception.ball_checks import fit_visible, near_edge
+    from tafel.modules.perception.ball_spots import Spot
 
     image = np.zeros((120, 160, 3), np.uint8)
     image[:] = (45, 140, 50)
@@ -513,10 +514,10 @@ def test_a_ball_cut_by_the_image_edge_is_centred_on_what_is_seen() -> None:
     hsv = cv2.cvtColor(image, cv2.COLOR_RGB2HSV)
     green = (hsv[..., 0] > 30) & (hsv[..., 0] < 90) & (hsv[..., 1] > 60)
     spot = Spot(12.0, 58.0, 24.0, 20.0)  # where the peak of ball and shadow together is
-    assert SPLBallDetector.near_edge(spot, green.shape)
-    fitted = SPLBallDetector.fit_visible(hsv, green, spot)
+    assert near_edge(spot, green.shape)
+    fitted = fit_visible(hsv, green, spot)
     assert fitted is not None and math.hypot(fitted.x - 4, fitted.y - 50) < 2.0, fitted
-    assert not SPLBallDetector.near_edge(Spot(80.0, 60.0, 10.0, 10.0), green.shape)
+    assert not near_edge(Spot(80.0, 60.0, 10.0, 10.0), green.shape)
 
 
 @pytest.mark.parametrize("pitch", [0.4, 0.42, 0.45])  # the ball's size implies 0.4; the pose is not known exactly

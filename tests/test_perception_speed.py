@@ -21,7 +21,21 @@ from hypothesis import strategies as st
 from tafel.core.framework.manager import make_module
 from tafel.modules.modeling.field_model import FIELD_MODEL
 from tafel.modules.modeling.self_locator import robust, seen_from
-from tafel.modules.perception import spl_ball_detector
+from tafel.modules.perception import ball_checks, ball_spots
+from tafel.modules.perception.ball_checks import LOOSER_TESTS, beside_post, check, post_columns, under_post, verdict
+from tafel.modules.perception.ball_spots import (
+    Spot,
+    ball_ranges,
+    carpet,
+    carpet_light,
+    carpet_sample,
+    dark_pixels,
+    dark_share,
+    inside_image,
+    spots,
+    strict_green,
+)
+from tafel.modules.perception.far_ball_spots import centroids, edge_spots, green_below, white_halves
 from tafel.modules.perception.field_boundary_detector import cell_shares, chain, lower_hull
 from tafel.modules.perception.goal_post_detector import (
     GoalPostDetector,
@@ -46,18 +60,7 @@ from tafel.modules.perception.pixel_statistics import (
     histogram_percentile,
     white_pixels,
 )
-from tafel.modules.perception.spl_ball_detector import (
-    LOOSER_TESTS,
-    SPLBallDetector,
-    Spot,
-    ball_ranges,
-    carpet,
-    carpet_light,
-    carpet_sample,
-    centroids,
-    green_below,
-    white_halves,
-)
+from tafel.modules.perception.spl_ball_detector import SPLBallDetector
 from tafel.platforms.images import posed_image
 from tafel.representations.field import BALL_RADIUS, GOAL_HEIGHT, GOAL_POST_DIAMETER
 from tafel.representations.motion import CameraMatrix, CameraMatrixBuffer
@@ -179,7 +182,7 @@ def reference_spots(self: SPLBallDetector, green: np.ndarray, boundary: np.ndarr
         if all((x - s.x) ** 2 + (y - s.y) ** 2 > (s.expected * 1.5) ** 2 for s in chosen):
             spot = Spot(float(x), float(y), float(max(r, 0.5 * (r + e))), float(e))
             if spot.x < e or spot.x > width - 1 - e or spot.y > height - 1 - e:
-                spot = self.inside_image(spot, ~green)
+                spot = inside_image(spot, ~green)
                 if any((spot.x - s.x) ** 2 + (spot.y - s.y) ** 2 <= (s.expected * 1.5) ** 2 for s in chosen):
                     continue
             chosen.append(spot)
@@ -314,7 +317,7 @@ def reference_check(self: SPLBallDetector, hsv: np.ndarray, green: np.ndarray, s
     field_value = float(np.median(carpet if carpet.size >= 3 else patch[..., 2][around]))
     black = value[value < p.dark_ratio * bright]
     darkest = float(black.mean()) if black.size else math.inf
-    first, posts = self.post_columns(hsv, green, spot, white)
+    first, posts = post_columns(hsv, green, spot, white, self.parameters)
     if not beside_post and 0 <= int(spot.x) - first < len(posts) and posts[int(spot.x) - first]:
         return 0.0, True
     if (green_inside > p.green_inside_max or green_around < p.green_around_min or not p.dark_share_min <= dark <= p.dark_share_max
@@ -324,7 +327,7 @@ def reference_check(self: SPLBallDetector, hsv: np.ndarray, green: np.ndarray, s
 
 
 def reference_beside_post(self: SPLBallDetector, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float) -> Spot | None:
-    first, posts = self.post_columns(hsv, green, spot, white)
+    first, posts = post_columns(hsv, green, spot, white, self.parameters)
     height, width = green.shape
     post = np.nonzero(posts)[0]
     if len(post) == 0:
@@ -374,26 +377,26 @@ def test_spl_candidates_are_the_loops(painted: tuple[np.ndarray, np.ndarray, np.
     self = detector()
     projection = level_projection(width, height, pitch)
     sampled = carpet_light(hsv, green)
-    strict = self.strict_green(hsv, green, sampled)
+    strict = strict_green(hsv, green, self.parameters, sampled)
     np.testing.assert_array_equal(strict, reference_strict_green(self, hsv, green))
-    dark, old_dark = self.dark_pixels(hsv, green, sampled), reference_dark_pixels(self, hsv, green)
+    dark, old_dark = dark_pixels(hsv, green, self.parameters, sampled), reference_dark_pixels(self, hsv, green)
     assert (dark is None) == (old_dark is None)
     if dark is not None:
         np.testing.assert_array_equal(dark, old_dark)
     assert carpet(hsv, green, sampled) == carpet(hsv, green) == reference_carpet(hsv, green)
     for rows in (boundary, np.zeros(0, np.float32)):
-        spots = self.spots(strict, rows, projection, dark)
-        same_spots(spots, reference_spots(self, strict, rows, projection, old_dark))
-        few = spl_ball_detector.FEW_PEAKS
+        found = spots(strict, rows, projection, self.parameters, dark)
+        same_spots(found, reference_spots(self, strict, rows, projection, old_dark))
+        few = ball_spots.FEW_PEAKS
         try:  # the greedy choice over many peaks (numpy's) as over few (a Python loop)
-            spl_ball_detector.FEW_PEAKS = -1
-            same_spots(self.spots(strict, rows, projection, dark), spots)
+            ball_spots.FEW_PEAKS = -1
+            same_spots(spots(strict, rows, projection, self.parameters, dark), found)
         finally:
-            spl_ball_detector.FEW_PEAKS = few
-    for spot in spots:
+            ball_spots.FEW_PEAKS = few
+    for spot in found:
         for beside in (False, True):
-            assert self.check(hsv, green, spot, white, beside) == reference_check(self, hsv, green, spot, white, beside)
-        moved, old = self.beside_post(hsv, green, spot, white), reference_beside_post(self, hsv, green, spot, white)
+            assert check(hsv, green, spot, white, self.parameters, beside) == reference_check(self, hsv, green, spot, white, beside)
+        moved, old = beside_post(hsv, green, spot, white, self.parameters), reference_beside_post(self, hsv, green, spot, white)
         same_spots([moved] if moved else [], [old] if old else [])
 
 
@@ -408,12 +411,12 @@ def test_spl_checks_anywhere_are_the_loops(painted: tuple[np.ndarray, np.ndarray
         x, y = data.draw(st.floats(-3.0, width + 2.0)), data.draw(st.floats(-3.0, height + 2.0))
         spot = Spot(x, y, data.draw(st.floats(0.5, 25.0)), data.draw(st.floats(0.5, 25.0)))
         for beside in (False, True):
-            assert self.check(hsv, green, spot, white, beside) == reference_check(self, hsv, green, spot, white, beside)
-        moved, old = self.beside_post(hsv, green, spot, white), reference_beside_post(self, hsv, green, spot, white)
+            assert check(hsv, green, spot, white, self.parameters, beside) == reference_check(self, hsv, green, spot, white, beside)
+        moved, old = beside_post(hsv, green, spot, white, self.parameters), reference_beside_post(self, hsv, green, spot, white)
         same_spots([moved] if moved else [], [old] if old else [])
-        score, _, failed = self.verdict(hsv, green, spot, white)
+        score, _, failed = verdict(hsv, green, spot, white, self.parameters)
         if score == 0.0 and failed not in LOOSER_TESTS:  # the second look, left out for such spots, would turn them down
-            assert self.check(hsv, green, spot, white, parameters=self.looser())[0] == 0.0
+            assert check(hsv, green, spot, white, self.parameters, parameters=self.looser())[0] == 0.0
 
 
 #: the band search's parameters that let the most candidates through to its last checks (where the loops ran)
@@ -427,15 +430,15 @@ def same_band_spots(self: SPLBallDetector, hsv: np.ndarray, green: np.ndarray, b
     sampled = carpet_light(hsv, green)
     if sampled.count < 10:
         return 0
-    strict, value = self.strict_green(hsv, green, sampled), byte_median(carpet_sample(hsv, green)[:, 2])
+    strict, value = strict_green(hsv, green, self.parameters, sampled), byte_median(carpet_sample(hsv, green)[:, 2])
     found = 0
     for loose in (False, True):
         if loose:
             self.parameters = SPLBallDetector.Parameters(**LOOSE_BAND)
-        spots = self.edge_spots(hsv, strict, boundary, projection, value, list(taken))
-        same_spots(spots, reference_edge_spots(self, hsv, strict, boundary, projection, value, list(taken)))
-        assert all(spot.edge for spot in spots)
-        found = len(spots)
+        band = edge_spots(hsv, strict, boundary, projection, value, list(taken), self.parameters)
+        same_spots(band, reference_edge_spots(self, hsv, strict, boundary, projection, value, list(taken)))
+        assert all(spot.edge for spot in band)
+        found = len(band)
     self.parameters = SPLBallDetector.Parameters()
     return found
 
@@ -448,7 +451,7 @@ def test_the_band_search_is_the_loops_over_the_whole_band(seed: int, size: tuple
     hsv, green, boundary, _ = scene(seed, *size)
     self = detector()
     projection = level_projection(*size, pitch)
-    taken = self.spots(green, boundary, projection)[:3]
+    taken = spots(green, boundary, projection, self.parameters)[:3]
     same_band_spots(self, hsv, green, boundary, projection, taken)
 
 
@@ -662,7 +665,7 @@ def test_dark_shares_from_the_part_the_squares_cover_are_the_whole_masks(seed: i
     dark = rng.random((rows, columns)) < share
     xs, ys = rng.integers(-5, columns + 5, count), rng.integers(-5, rows + 5, count)
     radii = rng.uniform(0.5, 12.0, count)
-    shares = SPLBallDetector.dark_share(dark, xs, ys, radii)
+    shares = dark_share(dark, xs, ys, radii)
     expected = reference_dark_share(dark, xs, ys, radii)
     assert shares.dtype == expected.dtype
     np.testing.assert_array_equal(shares, expected)
@@ -937,7 +940,7 @@ def test_goal_posts_and_the_band_search_in_recorded_frames_are_the_loops() -> No
     """On every real image (at both resolutions; renders where the set is absent), after the perception
     before it has run: the same posts as the loops, bit for bit, and the band search's spots as the loops over the
     whole band found them."""
-    found = spots = 0
+    found = band_spots = 0
     for frames in recorded_frames():
         perception = Perception()
         perception(frames)  # type: ignore[arg-type]
@@ -949,9 +952,9 @@ def test_goal_posts_and_the_band_search_in_recorded_frames_are_the_loops() -> No
             if boundary.size == projection.width:
                 found += len(same_posts_as_the_loops(self, camera, np.asarray(image.image), boundary, projection))
             hsv, green = ball.segmented_image.hsv(camera), ball.segmented_image.green(camera)
-            spots += same_band_spots(ball, hsv, green, boundary, projection, [])
+            band_spots += same_band_spots(ball, hsv, green, boundary, projection, [])
     assert found > 0  # the frames held posts, so the whole of the check ran
-    assert spots > 0  # the loose band search found spots, so the whole of it ran
+    assert band_spots > 0  # the loose band search found spots, so the whole of it ran
 
 
 def post_scene(seed: int, width: int, height: int, pitch: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, np.ndarray, ImageProjection]:
@@ -1248,7 +1251,7 @@ def test_robust_log_likelihoods_in_place_are_the_formulas(values: list[float], s
 
 def reference_verdict(self: SPLBallDetector, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, beside_post: bool = False,
                       parameters: SPLBallDetector.Parameters | None = None) -> tuple[float, bool, str]:
-    """``SPLBallDetector.verdict`` before its dark pixels were counted from the histogram: the own pixels gathered,
+    """``ball_checks.verdict`` before its dark pixels were counted from the histogram: the own pixels gathered,
     compared and averaged."""
     p = parameters or self.parameters
     height, width = green.shape
@@ -1265,7 +1268,7 @@ def reference_verdict(self: SPLBallDetector, hsv: np.ndarray, green: np.ndarray,
     solid = inside & ~patch_green
     if np.count_nonzero(solid) < 3:
         return 0.0, False, "size"
-    if not beside_post and self.under_post(hsv, green, spot, white):
+    if not beside_post and under_post(hsv, green, spot, white, self.parameters):
         return 0.0, True, "post"
     green_inside = np.count_nonzero(patch_green & inside) / n_inside
     green_around = np.count_nonzero(patch_green & around) / n_around
@@ -1308,7 +1311,8 @@ def test_spl_verdicts_from_the_histogram_are_the_gathered_pixels(painted: tuple[
         spot = Spot(x, y, data.draw(st.floats(0.5, 25.0)), data.draw(st.floats(0.5, 25.0)))
         for parameters in (None, self.looser(), drawn):
             for beside in (False, True):
-                assert self.verdict(hsv, green, spot, white, beside, parameters) == reference_verdict(self, hsv, green, spot, white, beside, parameters)
+                assert (verdict(hsv, green, spot, white, self.parameters, beside, parameters)
+                        == reference_verdict(self, hsv, green, spot, white, beside, parameters))
 
 
 @settings(max_examples=300)
@@ -1321,13 +1325,13 @@ def test_distances_from_a_whole_pixel_are_numpys_hypot(x: int, y: int, reach_x: 
     sx, sy = x + fraction_x, y + fraction_y
     x0, x1, y0, y1 = x - reach_x + skew_x, x + reach_x + 1 + skew_x, y - reach_y + skew_y, y + reach_y + 1 + skew_y
     expected = np.hypot(np.arange(x0, x1)[None, :] - sx, np.arange(y0, y1)[:, None] - sy)
-    got = spl_ball_detector.distances(x0, x1, y0, y1, sx, sy)
+    got = ball_checks.distances(x0, x1, y0, y1, sx, sy)
     assert got.shape == expected.shape
     np.testing.assert_array_equal(got, expected)
 
 
 def test_the_distance_table_is_numpys_hypot_of_signed_offsets() -> None:
     """Every offset of the table with either sign: its value (hypot does not depend on the signs)."""
-    offsets = np.arange(-spl_ball_detector.HYPOT_REACH + 1, spl_ball_detector.HYPOT_REACH, dtype=float)
+    offsets = np.arange(-ball_checks.HYPOT_REACH + 1, ball_checks.HYPOT_REACH, dtype=float)
     index = np.abs(offsets).astype(int)
-    np.testing.assert_array_equal(np.hypot(offsets[None, :], offsets[:, None]), spl_ball_detector.HYPOT[index][:, index])
+    np.testing.assert_array_equal(np.hypot(offsets[None, :], offsets[:, None]), ball_checks.HYPOT[index][:, index])

@@ -39,7 +39,8 @@ import cv2
 import numpy as np
 
 from tafel.modules.perception.ball_classifier import FEATURES, MODEL_PATH, features, train
-from tafel.modules.perception.spl_ball_detector import SPLBallDetector, carpet
+from tafel.modules.perception.ball_spots import carpet
+from tafel.modules.perception.spl_ball_detector import SPLBallDetector
 from tafel.platforms.images import posed_image
 from tafel.platforms.realism import CameraRealism, realism_level
 from tafel.representations.motion import CameraMatrix
