@@ -37,17 +37,9 @@ from tafel.modules.perception.ball_spots import (
 )
 from tafel.modules.perception.far_ball_spots import centroids, edge_spots, green_below, white_halves
 from tafel.modules.perception.field_boundary_detector import cell_shares, chain, lower_hull
-from tafel.modules.perception.goal_post_detector import (
-    GoalPostDetector,
-    band_passes,
-    edge_peaks,
-    exact_norms,
-    rising_rows,
-    runs_of_rows,
-    segment_medians,
-    strip_means,
-    strip_sums,
-)
+from tafel.modules.perception.goal_post_band import band_checks, band_passes, edge_peaks
+from tafel.modules.perception.goal_post_detector import GoalPostDetector
+from tafel.modules.perception.goal_post_shapes import exact_norms, rising_rows, runs_of_rows, segment_medians, strip_means, strip_sums
 from tafel.modules.perception.image_geometry import BODY_POINTS, BODY_POINTS_ALL, ImageProjection, camera_views, own_body_mask, rows_times
 from tafel.modules.perception.line_detector import CIRCLE_RADIUS, LineDetector, green_on_both_sides, longest_arc, white_runs
 from tafel.modules.perception.pixel_statistics import (
@@ -1068,7 +1060,7 @@ def test_the_band_checks_of_all_pairs_at_once_let_through_what_may_pass(seed: in
         loops = self.band_white[inner].mean() >= 0.6 and all(  # type: ignore[attr-defined]
             np.linalg.norm(inside - outside.mean(axis=0)) >= contrast_min
             for outside in (self.band_colour[max(0, int(left[k]) - side) : int(left[k])], self.band_colour[int(right[k]) + 1 : int(right[k]) + 1 + side]))  # type: ignore[attr-defined]
-        assert self.band_checks(int(left[k]), int(right[k])) == loops  # type: ignore[attr-defined]
+        assert band_checks(self.band_white, self.band_colour, int(left[k]), int(right[k]), contrast_min) == loops  # type: ignore[attr-defined]
         assert passes[k] or not loops
         if not near[k]:
             assert passes[k] == loops
