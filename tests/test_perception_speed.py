@@ -20,7 +20,8 @@ from hypothesis import strategies as st
 
 from tafel.core.framework.manager import make_module
 from tafel.modules.modeling.field_model import FIELD_MODEL
-from tafel.modules.modeling.self_locator import robust, seen_from
+from tafel.modules.modeling.particle_filter import seen_from
+from tafel.modules.modeling.pose_measurements import robust
 from tafel.modules.perception import ball_checks, ball_spots
 from tafel.modules.perception.ball_checks import LOOSER_TESTS, beside_post, check, post_columns, under_post, verdict
 from tafel.modules.perception.ball_spots import (

@@ -12,7 +12,9 @@ from hypothesis import strategies as st
 
 from tafel.core.testing import ModuleHarness
 from tafel.modules.modeling.field_model import FIELD_MODEL, mirror
-from tafel.modules.modeling.self_locator import SelfLocator, low_variance_indices, robust
+from tafel.modules.modeling.particle_filter import low_variance_indices
+from tafel.modules.modeling.pose_measurements import robust
+from tafel.modules.modeling.self_locator import SelfLocator
 from tafel.representations import field
 from tafel.representations.game import GameState, Penalty, RobotInfo, TeamInfo
 from tafel.representations.infrastructure import FrameInfo

@@ -1,4 +1,5 @@
-"""SelfLocator: where the robot is on the field, by a particle filter over (x, y, rotation)."""
+"""SelfLocator: where the robot is on the field, by a particle filter over (x, y, rotation). The particle cloud's maths
+(motion noise, resampling, the mean pose) is ``particle_filter``, what the percepts say of poses ``pose_measurements``."""
 
 from __future__ import annotations
 
@@ -11,27 +12,22 @@ from tafel.core import Module, bounded, provides, requires, uses
 from tafel.debug import Canvas, DebugRequest, Plot
 from tafel.modules.modeling.field_model import FIELD_MODEL, OWN_HALF
 from tafel.modules.modeling.mirror_hypotheses import SideBelief, fold, pose_distance, twin
-from tafel.representations import field
+from tafel.modules.modeling.particle_filter import mean_pose, moved, near, on_field_prior, resampled, spread_round, walk
+from tafel.modules.modeling.pose_measurements import (
+    ball_against_team,
+    contradictions,
+    evidence_seen,
+    log_likelihoods,
+    team_ball_off,
+    usable_percepts,
+)
 from tafel.representations.game import GameState
 from tafel.representations.geometry import Pose2D
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import KnownPose, RobotPose
 from tafel.representations.motion_control import FallState, Odometry
 from tafel.representations.perception import BallPercept, GoalPostPercept, LinePercept
-from tafel.representations.team import TeamBall, TeamMates
-
-KNOWN_POSE_STD, KNOWN_ROTATION_STD = 30.0, 0.03  # mm and rad: the particles' spread round a pose told (KnownPose)
-WATCH_MIN_POINTS = 10  # line points a frame needs to say whether the lines fit the estimate ...
-WATCH_LINES_OFF = 0.2  # ... the share of them beyond 2.5 standard deviations that contradicts it (a robot carried where
-WATCH_LINES_ON = 0.1  # the old pose half fits: about a quarter), and the share at most that agrees (an accurate pose: 0)
-
-
-def seen_from(poses: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Robot-frame points (M x 2, mm) as seen from each of the field poses (N x 3: mm, mm, rad): N x M x 2
-    field positions (mm)."""
-    x, y, heading = (poses[:, i : i + 1] for i in range(3))
-    c, s = np.cos(heading), np.sin(heading)
-    return np.stack([x + c * points[:, 0] - s * points[:, 1], y + s * points[:, 0] + c * points[:, 1]], axis=-1)
+from tafel.representations.team import TeamMates
 
 
 @requires(Odometry, LinePercept, GoalPostPercept, FrameInfo)
@@ -225,22 +221,12 @@ class SelfLocator(Module):
         if self.anchor is not None:
             self.anchor = moved(self.anchor, forward, left, turn)
         self.side.walked(math.hypot(forward, left))
-        n = len(self.particles)
-        step = math.hypot(forward, left)
-        forwards = forward + self.rng.normal(0.0, p.translation_noise * step + 1.0, n)  # each particle's step
-        lefts = left + self.rng.normal(0.0, p.translation_noise * step + 1.0, n)
-        turns = turn + self.rng.normal(0.0, p.rotation_noise * abs(turn) + 0.0002 * step + 0.002, n)
-        heading = self.particles[:, 2]
-        self.particles[:, 0] += np.cos(heading) * forwards - np.sin(heading) * lefts
-        self.particles[:, 1] += np.sin(heading) * forwards + np.cos(heading) * lefts
-        self.particles[:, 2] = np.remainder(heading + turns + math.pi, math.tau) - math.pi
+        walk(self.particles, forward, left, turn, p, self.rng)
 
     def start_at(self, pose: KnownPose) -> None:
         """Every particle at a pose the robot was told, a little spread; trusted and valid at once."""
-        n = len(self.particles)
         told = np.array([pose.x, pose.y, pose.rotation])
-        self.particles = told + self.rng.normal(0.0, [KNOWN_POSE_STD, KNOWN_POSE_STD, KNOWN_ROTATION_STD], (n, 3))
-        self.particles[:, 2] = np.remainder(self.particles[:, 2] + math.pi, math.tau) - math.pi
+        self.particles = spread_round(told, len(self.particles), self.rng)
         self.trusted, self.estimate, self.best = (pose.x, pose.y, pose.rotation), told, None
         self.slow = self.fast = 0.0  # the measurements' fit is learnt anew at this place
         self.concentrated_since, self.evidence = self.frame_info.time_s - self.parameters.confirm_after, {"told"}
@@ -252,39 +238,15 @@ class SelfLocator(Module):
         """Weigh and resample the particles by this frame's percepts; the mean fit per measurement
         (0..1), or None if nothing was seen."""
         p = self.parameters
-        log_weight = np.zeros(len(self.particles))
-        measurements = 0.0
-        points = self.line_points()
-        if len(points):
-            if len(points) > p.max_points:
-                points = points[np.linspace(0, len(points) - 1, p.max_points).astype(int)]
-            std = self.point_std(points)
-            distance = FIELD_MODEL.line_distance_seen(self.particles, points)  # line_distance(self.to_field(points))'s
-            log_weight += p.point_weight * robust(distance / std).sum(axis=1)
-            measurements += p.point_weight * len(points)
-        posts = [(post.x, post.y) for post in self.goal_post_percept.posts if math.isfinite(post.x) and math.isfinite(post.y)]
-        if posts:  # every post from every particle at once; each post's term added in turn, as one by one
-            seen = np.array(posts)
-            distances = FIELD_MODEL.post_distance(self.to_field(seen).reshape(-1, 2)).reshape(len(self.particles), len(posts))
-            for k, (x, y) in enumerate(posts):
-                log_weight += robust(distances[:, k] / self.post_std(x, y))
-            measurements += len(posts)
-        if self.line_percept.circle_seen and math.isfinite(self.line_percept.circle_x) and math.isfinite(self.line_percept.circle_y):
-            centre = self.to_field(np.array([[self.line_percept.circle_x, self.line_percept.circle_y]]))[:, 0]
-            log_weight += robust(np.linalg.norm(centre, axis=1) / p.circle_std)
-            measurements += 1
+        log_weight, measurements = log_likelihoods(self.particles, self.line_percept, self.goal_post_percept, p)
         if measurements == 0:
             return None
         fit = float(np.mean(np.exp(log_weight / measurements)))
-        log_weight += self.on_field_prior()
+        log_weight += on_field_prior(self.particles, p.outside_std)
         weights = np.exp(log_weight - log_weight.max())
         weights /= weights.sum()
         best = self.particles[int(np.argmax(weights))]
-        if 1.0 / np.sum(weights**2) < 0.5 * len(weights):
-            self.particles = self.particles[low_variance_indices(weights, self.rng)]
-            n = len(self.particles)
-            self.particles[:, :2] += self.rng.normal(0.0, p.roughening, (n, 2))
-            self.particles[:, 2] += self.rng.normal(0.0, p.roughening_rotation, n)
+        self.particles = resampled(self.particles, weights, p, self.rng)
         reference = self.reference()
         self.particles = fold(self.particles, reference)  # both twins' particles in one cloud
         self.best = fold(best[None, :], reference)[0]
@@ -294,29 +256,6 @@ class SelfLocator(Module):
         """The pose the particles are folded towards: the estimate, or before one the own half's middle."""
         return self.estimate if self.estimate is not None else np.array(OWN_HALF)
 
-    def on_field_prior(self) -> np.ndarray:
-        """Log-prior of each particle's place: a robot far beyond the lines is taken off by the referee, and
-        one beyond the carpet stands in the wall; so poses out there need much more evidence."""
-        outside = np.maximum(np.abs(self.particles[:, 0]) - field.LENGTH / 2, 0.0) + np.maximum(np.abs(self.particles[:, 1]) - field.WIDTH / 2, 0.0)
-        return -0.5 * (outside / self.parameters.outside_std) ** 2
-
-    def to_field(self, points: np.ndarray) -> np.ndarray:
-        """Robot-frame points (M x 2) as seen from every particle: (N x M x 2) field positions."""
-        return seen_from(self.particles, points)
-
-    def line_points(self) -> np.ndarray:
-        """This frame's line points (M x 2, robot mm), without the ones no camera sees (not finite, over 20 m)."""
-        points = np.asarray(self.line_percept.points, dtype=float).reshape(-1, 2)
-        return points[np.isfinite(points).all(axis=1) & (np.abs(points) < 20000.0).all(axis=1)]
-
-    def point_std(self, points: np.ndarray) -> np.ndarray:
-        """mm: each line point's noise, growing with its distance."""
-        return self.parameters.point_std + self.parameters.point_std_per_m * np.linalg.norm(points, axis=1) / 1000.0
-
-    def post_std(self, x: float, y: float) -> float:
-        """mm: a goal post's noise at (x, y) (robot mm), growing with its distance."""
-        return self.parameters.post_std + self.parameters.post_std_per_m * math.hypot(x, y) / 1000.0
-
     def reset_if_lost(self, fit: float) -> None:
         """Make part of the particles anew from the percepts while lost, or while the pose is not valid."""
         p = self.parameters
@@ -324,7 +263,7 @@ class SelfLocator(Module):
         self.fast += p.alpha_fast * (fit - self.fast) if self.fast else fit
         self.fit.add(fit)
         lost = self.fast < p.lost_ratio * self.slow
-        if not lost and not self.usable_percepts():
+        if not lost and not usable_percepts(self.line_percept, self.goal_post_percept):
             return  # guesses anywhere only while lost: elsewhere they spread a gathered cloud in frames that saw little
         # a few fresh particles a frame keep every pose that fits what is seen alive, and while the pose is
         # valid they watch for a carried robot: where they keep fitting better, they win the resampling
@@ -338,57 +277,17 @@ class SelfLocator(Module):
     def count_contradictions(self) -> None:
         """Count the frames in a row in which the centre circle or a goal post, seen from the estimate (moved by
         odometry), lies beyond 2.5 standard deviations of the circle's or the nearest post's place, many line
-        points (``WATCH_LINES_OFF``) lie that far off every line, or the ball seen lies that far from the team's
-        ball and from its mirror image: the robot may have been carried where the particles still half fit. A
-        frame that sees none of them leaves the count; one in which all agree starts it anew."""
-        p = self.parameters
+        points (``pose_measurements.WATCH_LINES_OFF``) lie that far off every line, or the ball seen lies that far
+        from the team's ball and from its mirror image (``contradictions``): the robot may have been carried where
+        the particles still half fit. A frame that sees none of them leaves the count; one in which all agree
+        starts it anew."""
         if self.estimate is None:
             return
-        pose, verdicts = Pose2D(*self.estimate), []
-        lines = self.line_percept
-        if lines.circle_seen and math.isfinite(lines.circle_x) and math.isfinite(lines.circle_y):
-            verdicts.append(math.hypot(*pose.to_global(lines.circle_x, lines.circle_y)) / p.circle_std >= 2.5)
-        for post in self.goal_post_percept.posts:
-            if math.isfinite(post.x) and math.isfinite(post.y):
-                place = np.array([pose.to_global(post.x, post.y)])
-                verdicts.append(float(FIELD_MODEL.post_distance(place)[0]) / self.post_std(post.x, post.y) >= 2.5)
-        points = self.line_points()
-        if len(points) >= WATCH_MIN_POINTS:
-            seen = seen_from(np.array([self.estimate]), points)
-            off = float(np.mean(FIELD_MODEL.line_distance(seen)[0] / self.point_std(points) >= 2.5))
-            if off >= WATCH_LINES_OFF or off <= WATCH_LINES_ON:  # in between, lines say nothing either way
-                verdicts.append(off >= WATCH_LINES_OFF)
-        ball_off = self.team_ball_off(pose)
-        if ball_off is not None and (ball_off[0] < 2.5 or min(ball_off) >= 2.5):  # near the mirror image: the side belief's matter
-            verdicts.append(min(ball_off) >= 2.5)
+        seen = ball_against_team(self.ball_percept, self.team_mates, self.parameters)
+        ball_off = team_ball_off(Pose2D(*self.estimate), self.ball_percept, seen)
+        verdicts = contradictions(self.estimate, self.line_percept, self.goal_post_percept, ball_off, self.parameters)
         if verdicts:
             self.contradicted = self.contradicted + 1 if any(verdicts) else 0
-
-    def team_ball_off(self, pose: Pose2D) -> tuple[float, float] | None:
-        """The ball seen this frame, placed on the field from ``pose``, against the team's ball and its mirror image
-        (the twin's view): the distances in standard deviations (as the side belief weighs them); None without
-        either ball. Far from both, the pose is wrong, not mirrored: a robot carried where the lines it looks at
-        (next to the ball) half fit the old place."""
-        seen = self.ball_against_team()
-        if seen is None:
-            return None
-        team, std = seen
-        x, y = pose.to_global(self.ball_percept.x, self.ball_percept.y)
-        return math.hypot(x - team.x, y - team.y) / std, math.hypot(x + team.x, y + team.y) / std
-
-    def ball_against_team(self) -> tuple[TeamBall, float] | None:
-        """The team's ball and the standard deviation (mm) of where the ball seen this frame may lie against it
-        (its own distance's error and the team ball's age); None without either ball."""
-        p, ball = self.parameters, self.ball_percept
-        team = self.team_mates.freshest_ball(p.team_ball_max_age)
-        if team is None or not (ball.seen and math.isfinite(ball.x) and math.isfinite(ball.y)):
-            return None
-        return team, p.team_ball_std + p.team_ball_std_per_m * math.hypot(ball.x, ball.y) / 1000.0 + p.team_ball_std_per_s * team.age
-
-    def usable_percepts(self) -> bool:
-        """Whether this frame saw something fresh poses can be made from: the circle, a post, a line segment."""
-        return bool(self.line_percept.circle_seen or self.goal_post_percept.posts
-                    or any(s.length >= 300.0 for s in self.line_percept.segments))
 
     # ---------------------------------------------------------------------------------- estimate
     def publish(self) -> None:
@@ -397,27 +296,23 @@ class SelfLocator(Module):
         # there: one frame's best can be a lone particle when little was seen, but after a kidnap the new
         # place gathers the particles
         centres = [c for c in (self.estimate, self.best) if c is not None] or [self.particles.mean(axis=0)]
-        near = max((self.near(c) for c in centres), key=np.count_nonzero)
-        cluster = self.particles[near] if near.sum() >= 3 else self.particles
+        around = max((near(self.particles, c) for c in centres), key=np.count_nonzero)
+        cluster = self.particles[around] if around.sum() >= 3 else self.particles
         previous = self.estimate
-        pose.x, pose.y = float(cluster[:, 0].mean()), float(cluster[:, 1].mean())
-        pose.rotation = float(math.atan2(np.sin(cluster[:, 2]).mean(), np.cos(cluster[:, 2]).mean()))
-        spread = np.hypot(cluster[:, 0] - pose.x, cluster[:, 1] - pose.y)
-        pose.deviation = float(math.sqrt(np.mean(spread**2)))
+        pose.x, pose.y, pose.rotation, pose.deviation, pose.rotation_deviation = mean_pose(cluster)
         self.estimate = np.array([pose.x, pose.y, pose.rotation])
-        pose.rotation_deviation = float(math.sqrt(max(0.0, -2.0 * math.log(max(1e-9, math.hypot(np.sin(cluster[:, 2]).mean(), np.cos(cluster[:, 2]).mean()))))))
         lost = bool(self.slow and self.fast < p.lost_ratio * self.slow)
         now = self.frame_info.time_s
         gathered = self.concentrated_since is not None
         keep = p.keep_share if gathered else 1.0  # gathered once, a frame that saw little does not undo it
         jumped = previous is not None and float(pose_distance(self.estimate[None, :], previous)[0]) > p.jump
-        if jumped or not (near.mean() >= p.valid_share * keep and pose.deviation <= p.valid_deviation / keep and not lost):
+        if jumped or not (around.mean() >= p.valid_share * keep and pose.deviation <= p.valid_deviation / keep and not lost):
             self.concentrated_since, self.evidence = None, set()
         elif self.concentrated_since is None:
             self.concentrated_since = now
         if self.concentrated_since is not None:
             self.decide_side(pose)
-            self.evidence |= self.evidence_seen(pose.rotation)
+            self.evidence |= evidence_seen(self.line_percept, self.goal_post_percept, pose.rotation)
         pose.valid = (self.concentrated_since is not None and now - self.concentrated_since >= p.confirm_after
                       and bool(self.evidence & {"circle", "post", "told"} or {"along", "across"} <= self.evidence)
                       and self.side.odds >= p.side_decided)
@@ -449,7 +344,7 @@ class SelfLocator(Module):
                 self.turn_to_twin(pose)  # old place (the anchor), which is tracked again; it must not flip
         odometry = (self.odometry.x, self.odometry.y, self.odometry.rotation)
         side.add_placement(self.estimate, odometry, p.placement_cap, p.placement_rate * p.placement_cap, p.side_cap)
-        seen = self.ball_against_team()
+        seen = ball_against_team(self.ball_percept, self.team_mates, p)
         if seen is not None:
             side.add_team_ball(self.estimate, (self.ball_percept.x, self.ball_percept.y), seen[0], seen[1], p.team_ball_rate,
                                p.team_message_cap, p.side_cap)
@@ -471,41 +366,3 @@ class SelfLocator(Module):
             self.best = twin(self.best)
         pose.x, pose.y, pose.rotation = float(self.estimate[0]), float(self.estimate[1]), float(self.estimate[2])
 
-    def near(self, centre: np.ndarray) -> np.ndarray:
-        """Which particles are within 600 mm and 0.6 rad of ``centre``."""
-        return (np.hypot(self.particles[:, 0] - centre[0], self.particles[:, 1] - centre[1]) < 600.0) & (
-            np.abs(np.remainder(self.particles[:, 2] - centre[2] + math.pi, math.tau) - math.pi) < 0.6)
-
-    def evidence_seen(self, rotation: float) -> set[str]:
-        """What this frame saw that pins a pose down: the circle, a post, lines along or across the field."""
-        seen = {"circle"} if self.line_percept.circle_seen else set()
-        if self.goal_post_percept.posts:
-            seen.add("post")
-        for segment in self.line_percept.segments:
-            if segment.length >= 300.0:
-                angle = abs(math.remainder(math.atan2(segment.y2 - segment.y1, segment.x2 - segment.x1) + rotation, math.pi))
-                seen.add("along" if angle < 0.35 else "across" if angle > math.pi / 2 - 0.35 else "slanted")
-        return seen
-
-
-def moved(pose: np.ndarray, forward: float, left: float, turn: float) -> np.ndarray:
-    """A field pose (x, y, rotation) after a step given in its own frame."""
-    return np.array(tuple(Pose2D(*pose) * Pose2D(forward, left, turn)))
-
-
-def robust(normalized: np.ndarray) -> np.ndarray:
-    """Log-likelihood of normalized errors, Gaussian near zero and flat beyond 2.5 standard deviations,
-    so that one wrong percept cannot wipe out the right particles."""
-    log = np.minimum(normalized, 2.5)  # -0.5 * min(...) ** 2, in place for arrays: the particles' largest
-    if not isinstance(log, np.ndarray):
-        return -0.5 * log**2
-    np.square(log, out=log)
-    log *= -0.5
-    return log
-
-
-def low_variance_indices(weights: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """Indices of a low-variance (systematic) resampling of normalized ``weights``."""
-    n = len(weights)
-    positions = (rng.random() + np.arange(n)) / n
-    return np.minimum(np.searchsorted(np.cumsum(weights), positions), n - 1)
