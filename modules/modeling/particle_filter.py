@@ -4,15 +4,22 @@ spread round a pose the robot was told, resampled by their weights, and summed u
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
 from tafel.representations import field
 from tafel.representations.geometry import Pose2D
 
-if TYPE_CHECKING:
-    from tafel.modules.modeling.self_locator import SelfLocator
+
+class FilterParameters(Protocol):
+    """What these functions read of SelfLocator.Parameters."""
+
+    rotation_noise: float
+    roughening: float  # mm
+    roughening_rotation: float  # rad
+    translation_noise: float
+
 
 KNOWN_POSE_STD, KNOWN_ROTATION_STD = 30.0, 0.03  # mm and rad: the particles' spread round a pose told (KnownPose)
 
@@ -30,7 +37,7 @@ def moved(pose: np.ndarray, forward: float, left: float, turn: float) -> np.ndar
     return np.array(tuple(Pose2D(*pose) * Pose2D(forward, left, turn)))
 
 
-def walk(particles: np.ndarray, forward: float, left: float, turn: float, p: SelfLocator.Parameters, rng: np.random.Generator) -> None:
+def walk(particles: np.ndarray, forward: float, left: float, turn: float, p: FilterParameters, rng: np.random.Generator) -> None:
     """Each particle (in place) moved by the step (``forward``, ``left``, ``turn``: the odometry's in the previous
     robot frame), with noise that grows with the motion."""
     n = len(particles)
@@ -59,7 +66,7 @@ def on_field_prior(particles: np.ndarray, outside_std: float) -> np.ndarray:
     return -0.5 * (outside / outside_std) ** 2
 
 
-def resampled(particles: np.ndarray, weights: np.ndarray, p: SelfLocator.Parameters, rng: np.random.Generator) -> np.ndarray:
+def resampled(particles: np.ndarray, weights: np.ndarray, p: FilterParameters, rng: np.random.Generator) -> np.ndarray:
     """The particles drawn anew by their normalized ``weights`` (low variance), roughened against their collapse onto
     a few, once the weights' effective number is below half the particles'; else the particles as they are."""
     if 1.0 / np.sum(weights**2) < 0.5 * len(weights):

@@ -5,7 +5,7 @@ team's ball against the ball seen, and what was seen that pins a pose down."""
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
@@ -15,15 +15,29 @@ from tafel.representations.geometry import Pose2D
 from tafel.representations.perception import BallPercept, GoalPostPercept, LinePercept
 from tafel.representations.team import TeamBall, TeamMates
 
-if TYPE_CHECKING:
-    from tafel.modules.modeling.self_locator import SelfLocator
+
+class MeasurementParameters(Protocol):
+    """What these functions read of SelfLocator.Parameters."""
+
+    circle_std: float
+    max_points: int
+    point_std: float  # mm
+    point_std_per_m: float  # mm per metre
+    point_weight: float
+    post_std: float
+    post_std_per_m: float
+    team_ball_max_age: float  # s
+    team_ball_std: float  # mm
+    team_ball_std_per_m: float  # mm per metre
+    team_ball_std_per_s: float  # mm per second
+
 
 WATCH_MIN_POINTS = 10  # line points a frame needs to say whether the lines fit the estimate ...
 WATCH_LINES_OFF = 0.2  # ... the share of them beyond 2.5 standard deviations that contradicts it (a robot carried where
 WATCH_LINES_ON = 0.1  # the old pose half fits: about a quarter), and the share at most that agrees (an accurate pose: 0)
 
 
-def log_likelihoods(particles: np.ndarray, lines: LinePercept, posts: GoalPostPercept, p: SelfLocator.Parameters
+def log_likelihoods(particles: np.ndarray, lines: LinePercept, posts: GoalPostPercept, p: MeasurementParameters
                     ) -> tuple[np.ndarray, float]:
     """Each particle's log-likelihood of this frame's percepts (line points, goal posts, the centre circle's centre),
     and how many full measurements they count as (0: nothing was seen)."""
@@ -68,18 +82,18 @@ def line_points(lines: LinePercept) -> np.ndarray:
     return points[np.isfinite(points).all(axis=1) & (np.abs(points) < 20000.0).all(axis=1)]
 
 
-def point_std(points: np.ndarray, p: SelfLocator.Parameters) -> np.ndarray:
+def point_std(points: np.ndarray, p: MeasurementParameters) -> np.ndarray:
     """mm: each line point's noise, growing with its distance."""
     return p.point_std + p.point_std_per_m * np.linalg.norm(points, axis=1) / 1000.0
 
 
-def post_std(x: float, y: float, p: SelfLocator.Parameters) -> float:
+def post_std(x: float, y: float, p: MeasurementParameters) -> float:
     """mm: a goal post's noise at (x, y) (robot mm), growing with its distance."""
     return p.post_std + p.post_std_per_m * math.hypot(x, y) / 1000.0
 
 
 def contradictions(estimate: np.ndarray, lines: LinePercept, posts: GoalPostPercept, ball_off: tuple[float, float] | None,
-                   p: SelfLocator.Parameters) -> list[bool]:
+                   p: MeasurementParameters) -> list[bool]:
     """For the centre circle, each goal post, the line points (``WATCH_MIN_POINTS`` at least) and the ball seen
     (``ball_off``: ``team_ball_off``), seen from the ``estimate``: whether it contradicts the estimate (lies beyond 2.5
     standard deviations of the circle's or the nearest post's place; ``WATCH_LINES_OFF`` of the points that far off
@@ -116,7 +130,7 @@ def team_ball_off(pose: Pose2D, ball: BallPercept, seen: tuple[TeamBall, float] 
     return math.hypot(x - team.x, y - team.y) / std, math.hypot(x + team.x, y + team.y) / std
 
 
-def ball_against_team(ball: BallPercept, team_mates: TeamMates, p: SelfLocator.Parameters) -> tuple[TeamBall, float] | None:
+def ball_against_team(ball: BallPercept, team_mates: TeamMates, p: MeasurementParameters) -> tuple[TeamBall, float] | None:
     """The team's ball and the standard deviation (mm) of where the ball seen this frame may lie against it
     (its own distance's error and the team ball's age); None without either ball."""
     team = team_mates.freshest_ball(p.team_ball_max_age)

@@ -6,15 +6,27 @@ of it (``fit_visible``)."""
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
 from tafel.modules.perception.ball_spots import Spot
 from tafel.modules.perception.pixel_statistics import byte_median, histogram_percentile
 
-if TYPE_CHECKING:
-    from tafel.modules.perception.spl_ball_detector import SPLBallDetector
+
+class CheckParameters(Protocol):
+    """What these functions read of SPLBallDetector.Parameters."""
+
+    black_contrast: float
+    dark_ratio: float
+    dark_share_max: float
+    dark_share_min: float
+    green_around_min: float
+    green_inside_max: float
+    post_share: float
+    post_white: float
+    saturation_max: float
+
 
 #: every byte's value (int64), to sum bytes from their histogram
 BYTE_VALUES = np.arange(256, dtype=np.int64)
@@ -27,8 +39,8 @@ HYPOT = np.hypot(np.arange(HYPOT_REACH, dtype=float)[None, :], np.arange(HYPOT_R
 LOOSER_TESTS = ("saturation", "dark", "black")
 
 
-def check(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: SPLBallDetector.Parameters, beside_post: bool = False,
-          parameters: SPLBallDetector.Parameters | None = None) -> tuple[float, bool]:
+def check(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: CheckParameters, beside_post: bool = False,
+          parameters: CheckParameters | None = None) -> tuple[float, bool]:
     """(0 if the spot is no ball, else a score in (0, 1]: how well it fits; whether a post rises over
     it). ``white``: the value (V) of the image's brightest non-green pixels. ``p``: the module's parameters.
     ``beside_post``: the spot was moved off a post already (its edge may still be in the way above).
@@ -37,8 +49,8 @@ def check(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: SPLBa
     return score, under
 
 
-def verdict(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: SPLBallDetector.Parameters, beside_post: bool = False,
-            parameters: SPLBallDetector.Parameters | None = None) -> tuple[float, bool, str]:
+def verdict(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: CheckParameters, beside_post: bool = False,
+            parameters: CheckParameters | None = None) -> tuple[float, bool, str]:
     """``check``'s (score, under a post) and the test a spot that is no ball failed (``LOOSER_TESTS``: one that the
     second look's thresholds loosen; "" for a ball)."""
     thresholds = parameters or p  # the post's test is the module's always
@@ -84,7 +96,7 @@ def verdict(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: SPL
     return float(min(1.0, 0.5 + dark + 0.3 * green_around - green_inside)), False, ""
 
 
-def under_post(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: SPLBallDetector.Parameters) -> bool:
+def under_post(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: CheckParameters) -> bool:
     """Whether ``post_columns`` flags the spot's own column (only that column measured)."""
     column = int(spot.x)
     x0, x1 = max(0, int(spot.x - 3 * spot.radius)), min(green.shape[1], int(spot.x + 3 * spot.radius) + 1)
@@ -99,7 +111,7 @@ def under_post(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: 
     return bool(np.count_nonzero(whites) / len(whites) >= p.post_share)
 
 
-def post_columns(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: SPLBallDetector.Parameters) -> tuple[int, np.ndarray]:
+def post_columns(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: CheckParameters) -> tuple[int, np.ndarray]:
     """(first column, flags): for the columns within three radii of the spot, whether something white
     rises above the spot's row there (a goal post, or a robot's leg), judged on the rows 1.5 to 4
     radii above it. White is measured against the brighter of ``white`` and the spot's own white: where the
@@ -116,7 +128,7 @@ def post_columns(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p
     return x0, whites.mean(axis=0) >= p.post_share
 
 
-def beside_post(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: SPLBallDetector.Parameters) -> Spot | None:
+def beside_post(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: CheckParameters) -> Spot | None:
     """Where a ball seen next to a post (partly behind it) has its centre. A post hides a vertical
     strip of it, so the row where the non-green run leaving the post's side is longest is the
     ball's centre row, and that run ends at its far edge, one radius from the centre."""

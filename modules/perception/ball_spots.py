@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import cv2
 import numpy as np
@@ -22,8 +22,19 @@ from tafel.modules.perception.pixel_statistics import (
 )
 from tafel.representations.field import BALL_RADIUS
 
-if TYPE_CHECKING:
-    from tafel.modules.perception.spl_ball_detector import SPLBallDetector
+
+class SpotParameters(Protocol):
+    """What these functions read of SPLBallDetector.Parameters."""
+
+    above_boundary: float  # px
+    black_contrast: float
+    dark_spot_min: float
+    max_spots: int
+    min_radius: float  # px
+    size_high: float
+    size_low: float
+    strict_saturation: float
+
 
 #: candidates after ``spots``' tests up to which the greedy choice among them runs as a Python loop
 #: (a frame mostly leaves a few dozen; beyond, numpy's calls on arrays cost less than the loop)
@@ -42,7 +53,7 @@ class Spot:
     """found by ``far_ball_spots.edge_spots`` (the field's edge, where the hall behind is)"""
 
 
-def spots(green: np.ndarray, boundary: np.ndarray, projection: ImageProjection, p: SPLBallDetector.Parameters,
+def spots(green: np.ndarray, boundary: np.ndarray, projection: ImageProjection, p: SpotParameters,
           dark: np.ndarray | None = None) -> list[Spot]:
     """Peaks of the non-green field's distance transform whose thickness fits a ball there (and, given
     ``dark``, the pixels darker than the carpet, with black patches near them)."""
@@ -113,7 +124,7 @@ def spots(green: np.ndarray, boundary: np.ndarray, projection: ImageProjection, 
 
 
 def chosen_spots(green: np.ndarray, xs: np.ndarray, ys: np.ndarray, radii: np.ndarray, expected: np.ndarray,
-                 p: SPLBallDetector.Parameters) -> list[Spot]:
+                 p: SpotParameters) -> list[Spot]:
     """``spots``' greedy choice over many peaks (each spot taken keeps the ones after it that are too close to it
     out, all at once)."""
     height, width = green.shape
@@ -219,7 +230,7 @@ def carpet(hsv: np.ndarray, green: np.ndarray, light: CarpetLight | None = None)
     return light.value, light.saturation
 
 
-def strict_green(hsv: np.ndarray, green: np.ndarray, p: SPLBallDetector.Parameters, sampled: CarpetLight | None = None) -> np.ndarray:
+def strict_green(hsv: np.ndarray, green: np.ndarray, p: SpotParameters, sampled: CarpetLight | None = None) -> np.ndarray:
     """The green mask without the pixels much less saturated than the carpet's median. ``sampled``:
     ``carpet_light(hsv, green)`` where it is at hand."""
     if not green.any():
@@ -235,7 +246,7 @@ def strict_green(hsv: np.ndarray, green: np.ndarray, p: SPLBallDetector.Paramete
     return green & ~below(hsv, 1, threshold)
 
 
-def dark_pixels(hsv: np.ndarray, green: np.ndarray, p: SPLBallDetector.Parameters, sampled: CarpetLight | None = None) -> np.ndarray | None:
+def dark_pixels(hsv: np.ndarray, green: np.ndarray, p: SpotParameters, sampled: CarpetLight | None = None) -> np.ndarray | None:
     """Pixels darker than ``black_contrast`` times the carpet's median value (the ball's black patches
     are); None without carpet to compare with. ``sampled``: ``carpet_light(hsv, green)`` where it is at hand."""
     if sampled is None:

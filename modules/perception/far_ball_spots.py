@@ -5,7 +5,7 @@ their halves)."""
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import cv2
 import numpy as np
@@ -15,8 +15,24 @@ from tafel.modules.perception.image_geometry import ImageProjection
 from tafel.modules.perception.pixel_statistics import below, white_pixels
 from tafel.representations.field import BALL_RADIUS
 
-if TYPE_CHECKING:
-    from tafel.modules.perception.spl_ball_detector import SPLBallDetector
+
+class EdgeParameters(Protocol):
+    """What these functions read of SPLBallDetector.Parameters."""
+
+    dark_spot_min: float
+    edge_above: int  # px
+    edge_below: int  # px
+    edge_black: float
+    edge_green_below: float
+    edge_max_radius: float  # px
+    edge_max_spots: int
+    edge_white: float
+    edge_white_halves: float
+    min_radius: float  # px
+    saturation_max: float
+    size_high: float
+    size_low: float
+
 
 #: px round a candidate of the band search that its checks look at: its thickness (a ball at most 14.5 px, from the
 #: distance transform of the pixels within 17 px), its black patches (a square of its thickness) and its centre
@@ -25,7 +41,7 @@ EDGE_REACH = 30
 
 
 def edge_spots(hsv: np.ndarray, green: np.ndarray, boundary: np.ndarray, projection: ImageProjection, carpet_value: float,
-               taken: list[Spot], p: SPLBallDetector.Parameters) -> list[Spot]:
+               taken: list[Spot], p: EdgeParameters) -> list[Spot]:
     """Far balls on the field's edge: there a ball reaches over the carpet into the hall, whose non-green merges with it
     in ``spots``' distance transform. In a band round the boundary only ball-coloured pixels count (white: brighter
     than the carpet, without colour; black: far darker than it), so the hall's middle greys part the ball from what
@@ -94,7 +110,7 @@ def edge_spots(hsv: np.ndarray, green: np.ndarray, boundary: np.ndarray, project
     return chosen
 
 
-def edge_window(boundary: np.ndarray, projection: ImageProjection, bottom: int, p: SPLBallDetector.Parameters
+def edge_window(boundary: np.ndarray, projection: ImageProjection, bottom: int, p: EdgeParameters
                 ) -> tuple[int, int, int]:
     """(first column, column after the last, row after the last) of the band (rows down to ``bottom``) round the part
     where a ball would be at most ``edge_max_radius`` px (nearer ones the candidates of the green find), with everything

@@ -5,7 +5,7 @@ means of strips of pixels and their medians, as numpy gives them for each post a
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import cv2
 import numpy as np
@@ -15,8 +15,18 @@ from tafel.modules.perception.image_geometry import ImageProjection
 from tafel.representations.field import GOAL_HEIGHT, GOAL_POST_DIAMETER
 from tafel.representations.perception import GoalPost
 
-if TYPE_CHECKING:
-    from tafel.modules.perception.goal_post_detector import GoalPostDetector
+
+class ShapeParameters(Protocol):
+    """What these functions read of GoalPostDetector.Parameters."""
+
+    contrast_min: float  # YCrCb
+    max_behind: float  # mm
+    min_height: float  # post widths
+    rise: float
+    uniform_max: float  # YCrCb
+    width_low: float
+    width_tolerance: float
+
 
 Rows = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 """rows of the image (``ys``), a post's centre column in each (``xs``) and the post's width (px) in each, the
@@ -24,7 +34,7 @@ posts' rows one post after the other; and how many rows each post has"""
 
 
 def shapes(camera: str, left: np.ndarray, right: np.ndarray, foot: np.ndarray, top: np.ndarray, projection: ImageProjection,
-           height: int, p: GoalPostDetector.Parameters) -> tuple[list[GoalPost | None], Rows, Rows]:
+           height: int, p: ShapeParameters) -> tuple[list[GoalPost | None], Rows, Rows]:
     """For the edges at columns ``left`` and ``right`` with a foot at row ``foot`` (the first rows of
     carpet below the boundary between them) whose band passed its checks, in an image ``height`` rows high:
     the post, if its width and height fit one, else None; and for those posts in turn the rows in which the
@@ -66,7 +76,7 @@ def shapes(camera: str, left: np.ndarray, right: np.ndarray, foot: np.ndarray, t
     return posts, rising, down
 
 
-def upright(rows: Rows, image: np.ndarray, white: Callable[[slice, slice], np.ndarray], p: GoalPostDetector.Parameters) -> np.ndarray:
+def upright(rows: Rows, image: np.ndarray, white: Callable[[slice, slice], np.ndarray], p: ShapeParameters) -> np.ndarray:
     """For each post's ``rows`` of ``image`` (RGB): the share of them in which its middle is white, of the
     post's colour (the median along those rows) and unlike at least one side (nan for a post without rows). All posts'
     rows at once: the strips' means from the integral of the block of rows and columns they lie in (their
