@@ -30,7 +30,7 @@ KEEPER_AREA_MARGIN = 150.0  # mm inside its penalty area's lines a goalkeeper is
 #: rad beside the heading beyond which the robot sees nothing (robots are seen within 100 degrees); mm a walk's target
 #: lies that way at most (with the walk's target_gain, 1.5/s: no faster than 70 mm/s, below the rules' pushing) when it
 #: is nearer than BLIND_TURN mm; farther, the robot is to face its way (the walk turns to it first, nearly in place:
-#: ``WalkingEngine``'s turn_first)
+#: ``WalkingEngine``'s turn_in_place_beyond)
 BLIND, BLIND_STEP, BLIND_TURN = math.radians(100.0), 45.0, 400.0
 POST_SEEN = 300.0  # mm round a goal post within which ObstacleModeler takes what is seen for the post (its post_radius)
 KICK_HELD_BACK = 30.0  # mm a walk's target may be held back from a robot (``keep_from_pushing``) and the walk kick still be asked for

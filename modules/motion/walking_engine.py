@@ -101,11 +101,11 @@ class WalkingEngine(Module):
         """1/s: walk_to speed per mm (and rad) still to go"""
         target_tolerance: float = bounded(5.0, 300.0, 40.0)
         """mm (and tolerance / 400 rad) within which walk_to has arrived"""
-        turn_first: float = bounded(0.5, math.pi, math.pi / 2)
+        turn_in_place_beyond: float = bounded(0.5, math.pi, math.pi / 2)
         """rad: a walk_to target far behind whose rotation differs more than this from the heading is turned to nearly
-        in place first (at most ``turn_first_step`` mm of it at a time), not walked to backwards and blind"""
-        turn_first_step: float = bounded(0.0, 400.0, 45.0)
-        """mm of a turn_first target's way walked to while turning"""
+        in place first (at most ``turn_in_place_step`` mm of it at a time), not walked to backwards and blind"""
+        turn_in_place_step: float = bounded(0.0, 400.0, 45.0)
+        """mm of the way to a target turned to in place (turn_in_place_beyond) walked while turning"""
         com_height: float = bounded(100.0, 500.0, 280.0)
         """mm of the centre of mass above the ground: turns the torso's tilt and its rate into where the body goes"""
         balance_x_gain: float = bounded(0.0, 3.0, 1.0)
@@ -294,8 +294,8 @@ class WalkingEngine(Module):
         distance = math.hypot(x, y)
         far = distance > 400.0  # far away: face the target first, then turn to its rotation
         heading = math.atan2(y, x) if far and x > -200 else turn
-        if far and x <= -200 and abs(turn) > p.turn_first:  # behind, to be faced: turn first (behind, nothing is seen)
-            x, y = x * p.turn_first_step / distance, y * p.turn_first_step / distance
+        if far and x <= -200 and abs(turn) > p.turn_in_place_beyond:  # behind, to be faced: turn first (behind, nothing is seen)
+            x, y = x * p.turn_in_place_step / distance, y * p.turn_in_place_step / distance
         return np.array([x, y, heading]) * p.target_gain, False
 
     def duration(self) -> float:

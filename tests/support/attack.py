@@ -263,5 +263,5 @@ def skip_without_headroom(unloaded: dict[str, float], load: str) -> None:
     own computing, whatever ``load`` does. The reason gives the rates."""
     short = {name: round(rate, 1) for name, rate in unloaded.items() if rate < BEATS.get(name, 0.0)}
     if short:
-        pytest.skip(f"this machine misses the loops' beat without {load} ({short} Hz, beats {BEATS}): "
-                    f"whether {load} slows them cannot be judged here")
+        pytest.skip(f"the program misses its beat on this machine ({short} Hz, beats {BEATS}): "
+                    f"its rates under {load} cannot be judged here")
