@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from websockets.exceptions import InvalidStatus
 
-from tests.support.attack import skip_without_headroom
+from tests.support.attack import loop_frames, skip_without_headroom
 from tests.support.foxglove_client import FoxgloveClient, ServiceCallFailure
 from tests.test_cli_runtime import tafel
 from tests.test_debug_server import Program
@@ -108,8 +108,7 @@ def test_with_everything_subscribed_the_loops_keep_their_rates(clients: tuple[Fo
     client, debug = clients
 
     def frames() -> tuple[float, dict[str, int]]:
-        counts = re.findall(r"\[(\w+)\]\nloop: [\d.]+ Hz, frame (\d+)", debug.ask("stopwatch:list"))
-        return time.monotonic(), {context: int(frame) for context, frame in counts}
+        return time.monotonic(), loop_frames(debug.ask("stopwatch:list"))
 
     def rates(seconds: float) -> dict[str, float]:
         start, first = frames()

@@ -21,7 +21,7 @@ import pytest
 from tafel.core.logs import read_log
 from tafel.core.logs.serialization import deserialize
 from tafel.representations.modeling import RobotPose
-from tests.support.attack import skip_without_headroom
+from tests.support.attack import loop_frames, skip_without_headroom
 from tests.support.browser import WebProgram, launch, missing_browser, open_page, wait_for
 
 pytestmark = [pytest.mark.slow, pytest.mark.skipif(missing_browser() is not None, reason=str(missing_browser()))]
@@ -197,8 +197,9 @@ def test_the_image_view_updates_at_least_ten_times_a_second(page: Any, program: 
     """Judged where the program keeps its cognition beat meanwhile (its own frame count): where the machine's cores
     are used up, fewer images are made to be drawn, whatever the page does."""
     def cognition_frame() -> int:
-        return int(re.search(r"\[cognition\]\nloop: [\d.]+ Hz, frame (\d+)", program.ask("stopwatch:list")).group(1))
+        return loop_frames(program.ask("stopwatch:list"))["cognition"]
 
+    wait_for(page, "tafel.state.images.top.drawn && tafel.state.images.bottom.drawn")  # the first images are in
     start = time.monotonic(), cognition_frame()
     before = page.evaluate("[tafel.state.images.top.drawn, tafel.state.images.bottom.drawn, performance.now()]")
     time.sleep(3.0)

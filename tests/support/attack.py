@@ -252,6 +252,11 @@ def rates_during(errors: list[str], seconds: float, forgive: int = 0) -> dict[st
     return {name: sorted(values[1:])[forgive] if len(values) > 1 + forgive else float("nan") for name, values in rates.items()}
 
 
+def loop_frames(stopwatches: str) -> dict[str, int]:
+    """Each context's frame count from ``stopwatch:list``'s answer (its ``[context]`` headings and ``loop:`` lines)."""
+    return {context: int(frame) for context, frame in re.findall(r"\[(\w+)\]\nloop: [\d.]+ Hz, frame (\d+)", stopwatches)}
+
+
 #: Hz each loop keeps on a machine with room for the program: the beats (100 and 30 Hz) less a little slack
 BEATS = {"motion": 95.0, "cognition": 28.0}
 
