@@ -18,6 +18,7 @@ def walking(*args: str) -> subprocess.CompletedProcess:
                           capture_output=True, text=True, timeout=120)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("setting", "message"), [
     ("parameters.WalkingEngine.foot_lfit=25", "WalkingEngine has no parameter 'foot_lfit'; did you mean 'foot_lift'?"),
     ("WalkingEngine.foot_lift=25", "[WalkingEngine] is not a section of the configuration"),

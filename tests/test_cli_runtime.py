@@ -30,6 +30,7 @@ def frames(output: str) -> dict[str, int]:
     return {name: int(n) for name, n in re.findall(r"^  (\w+): (\d+) frames", output, re.MULTILINE)}
 
 
+@pytest.mark.slow
 def test_dummy_run_gives_frame_counts_matching_the_rates() -> None:
     result = dummy("--frames", "1000", "--speed", "max")
     assert result.returncode == 0, result.stderr
@@ -52,18 +53,21 @@ def test_dummy_runs_are_deterministic() -> None:
     assert without_wall_time(other_seed.stdout) != without_wall_time(first.stdout)  # the digest depends on the data
 
 
+@pytest.mark.slow
 def test_rates_come_from_configuration() -> None:
     result = dummy("--frames", "200", "--speed", "max", "--set", "runtime.cognition_hz=10", "--set", "runtime.motion_hz=50")
     assert result.returncode == 0, result.stderr
     assert frames(result.stdout) == {"cognition": 40, "motion": 200}
 
 
+@pytest.mark.slow
 def test_seconds_limit_uses_platform_time() -> None:
     result = dummy("--seconds", "2", "--speed", "max")
     assert result.returncode == 0, result.stderr
     assert frames(result.stdout) == {"cognition": 60, "motion": 200}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("args", "message"),
     [
@@ -86,6 +90,7 @@ def test_wrong_names_and_arguments_exit_2_with_advice(args: list[str], message: 
     assert "Traceback" not in result.stderr
 
 
+@pytest.mark.slow
 def test_platforms_lists_what_each_provides_and_consumes() -> None:
     result = tafel("platforms")
     assert result.returncode == 0
@@ -117,6 +122,7 @@ def test_modules_dot_has_both_contexts_and_the_hand_over() -> None:
     assert '"cognition:HeadMotionRequest" -> "motion:HeadMotionRequest"' in result.stdout
 
 
+@pytest.mark.slow
 def test_module_exceptions_are_counted_and_the_loop_goes_on() -> None:
     result = dummy("--frames", "100", "--speed", "max", "--set",
                    'cognition.modules=["KalmanBallModeler", "LookAtBallBehavior", "Striker", "tests.support.runtime_faults:RaiseEveryFrame"]')
@@ -282,6 +288,7 @@ def test_context_processes_stop_when_the_supervisor_is_killed(tmp_path: Path) ->
     assert not left, "context processes outlived their supervisor"
 
 
+@pytest.mark.slow
 def test_a_taken_debug_port_is_an_error_not_a_silent_run_without_the_server() -> None:
     import socket
 
@@ -304,6 +311,7 @@ def test_a_debug_port_out_of_range_is_an_error(port: str) -> None:
     assert result.returncode == 2 and f"argument --debug-port: takes a port number from 0 to 65535 (0: any free one), got '{port}'" in result.stderr
 
 
+@pytest.mark.slow
 def test_a_requirement_nobody_provides_is_a_missing_provider_not_a_platform_gap() -> None:
     result = dummy("--frames", "10", "--set", 'cognition.modules=["LookAtBallBehavior"]', "--set", "cognition.providers={}")
     assert result.returncode == 2
@@ -318,6 +326,7 @@ def test_a_requirement_nobody_provides_is_a_missing_provider_not_a_platform_gap(
         or "BallDetector disabled: nothing provides CameraImageTop, CameraImageBottom on this platform" in gap.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("setting", "message"), [
     ("runtime.motion_hz=abc", "runtime.motion_hz takes a finite number of Hz above 0 and at most 1000, got 'abc'"),
     ("runtime.motion_hz=nan", "runtime.motion_hz takes a finite number of Hz above 0 and at most 1000, got nan"),
@@ -336,6 +345,7 @@ def test_set_is_validated_with_advice(setting: str, message: str) -> None:
     assert message in result.stderr and "Traceback" not in result.stderr
 
 
+@pytest.mark.slow
 def test_add_and_remove_module_edit_the_lists_without_restating_them() -> None:
     result = tafel("modules", "--platform", "dummy", "--remove-module", "cognition:LookAtBallBehavior",
                    "--add-module", "cognition:SimpleBallModeler")

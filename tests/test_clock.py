@@ -113,6 +113,7 @@ def test_simulated_images_are_taken_camera_latency_before_they_arrive() -> None:
         sim.close()
 
 
+@pytest.mark.slow
 def test_camera_latency_option_is_checked() -> None:
     result = dummy("--frames", "1")  # the dummy has no cameras: the option belongs to the simulators
     assert result.returncode == 0

@@ -87,6 +87,7 @@ def test_pretty_prints_nested_values() -> None:
     assert text == "value: 1.5"
 
 
+@pytest.mark.slow
 def test_console_completion_and_an_interactive_session() -> None:
     program = Program()
     try:
@@ -169,6 +170,7 @@ def test_console_ctrl_c_clears_the_line_and_ctrl_d_leaves() -> None:
         program.stop()
 
 
+@pytest.mark.slow
 def test_debug_data_is_recorded_like_representations(tmp_path) -> None:
     from tafel.core.logs import read_log
     from tafel.core.logs.serialization import deserialize

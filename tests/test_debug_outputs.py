@@ -165,6 +165,7 @@ def test_the_deprecated_free_functions_use_the_running_context_and_warn() -> Non
     assert isinstance(first.debug, DebugState)
 
 
+@pytest.mark.slow
 def test_tafel_modules_lists_every_modules_debug_outputs_before_anything_runs() -> None:
     from tests.test_cli_runtime import tafel
 

@@ -378,6 +378,7 @@ def test_concurrent_runtime_answers_commands_from_both_processes() -> None:
     assert concurrent.process.returncode == 0, err
 
 
+@pytest.mark.slow
 def test_console_runs_one_command_for_scripts(program: Program) -> None:
     ok = tafel("console", "--port", str(program.port), "-c", "ping")
     assert ok.returncode == 0 and ok.stdout == "pong\n"
@@ -387,6 +388,7 @@ def test_console_runs_one_command_for_scripts(program: Program) -> None:
     assert nobody.returncode == 2 and "cannot connect to 127.0.0.1:1" in nobody.stderr
 
 
+@pytest.mark.slow
 def test_the_listening_line_and_port_conflicts(program: Program) -> None:
     taken = tafel("run", "--platform", "dummy", "--frames", "10", "--speed", "max", "--debug-port", str(program.port))
     assert taken.returncode == 2 and f"debug port 127.0.0.1:{program.port} is taken" in taken.stderr

@@ -128,6 +128,7 @@ def test_a_full_disk_is_a_clear_error_and_changes_nothing(robot: dict, tmp_path:
     assert ((target / "current").resolve() if (target / "current").exists() else None) == before
 
 
+@pytest.mark.slow
 def test_a_robot_that_does_not_answer_is_a_clear_error(tmp_path: Path) -> None:
     (tmp_path / "robots.toml").write_text(f'[[robots]]\nname = "gone"\naddress = "127.0.0.1"\nport = {free_port()}\n'
                                           'dependencies = "robot"\n')

@@ -14,7 +14,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tafel.core import Module, ModuleManager, provides, representation
-from tafel.core.runtime.handover import HandoverError, LocalChannel, SharedChannel, apply_bundle, make_bundle, snapshot
+from tafel.core.framework.access import AccessMark, read_view
+from tafel.core.runtime.handover import HandoverError, LocalChannel, SharedChannel, apply_bundle, make_bundle, private_copy, snapshot
 
 
 @representation
@@ -125,6 +126,28 @@ def test_snapshots_do_not_change_with_the_producer() -> None:
     copy = snapshot(rep)
     rep.samples[0] = 5
     assert copy["samples"].tolist() == [1, 1, 1]
+
+
+@representation
+class HoSeen:
+    """A list of nested dataclasses, as the obstacle and teammate representations hold."""
+
+    robots: list[HoConsistent]
+
+
+def test_snapshots_of_nested_values_are_private_and_views_in_them_become_plain_copies() -> None:
+    """The pickle round trip of ``private_copy`` copies lists of dataclasses deeply; a read-only view a module
+    stored in its output (its class is made at run time, so pickle refuses it) falls back to ``deepcopy``."""
+    inner = HoConsistent(a=1, b=2, samples=np.ones(2, dtype=np.int64), label="1")
+    rep = HoSeen(robots=[inner, inner])
+    copied = snapshot(rep)["robots"]
+    inner.a, inner.samples[0] = 7, 9
+    assert [r.a for r in copied] == [1, 1] and copied[0].samples.tolist() == [1, 1]
+    assert copied[0] is copied[1]  # shared values stay shared, as with deepcopy
+    view = read_view(HoConsistent(a=3, b=6, samples=np.zeros(1, dtype=np.int64), label="3"), "M", AccessMark())
+    plain = private_copy([view])[0]
+    assert type(plain) is HoConsistent and plain.a == 3
+    plain.samples[0] = 1  # writeable: a private copy, not a view
 
 
 def test_oversized_bundles_are_refused_with_advice() -> None:

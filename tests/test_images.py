@@ -158,6 +158,7 @@ def test_bad_given_poses_say_what_is_expected(text: str) -> None:
         CameraPose.parse(text)
 
 
+@pytest.mark.slow
 def test_real_nao_images_run_through_the_whole_cognition(tmp_path: Path) -> None:
     log = tmp_path / "real.mcap"
     # HTWK's images carry no pose: the head pitch their ball's size implies is given on the command line
@@ -173,6 +174,7 @@ def test_real_nao_images_run_through_the_whole_cognition(tmp_path: Path) -> None
     assert any(c.camera == "top" and math.hypot(c.x - 282, c.y - 251) < 19 for c in percepts[1].candidates)  # the SPL ball detector ran
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("args", "message"), [
     (["--camera-pose", "tall"], "HEIGHT,PITCH,ROLL,YAW"),
     (["--camera", "left"], "invalid choice"),
@@ -183,6 +185,7 @@ def test_bad_image_options_are_clear_errors(args: list[str], message: str) -> No
     assert "Traceback" not in result.stderr
 
 
+@pytest.mark.slow
 def test_a_folder_without_images_is_a_clear_error(tmp_path: Path) -> None:
     (tmp_path / "notes.txt").write_text("no images here")
     result = tafel("run", "--platform", "video", "--source", str(tmp_path), "--no-debug")

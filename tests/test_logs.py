@@ -104,6 +104,7 @@ def test_a_plain_mcap_and_protobuf_reader_decodes_everything(recorded: Path, tmp
     assert report["decoded"]["/joints"] == 600 and report["decoded"]["/scene"] > 0  # Foxglove's channels decode too
 
 
+@pytest.mark.slow
 def test_log_info_summarises_the_recording(recorded: Path) -> None:
     result = tafel("log", "info", str(recorded))
     assert result.returncode == 0, result.stderr
@@ -140,6 +141,7 @@ def test_replace_feeds_a_recorded_representation_instead_of_its_module(recorded:
     assert original == again
 
 
+@pytest.mark.slow
 def test_log_platform_argument_errors(recorded: Path, tmp_path: Path) -> None:
     missing = tafel("run", "--platform", "log")
     assert missing.returncode == 2 and "needs a recording: tafel run --platform log --log FILE.mcap" in missing.stderr
@@ -149,6 +151,7 @@ def test_log_platform_argument_errors(recorded: Path, tmp_path: Path) -> None:
     assert absent.returncode == 1 and "nope.mcap" in absent.stderr and "Traceback" not in absent.stderr
 
 
+@pytest.mark.slow
 def test_foreign_and_missing_files_get_clear_errors(tmp_path: Path) -> None:
     foreign = tmp_path / "foreign.mcap"
     foreign.write_bytes(os.urandom(1000))
@@ -200,6 +203,7 @@ def test_sigkill_while_recording_loses_at_most_the_last_second(tmp_path: Path) -
     assert result.returncode == 0 and "recovered what was complete" in result.stdout
 
 
+@pytest.mark.slow
 def test_export_csv_and_jsonl(recorded: Path, tmp_path: Path) -> None:
     out = tmp_path / "ball.csv"
     result = tafel("log", "export", str(recorded), "--rep", "BallModel", "--format", "csv", "--out", str(out))
@@ -278,6 +282,7 @@ def test_concurrent_runs_record_into_one_file(tmp_path: Path) -> None:
     assert len(contents.frames("motion")) == 150 and len(contents.frames("cognition")) >= 30
 
 
+@pytest.mark.slow
 def test_good_magic_and_garbage_after_is_an_error_naming_file_and_byte(tmp_path: Path) -> None:
     garbage = tmp_path / "garbage.mcap"
     garbage.write_bytes(b"\x89MCAP0\r\n" + bytes(range(200, 256)) * 40)
@@ -345,6 +350,7 @@ def test_exporting_images_from_a_representation_without_images_is_an_error(recor
     assert "BallModel holds no image" in result.stderr and "--format csv" in result.stderr
 
 
+@pytest.mark.slow
 def test_the_summary_goes_to_one_stream_and_ran_is_the_length() -> None:
     result = dummy("--frames", "250", "--speed", "max")
     assert result.returncode == 0

@@ -111,7 +111,7 @@ def test_the_same_seed_plays_the_same_match(tmp_path: Path) -> None:
     for run in ("first", "second"):
         folder = tmp_path / run
         folder.mkdir()
-        result, done = match(folder, "--teams", "1v1", "--seconds", "2", "--cameras", "off", "--seed", "7", "--ready-seconds", "3",
+        result, done = match(folder, "--teams", "1v1", "--seconds", "2", "--halves", "1", "--cameras", "off", "--seed", "7", "--ready-seconds", "3",
                              "--record-dir", str(folder / "logs"), *LEAN)
         assert done.returncode == 0, done.stderr[-3000:]
         runs.append((result, [poses(folder / "logs" / f"team{t}_player1.mcap") for t in (1, 2)]))

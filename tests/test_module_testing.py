@@ -256,6 +256,7 @@ def test_replay_names_what_the_log_lacks() -> None:
     assert len(result.frames) == 15
 
 
+@pytest.mark.slow
 def test_log_slice_cuts_a_situation_that_replays_like_the_original(tmp_path) -> None:
     piece = tmp_path / "piece.mcap"
     done = tafel("log", "slice", str(SITUATION), "--out", str(piece), "--rep", "FrameInfo,BallImagePercept,CameraMatrixBuffer,BallPercept",

@@ -145,6 +145,7 @@ def test_malformed_packets_give_a_clear_error_and_a_safe_stop(tmp_path: Path) ->
     assert len(fake.answers) <= 52
 
 
+@pytest.mark.slow
 def test_a_missing_socket_is_a_clear_error(tmp_path: Path) -> None:
     result = run_nao(tmp_path / "nothing-here")
     assert result.returncode == 1

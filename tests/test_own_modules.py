@@ -112,6 +112,7 @@ def test_the_readme_module_example_runs_as_written(tmp_path: Path) -> None:
 
 
 # ------------------------------------------------------------------------------- --module-path DIR
+@pytest.mark.slow
 def test_without_the_module_path_the_module_is_unknown(own: tuple[Path, Path]) -> None:
     _, config = own
     result = tafel("modules", "--platform", "dummy", "--config", str(config))
@@ -119,6 +120,7 @@ def test_without_the_module_path_the_module_is_unknown(own: tuple[Path, Path]) -
     assert "BallSightingCounter" in result.stderr
 
 
+@pytest.mark.slow
 def test_modules_lists_a_module_from_a_folder_added_by_configuration(own: tuple[Path, Path]) -> None:
     modules, config = own
     result = tafel("modules", "--platform", "dummy", "--config", str(config), "--module-path", str(modules))
@@ -152,6 +154,7 @@ def test_a_run_loads_the_folder_and_records_the_modules_representation(own: tupl
     assert all(row["context"] == "cognition" for row in rows)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("files", "message"), [
     ({}, "holds no Python files"),
     ({"broken.py": "x = 1\ny = (\n"}, r"importing broken failed \(at .*broken.py:2\): SyntaxError"),
@@ -168,6 +171,7 @@ def test_a_folder_that_cannot_be_loaded_says_why(tmp_path: Path, files: dict[str
     assert re.search(message, result.stderr), result.stderr
 
 
+@pytest.mark.slow
 def test_a_missing_folder_is_an_error(tmp_path: Path) -> None:
     result = tafel("modules", "--platform", "dummy", "--module-path", str(tmp_path / "nowhere"))
     assert result.returncode == 2
@@ -203,6 +207,7 @@ def test_a_broken_entry_point_is_reported_and_does_not_stop_other_programs(tmp_p
 
 
 # --------------------------------------------------------------------------- configuration edits
+@pytest.mark.slow
 def test_a_misspelt_module_added_in_configuration_suggests_the_right_name(own: tuple[Path, Path]) -> None:
     modules, config = own
     (config / "general.toml").write_text('[cognition]\nadd = ["BallSightingCountr"]\n')
@@ -211,6 +216,7 @@ def test_a_misspelt_module_added_in_configuration_suggests_the_right_name(own: t
     assert "did you mean 'BallSightingCounter'" in result.stderr
 
 
+@pytest.mark.slow
 def test_configuration_removes_a_shipped_module_without_restating_the_list(tmp_path: Path) -> None:
     (tmp_path / "general.toml").write_text('[cognition]\nremove = ["GameControllerReporter"]\n')
     result = tafel("modules", "--platform", "dummy", "--config", str(tmp_path))
@@ -285,6 +291,7 @@ def test_replay_batch_replays_with_a_module_of_ones_own(tmp_path: Path) -> None:
     assert "1234 replayed" in done.stdout  # the mean of BallModel.x over the replay: the module's ball
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("command", "arguments", "message"), [
     ("replay-batch", ["--module-path", "nowhere"], "nowhere: no such folder; give the folder that holds your module files"),
     ("replay-batch", ["--add-module", "cognition:BallSightingCountr"], "unknown module 'BallSightingCountr': did you mean 'BallSightingCounter'"),

@@ -77,6 +77,7 @@ def test_a_stale_file_is_cleared_and_a_missing_one_is_fine(tmp_path: Path) -> No
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("concurrent", [False, True], ids=["lockstep", "concurrent"])
 def test_a_running_program_writes_its_pid_and_tells_systemd(concurrent: bool, tmp_path: Path,
                                                             notify_socket: tuple[str, socket.socket]) -> None:
@@ -101,6 +102,7 @@ def test_a_running_program_writes_its_pid_and_tells_systemd(concurrent: bool, tm
     assert "cognition:" in out and "motion:" in out
 
 
+@pytest.mark.slow
 def test_a_program_that_cannot_start_removes_a_stale_file_and_reports_nothing(tmp_path: Path,
                                                                                 notify_socket: tuple[str, socket.socket]) -> None:
     address, listener = notify_socket

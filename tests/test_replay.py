@@ -69,6 +69,7 @@ def test_compare_errors_name_what_is_wrong(tmp_path: Path) -> None:
     assert wrong.returncode == 2 and "did you mean 'BallModel'" in wrong.stderr
 
 
+@pytest.mark.slow
 def test_compare_reports_frames_present_in_one_log_only(tmp_path: Path) -> None:
     short, long = tmp_path / "short.mcap", tmp_path / "long.mcap"
     assert dummy("--frames", "100", "--speed", "max", "--record", str(short)).returncode == 0

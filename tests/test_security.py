@@ -207,6 +207,7 @@ def test_the_token_comes_from_a_file_and_never_shows_in_ps(tmp_path: Path) -> No
         running.stop()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("how", ["option", "file"])
 def test_an_empty_token_is_refused_at_start(tmp_path: Path, how: str) -> None:
     empty = tmp_path / "empty"
@@ -255,6 +256,15 @@ def test_listening_beyond_loopback_without_a_token_warns(tmp_path: Path) -> None
 
 
 # ------------------------------------------------------------------------------- values from clients
+@pytest.fixture(scope="module")
+def refusing_program(tmp_path_factory: pytest.TempPathFactory):
+    """One program for every refused value below: a refusal changes nothing, so they share it, and the
+    program has to come through all of them in a row."""
+    running = Program("--platform", "dummy", cwd=tmp_path_factory.mktemp("refusing"))
+    yield running
+    running.stop()
+
+
 @pytest.mark.parametrize("line, expected", [
     ("representation:set -name JointCommand -field position -value [1,2,3]", "JointCommand.position takes an array of shape 25"),
     ("representation:set -name JointCommand -field stiffness -value " + json.dumps([float("nan")] * 25).replace(" ", ""),
@@ -268,8 +278,8 @@ def test_listening_beyond_loopback_without_a_token_warns(tmp_path: Path) -> None
     ("parameter:set -module HeadMotion -name max_speed -value -1", "max_speed takes a finite number from 0.1 to 10, got '-1'"),
     ("parameter:set -module HeadMotion -name max_speed -value fast", "max_speed takes a finite number from 0.1 to 10, got 'fast'"),
 ])
-def test_values_that_do_not_fit_their_field_are_refused_and_change_nothing(program: Program, line: str, expected: str) -> None:
-    with program.client() as client:
+def test_values_that_do_not_fit_their_field_are_refused_and_change_nothing(refusing_program: Program, line: str, expected: str) -> None:
+    with refusing_program.client() as client:
         before = client.ask("representation:print JointCommand")
         answer = client.ask(line)
         assert answer.startswith("error:") and expected in answer, answer
@@ -511,6 +521,7 @@ def test_the_default_simulation_holds_its_rates_under_every_attack_at_once(tmp_p
 
 
 # ------------------------------------------------------------------------- configuration, command line
+@pytest.mark.slow
 @pytest.mark.parametrize("args, message", [
     (["--set", "runtime.motion_hz=abc"], "runtime.motion_hz takes a finite number of Hz above 0 and at most 1000, got 'abc'"),
     (["--set", "runtime.motion_hz=nan"], "runtime.motion_hz takes a finite number of Hz above 0 and at most 1000, got nan"),
@@ -531,6 +542,7 @@ def test_wrong_values_on_the_command_line_exit_2_with_what_would_be_right(tmp_pa
     assert message in result.stderr and "Traceback" not in result.stderr, result.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("content, message", [
     (b'a = "\xff\xfe"\n', "not UTF-8 text (byte 5 is 0xff); TOML files must be saved as UTF-8"),
     (b"a = " + b"[" * 5000 + b"]" * 5000 + b"\n", "nested too deeply to be configuration"),

@@ -230,6 +230,7 @@ def test_viewer_without_a_display_says_so_and_runs_headless(engine: str) -> None
     assert "--viewer needs a display" in result.stderr
 
 
+@pytest.mark.slow
 def test_concurrent_is_refused_with_a_reason(engine: str) -> None:
     result = tafel("run", "--platform", engine, "--concurrent", "--frames", "10", "--no-debug")
     assert result.returncode == 1 and "run it without --concurrent" in result.stderr
@@ -340,6 +341,7 @@ def test_a_ball_shot_into_either_goal_stops_in_its_net(engine: str) -> None:
         world.close()
 
 
+@pytest.mark.slow
 def test_importing_pybullet_prints_nothing() -> None:
     result = subprocess.run([sys.executable, "-c", "import tafel.platforms.pybullet_sim; print('imported')"],
                             cwd=REPO, capture_output=True, text=True, timeout=120, env={**os.environ, "PYTHONPATH": str(REPO)})

@@ -36,6 +36,7 @@ def video(tmp_path_factory) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_the_detector_reports_the_ball_frame_by_frame(video: Path, tmp_path: Path) -> None:
     log = tmp_path / "video.mcap"
     result = tafel("run", "--platform", "video", "--source", str(video), "--fps", "200", "--no-debug",
@@ -55,6 +56,7 @@ def test_the_detector_reports_the_ball_frame_by_frame(video: Path, tmp_path: Pat
         assert times[frame] == (frame - 1) * 5_000_000  # frame time from the playback rate (--fps 200)
 
 
+@pytest.mark.slow
 def test_modules_that_need_more_than_an_image_are_pruned_with_a_report(video: Path) -> None:
     result = tafel("run", "--platform", "video", "--source", str(video), "--fps", "200", "--no-debug")
     assert result.returncode == 0, result.stderr
@@ -76,6 +78,7 @@ def test_the_file_plays_at_its_own_rate_and_loops(video: Path) -> None:
     assert frames > FRAMES
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("source", "message"),
     [

@@ -41,8 +41,17 @@ def snapshot(instance: Any) -> dict[str, Any]:
         elif isinstance(value, (int, float, str, bytes, bool)) or value is None:
             values[name] = value
         else:
-            values[name] = copy.deepcopy(value)
+            values[name] = private_copy(value)
     return values
+
+
+def private_copy(value: Any) -> Any:
+    """A deep copy of a list, dict or nested dataclass. A pickle round trip copies such values several
+    times faster than ``copy.deepcopy`` (in C, not call by call); what pickle refuses is deep-copied."""
+    try:
+        return pickle.loads(pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL))
+    except (pickle.PicklingError, TypeError, AttributeError):
+        return copy.deepcopy(value)
 
 
 @dataclass(frozen=True)
