@@ -1,5 +1,5 @@
 """No pushing (issue 32, the rule book's "Player Pushing": a robot whose torso approaches a touching
-opponent faster than 80 mm/s over 0.5 s): ``SoccerBehavior.keep_from_pushing`` holds a walk's target back
+opponent faster than 80 mm/s over 0.5 s): ``keep_from_pushing`` (``modules/behavior/fair_walk.py``) holds a walk's target back
 from every robot, the striker does not walk backwards to the ball nor to one the own goalkeeper plays, and
 ``ObstacleModeler`` keeps an opponent beside a teammate. Checked through the mocked blackboard, with the walk as a simple kinematic model (the
 walking engine's ``target_gain``, speed and acceleration limits) and the referee's measure of an approach;
