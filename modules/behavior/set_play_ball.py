@@ -1,5 +1,6 @@
 """Where SoccerBehavior knows the ball to be when nobody of the team sees it: a teammate's ball (``team_ball``), and
-at the opponents' set play, where the rules put it (``placed_ball``) until it is seen again (``set_play_balls``).
+at the opponents' set play (noted by ``note_set_play``), where the rules put it (``placed_ball``) until it is seen
+again (``set_play_balls``).
 Field mm, the own goal at -x."""
 
 from __future__ import annotations
@@ -8,7 +9,7 @@ import math
 from typing import Protocol
 
 from tafel.representations import field as pitch
-from tafel.representations.game import SetPlay
+from tafel.representations.game import GameState, SetPlay
 from tafel.representations.infrastructure import FrameInfo
 from tafel.representations.modeling import BallModel, RobotPose
 from tafel.representations.team import TeamMates
@@ -25,17 +26,30 @@ class SetPlayBallParameters(Protocol):
     team_ball_age: float
 
 
-class SetPlayWatcher(Protocol):
-    """What ``set_play_balls`` reads of SoccerBehavior: the representations and the set play it noted."""
+class NotedSetPlay(Protocol):
+    """The opponents' set play SoccerBehavior noted (``note_set_play``), and the clock and ball it went by."""
 
-    ball_model: BallModel
-    robot_pose: RobotPose
-    team_mates: TeamMates
     frame_info: FrameInfo
     set_play: tuple[SetPlay, int] | None
     set_play_s: float
     set_play_spots: list[tuple[float, float]]
     last_ball: tuple[float, float] | None
+
+
+class SetPlayNoter(NotedSetPlay, Protocol):
+    """What ``note_set_play`` reads of SoccerBehavior beside what it notes."""
+
+    game_state: GameState
+
+    def opponents_set_play(self) -> bool: ...
+
+
+class SetPlayWatcher(NotedSetPlay, Protocol):
+    """What ``set_play_balls`` reads of SoccerBehavior: the representations and the set play it noted."""
+
+    ball_model: BallModel
+    robot_pose: RobotPose
+    team_mates: TeamMates
 
     @property
     def parameters(self) -> SetPlayBallParameters: ...
@@ -62,6 +76,16 @@ def placed_ball(set_play: SetPlay, last: tuple[float, float] | None) -> list[tup
     if set_play is SetPlay.kick_in:
         return [(max(-pitch.LENGTH / 2, min(pitch.LENGTH / 2, x)), math.copysign(pitch.WIDTH / 2, y))]
     return [last]
+
+
+def note_set_play(b: SetPlayNoter) -> None:
+    """An opponents' set play that begins: when, and where the rules put the ball (``placed_ball``), from where
+    it was last known (before this frame: where it went out)."""
+    game = b.game_state
+    now = (game.set_play, game.kicking_team) if b.opponents_set_play() else None
+    if now != b.set_play:
+        b.set_play, b.set_play_s = now, b.frame_info.time_s
+        b.set_play_spots = placed_ball(game.set_play, b.last_ball) if now is not None else []
 
 
 def team_balls(team_mates: TeamMates) -> list[tuple[float, tuple[float, float]]]:

@@ -6,20 +6,21 @@ the parameters and the helpers below."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 from tafel.core import Module, bounded, fields_of, provides, requires, uses
 from tafel.debug import Canvas, DebugRequest
 from tafel.modules.behavior.ball_search import SearchTurn
 from tafel.modules.behavior.fair_walk import avoid, keep_from_pushing, stay_on_field
 from tafel.modules.behavior.holding_back import contested, hold_point, keeper_plays
-from tafel.modules.behavior.kick_choice import indirect_direction, seen_opponents
-from tafel.modules.behavior.kicking import KickParameters, goal_direction, kick_tuning
+from tafel.modules.behavior.kick_choice import kick_plan
+from tafel.modules.behavior.kicking import KickParameters, kick_tuning
 from tafel.modules.behavior.options import OptionRunner
 from tafel.modules.behavior.options.soccer import FREE_KICKS, OWN_GOAL_X, PlaySoccer
-from tafel.modules.behavior.passing import PassParameters, best_shot, choose_pass, pass_kick
+from tafel.modules.behavior.passing import PassParameters
 from tafel.modules.behavior.paths import Disc
-from tafel.modules.behavior.set_play_ball import OPPONENT_PENALTY_MARK_X, placed_ball, set_play_balls, team_ball
+from tafel.modules.behavior.set_play_ball import OPPONENT_PENALTY_MARK_X, note_set_play, set_play_balls, team_ball
+from tafel.modules.behavior.set_play_ball import placed_ball as placed_ball  # the tests import it from here
 from tafel.representations import field as pitch
 from tafel.representations.behavior import ActivationGraph, OptionGraph
 from tafel.representations.game import GameState, SetPlay
@@ -191,7 +192,7 @@ class SoccerBehavior(Module):
             self.option_graph.root, self.option_graph.options = graph.root, graph.options
         busy = {info.name: getattr(out, info.name) for info in fields_of(MotionRequest)} if self.motion_info.busy else None
         self.keep_out, self.indirect = [], False
-        self.note_set_play()
+        note_set_play(self)
         self.last_ball = self.ball_on_field() or self.last_ball
         if self.ball_model.valid:
             self.ball_search.found()
@@ -239,15 +240,6 @@ class SoccerBehavior(Module):
         ball, pose = self.ball_model, self.robot_pose
         return ball.field_position(pose) if ball.valid and pose.valid else team_ball(self.team_mates, self.parameters.team_ball_age)
 
-    def note_set_play(self) -> None:
-        """An opponents' set play that begins: when, and where the rules put the ball (``placed_ball``), from where
-        it was last known (before this frame: where it went out)."""
-        game = self.game_state
-        now = (game.set_play, game.kicking_team) if self.opponents_set_play() else None
-        if now != self.set_play:
-            self.set_play, self.set_play_s = now, self.frame_info.time_s
-            self.set_play_spots = placed_ball(game.set_play, self.last_ball) if now is not None else []
-
     def set_play_balls(self) -> list[tuple[float, float]]:
         """Where the ball of the opponents' set play is (field mm; ``set_play_ball.set_play_balls``)."""
         return set_play_balls(self)
@@ -267,33 +259,8 @@ class SoccerBehavior(Module):
         return math.atan2(by - y, bx - x)
 
     def kick_plan(self) -> tuple[float, KickParameters, WalkKick]:
-        """The kick this frame (``passing``): the direction (rad, robot frame), the kick's parameters (tuned live)
-        and the walk kick's strength. A shot aims through the goal mouth's most open lane; a pass (by the pass
-        rule) goes to the point ahead of the teammate, by the walk kick its distance asks for (beyond it the
-        keyframe kick). The choice is kept ``pass_decide_s``; an own free kick is indirect; without a pose,
-        the goal's way by odometry."""
-        ball, pose, p = self.ball_model, self.robot_pose, self.parameters
-        tuned = self.kick_tuning.apply(p)
-        if self.indirect:
-            return indirect_direction(ball, pose, self.odometry, p.indirect_target), tuned, WalkKick.long
-        if not pose.valid:
-            return goal_direction(ball, pose, self.odometry), tuned, WalkKick.long
-        bx, by = ball.field_position(pose)
-        now = self.frame_info.time_s
-        if self.aim is None or now - self.aim_s >= p.pass_decide_s or now < self.aim_s:
-            mates = [(m.message.x, m.message.y) for m in self.team_mates.fresh(p.pass_mate_age)
-                     if m.message.pose_valid and not (m.message.fallen or m.message.penalized)]
-            opponents = seen_opponents(self)
-            target = choose_pass((bx, by), mates, opponents, p)
-            self.aim, self.aim_is_pass, self.aim_s = target or best_shot((bx, by), opponents, p)[0], target is not None, now
-        ax, ay = pose.to_robot(*self.aim)
-        direction = math.atan2(ay - ball.y, ax - ball.x)
-        if not self.aim_is_pass:
-            return direction, tuned, WalkKick.long
-        strength = pass_kick(math.hypot(ax - ball.x, ay - ball.y), p)
-        if strength is WalkKick.none:  # farther than the walk kicks go: the keyframe kick
-            return direction, replace(tuned, walk_kick=False), WalkKick.long
-        return direction, replace(tuned, walk_kick=True), strength
+        """The kick this frame, a shot or a pass, with the kick's parameters tuned live (``kick_choice.kick_plan``)."""
+        return kick_plan(self, self.parameters, self.kick_tuning.apply(self.parameters))
 
     def keeper_clears(self) -> bool:
         """Whether the ball is in the own penalty area and near enough for the goalkeeper to clear it."""
