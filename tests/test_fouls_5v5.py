@@ -7,7 +7,8 @@ import math
 
 from tafel.core.testing import ModuleHarness
 from tafel.modules.behavior.options.soccer import FREE_KICK_DISTANCE
-from tafel.modules.behavior.soccer_behavior import SoccerBehavior, placed_ball
+from tafel.modules.behavior.set_play_ball import placed_ball
+from tafel.modules.behavior.soccer_behavior import SoccerBehavior
 from tafel.representations import field as pitch
 from tafel.representations.game import GameState, RobotInfo, SetPlay, State, TeamInfo
 from tafel.representations.modeling import BallModel, RobotPose

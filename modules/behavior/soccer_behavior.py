@@ -20,7 +20,6 @@ from tafel.modules.behavior.options.soccer import FREE_KICKS, OWN_GOAL_X, PlaySo
 from tafel.modules.behavior.passing import PassParameters
 from tafel.modules.behavior.paths import Disc
 from tafel.modules.behavior.set_play_ball import OPPONENT_PENALTY_MARK_X, note_set_play, set_play_balls, team_ball
-from tafel.modules.behavior.set_play_ball import placed_ball as placed_ball  # the tests import it from here
 from tafel.representations import field as pitch
 from tafel.representations.behavior import ActivationGraph, OptionGraph
 from tafel.representations.game import GameState, SetPlay
