@@ -34,6 +34,7 @@ from tafel.debug.session import (
     MAX_BYTES_PER_FRAME,
     MAX_CONNECTIONS,
     MAX_OUTPUT,
+    NETWORK_S_PER_FRAME,
     RESOURCE_LOG_INTERVAL,
     Session,
     _Connection,
@@ -64,6 +65,9 @@ class DebugServer:
         self.refused = 0  # connections refused over the limit
         self._frame: asyncio.Event | None = None  # set (and replaced) when a frame starts, for throttled clients
         self._throttled = 0
+        self._frames = 0  # frames started: the owning thread counts, the network thread reads
+        self._spent_frame = 0  # the frame ``_spent_s`` belongs to
+        self._spent_s = 0.0  # network thread's time on lines in that frame
         self._resource_errors = 0
         self._resource_logged_at = 0.0  # monotonic s of the last line about them
         # queue.Queue, not SimpleQueue: in Python 3.11 a signal that arrives during SimpleQueue.get(timeout)
@@ -204,8 +208,17 @@ class DebugServer:
         finally:
             self._throttled -= 1
 
+    def spend_network_time(self, seconds: float) -> bool:
+        """Network thread: count ``seconds`` spent on lines in this frame; True once its share (``NETWORK_S_PER_FRAME``)
+        is used up, and the client should wait for the next frame."""
+        if self._spent_frame != self._frames:
+            self._spent_frame, self._spent_s = self._frames, 0.0
+        self._spent_s += seconds
+        return self._spent_s > NETWORK_S_PER_FRAME
+
     def next_frame(self) -> None:
         """A frame starts: clients that used up their bytes may be read again. Costs nothing when none did."""
+        self._frames += 1
         loop = self._loop
         if self._throttled and loop is not None:
             loop.call_soon_threadsafe(self._wake_throttled)

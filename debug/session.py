@@ -27,6 +27,9 @@ MAX_OUTSTANDING = 2000  # open commands per connection before it is read no more
 MAX_OUTPUT = 8 << 20  # unsent answer bytes per connection before it is dropped
 MAX_CONNECTIONS = 32  # connections served at once; more get one error line and are closed
 MAX_BYTES_PER_FRAME = 64 * 1024  # bytes read from one client per frame; it waits for the next frame beyond
+#: s of the network thread's time for handling lines, all clients together, per frame; beyond, they wait for the next
+#: frame. Lines run there hold the interpreter lock the loops need: ping, help and refusals are answered at once.
+NETWORK_S_PER_FRAME = 0.0005
 FRAME_WAIT = 0.05  # s a throttled client waits at most when no frame comes (a paused or ended loop)
 AUTH_PER_SECOND = 5  # auth attempts per connection and second; more are answered later
 AUTH_FAILURES = 20  # wrong tokens before the connection is closed
@@ -91,6 +94,9 @@ class SessionHost(Protocol):
     async def next_frame_started(self) -> None:
         """Returns when the next frame of the owning thread starts (or after ``FRAME_WAIT``)."""
 
+    def spend_network_time(self, seconds: float) -> bool:
+        """Count ``seconds`` the network thread spent on lines this frame; True when the frame's share is used up."""
+
 
 class Session:
     """One client of the debug server, whatever carries its lines (TCP, a WebSocket).
@@ -109,6 +115,7 @@ class Session:
         self.answers: dict[int, bytes] = {}
         self.outstanding = 0
         self.room = asyncio.Event()
+        self.frame_bytes = 0  # read in the current frame
         self.closed = False
         self.reading_done = False
         self.auth_times: deque[float] = deque(maxlen=AUTH_PER_SECOND)
@@ -131,6 +138,21 @@ class Session:
         while self.outstanding > MAX_OUTSTANDING and not self.closed:
             self.room.clear()
             await self.room.wait()
+
+    async def handle_lines(self, lines: list[bytes | None], size: int) -> None:
+        """The lines of one read of ``size`` bytes, then the read's pacing: wait while too many of this client's
+        commands are open, and for the next frame when it used up its bytes for this frame or all clients
+        together used up the network thread's share of it."""
+        start = time.perf_counter()
+        for line in lines:
+            await self.pace_auth(line)
+            self.handle_line(line)
+        used_up = self.server.spend_network_time(time.perf_counter() - start)
+        await self.wait_for_room()
+        self.frame_bytes += size
+        if used_up or self.frame_bytes > self.server.max_bytes_per_frame:
+            await self.server.next_frame_started()  # read no further from it this frame
+            self.frame_bytes = 0
 
     def handle_line(self, raw: bytes | None) -> None:
         """One line from the client (None: it was too long)."""
@@ -262,7 +284,6 @@ class _Connection(Session):
     def __init__(self, server: SessionHost, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         super().__init__(server, writer.get_extra_info("peername"))
         self.reader, self.writer = reader, writer
-        self.frame_bytes = 0  # read in the current frame
         self.head = b""  # the connection's first bytes, until they tell whether it speaks HTTP
         self.head_checked = False
 
@@ -276,14 +297,7 @@ class _Connection(Session):
                     break
                 if not self.head_checked and self._refuse_http(data):
                     return
-                for line in decoder.feed(data):
-                    await self.pace_auth(line)
-                    self.handle_line(line)
-                await self.wait_for_room()
-                self.frame_bytes += len(data)
-                if self.frame_bytes > self.server.max_bytes_per_frame:
-                    await self.server.next_frame_started()  # read no further from it this frame
-                    self.frame_bytes = 0
+                await self.handle_lines(list(decoder.feed(data)), len(data))
         except (ConnectionError, asyncio.IncompleteReadError):
             self.drop()
             return

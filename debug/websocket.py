@@ -86,21 +86,14 @@ class WebSocketSession(Session):
         self.skipped = 0  # streamed messages replaced before they went out, because of the topic's -hz
         self.sent = 0
         self.wake = asyncio.Event()
-        self.frame_bytes = 0
 
     async def serve(self) -> None:
         writer = asyncio.create_task(self._pump())
         try:
             async for message in self.connection:
                 data = message.encode() if isinstance(message, str) else message
-                for line in data.splitlines() or [b""]:
-                    await self.pace_auth(line)
-                    self.handle_line(line if len(line) <= self.server.max_line else None)
-                await self.wait_for_room()
-                self.frame_bytes += len(data)
-                if self.frame_bytes > self.server.max_bytes_per_frame:
-                    await self.server.next_frame_started()
-                    self.frame_bytes = 0
+                await self.handle_lines([line if len(line) <= self.server.max_line else None
+                                         for line in data.splitlines() or [b""]], len(data))
         except ConnectionClosed:
             pass
         finally:

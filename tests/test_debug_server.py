@@ -25,6 +25,7 @@ from tafel.core.logs.serialization import deserialize
 from tafel.debug.client import DebugClient
 from tafel.debug.router import DebugRouter
 from tafel.debug.server import DebugServer
+from tafel.debug.session import NETWORK_S_PER_FRAME
 from tafel.modules.modeling.kalman_ball_modeler import KalmanBallModeler
 from tafel.representations.modeling import BallModel
 from tests.support.processes import stop_program
@@ -494,4 +495,39 @@ def test_the_last_place_is_kept_for_a_client_on_this_machine() -> None:
     finally:
         for connection in held:
             connection.close()
+        server.stop()
+
+
+def test_the_network_threads_share_of_a_frame_is_for_all_clients_together() -> None:
+    """Lines answered at once (ping, help, refusals) run in the network thread, under the lock the loops need:
+    all clients together get ``NETWORK_S_PER_FRAME`` of it per frame, then wait for the next frame."""
+    server = DebugServer(DebugRouter())
+    assert not server.spend_network_time(0.6 * NETWORK_S_PER_FRAME)  # one client's lines
+    assert server.spend_network_time(0.6 * NETWORK_S_PER_FRAME)  # another's, in the same frame: the share is used up
+    assert server.spend_network_time(0.0)
+    server.next_frame()
+    assert not server.spend_network_time(0.6 * NETWORK_S_PER_FRAME)  # a new frame, a new share
+
+
+def test_a_client_flooding_lines_answered_at_once_gets_every_answer_in_order_while_no_frame_starts() -> None:
+    """Throttled by the network thread's share of each frame, a flood of pings still gets every answer, in order,
+    when the loop is paused (no frame starts: each wait ends after ``FRAME_WAIT``); other clients are answered meanwhile."""
+    server = DebugServer(DebugRouter())
+    server.start()
+    try:
+        with socket.create_connection(("127.0.0.1", server.port), timeout=30) as flood:
+            count = 30_000  # 150 kB of lines: more than a frame's bytes and share allow
+            sender = threading.Thread(target=flood.sendall, args=(b"ping\n" * (count - 1) + b"hello\n",), daemon=True)
+            sender.start()
+            with DebugClient("127.0.0.1", server.port) as other:
+                assert other.ask("ping") == "pong"
+            received = b""
+            while received.count(b"\0") < count:
+                chunk = flood.recv(1 << 16)
+                assert chunk, ("closed after", received.count(b"\0"), "answers")
+                received += chunk
+            sender.join(timeout=30)
+        answers = received.split(b"\0")[:count]
+        assert answers[:-1] == [b"pong\n"] * (count - 1) and answers[-1] != b"pong\n", answers[-1]
+    finally:
         server.stop()

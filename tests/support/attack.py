@@ -22,6 +22,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.support.cpu_use import CpuUse
+
 #: commands the pipelining clients send, round and round
 PIPELINED = ("ping", "modules:list", "representation:print FrameInfo", "stopwatch:list", "debug_request:list", "help")
 
@@ -257,16 +259,33 @@ def loop_frames(stopwatches: str) -> dict[str, int]:
     return {context: int(frame) for context, frame in re.findall(r"\[(\w+)\]\nloop: [\d.]+ Hz, frame (\d+)", stopwatches)}
 
 
+#: cores a machine must have idle, on average, under a load for the program's rates under it to say something
+MIN_IDLE_CORES = 0.25
+#: share of its core the program's busiest process may use without a load for its rates under one to say something
+MAX_BUSY_CORES = 0.8
+
 #: Hz each loop keeps on a machine with room for the program: the beats (100 and 30 Hz) less a little slack
 BEATS = {"motion": 95.0, "cognition": 28.0}
 
 
-def skip_without_headroom(unloaded: dict[str, float], load: str) -> None:
-    """Skip what is left of a test that judges whether ``load`` slows the loops when the program missed its beat
-    without it (``unloaded``: rates measured just before, in the same run): the machine's cores are used up
-    already, and anything more that runs (a streaming server, a log read beside it) slows a program paced by its
-    own computing, whatever ``load`` does. The reason gives the rates."""
+def skip_without_headroom(unloaded: dict[str, float], load: str, unloaded_use: CpuUse | None = None,
+                          loaded_use: CpuUse | None = None) -> None:
+    """Skip what is left of a test that judges whether ``load`` slows the loops where the machine leaves the
+    program no room for it, with the reason and figures:
+
+    - the program missed its beat without the load (``unloaded``: rates measured just before, in the same run);
+    - its busiest process used more than ``MAX_BUSY_CORES`` of its core without the load (``unloaded_use``): a
+      load bounded to a share of the loops' time (the debug server's budgets) would still push it over;
+    - the machine had less than ``MIN_IDLE_CORES`` idle under the load (``loaded_use``): the load's own clients
+      and log readers ran on the program's machine (on a robot they would be elsewhere) and took its share.
+    """
     short = {name: round(rate, 1) for name, rate in unloaded.items() if rate < BEATS.get(name, 0.0)}
     if short:
         pytest.skip(f"the program misses its beat on this machine ({short} Hz, beats {BEATS}): "
                     f"its rates under {load} cannot be judged here")
+    if unloaded_use is not None and unloaded_use.busiest_process_cores > MAX_BUSY_CORES:
+        pytest.skip(f"the program keeps its beat with no room to spare on this machine ({unloaded_use}; at most "
+                    f"{MAX_BUSY_CORES} of a core leaves room for {load}): its rates under {load} cannot be judged here")
+    if loaded_use is not None and loaded_use.machine_idle_cores < MIN_IDLE_CORES:
+        pytest.skip(f"the machine's cores were used up under {load} ({loaded_use}; at least {MIN_IDLE_CORES} idle "
+                    f"leave the program its share): its rates under {load} cannot be judged here")
