@@ -143,11 +143,13 @@ class Session:
         """The lines of one read of ``size`` bytes, then the read's pacing: wait while too many of this client's
         commands are open, and for the next frame when it used up its bytes for this frame or all clients
         together used up the network thread's share of it."""
-        start = time.perf_counter()
+        spent = 0.0
         for line in lines:
-            await self.pace_auth(line)
+            await self.pace_auth(line)  # may sleep: not the network thread's time
+            start = time.perf_counter()
             self.handle_line(line)
-        used_up = self.server.spend_network_time(time.perf_counter() - start)
+            spent += time.perf_counter() - start
+        used_up = self.server.spend_network_time(spent)
         await self.wait_for_room()
         self.frame_bytes += size
         if used_up or self.frame_bytes > self.server.max_bytes_per_frame:
