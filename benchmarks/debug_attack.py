@@ -3,7 +3,10 @@
 The attack is the security issues': 20 clients pipelining commands, one streaming 50 MB without
 newlines, 40 connections over the limit of 32, an HTTP POST, one with a request line over 64 KiB, a page
 of another site and a DNS-rebinding host at the Foxglove server, and two log bombs read beside it. Rates are the program's own, from its
-status line (one a second); the baseline is measured in the same run, just before the attack.
+status line (one a second); the baseline is measured in the same run, just before the attack. Beside them, the
+CPU the program used (all its processes, and its busiest one: a process's loops share one interpreter) and the
+cores the machine left idle: where the program's busiest process used most of its core before the attack, or the
+attack's clients and log readers on the same machine left none idle, slower rates are the machine's, not the attack's.
 
     python benchmarks/debug_attack.py [--seconds 10]
 
@@ -27,6 +30,7 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
+from tests.support import cpu_use  # noqa: E402
 from tests.support.attack import Attack, status_rates  # noqa: E402
 from tests.support.mcap_files import cpu_bomb, memory_bomb  # noqa: E402
 from tests.support.ssh_server import free_port  # noqa: E402
@@ -51,16 +55,16 @@ def main() -> None:
     threading.Thread(target=lambda: [None for _ in process.stdout], daemon=True).start()
     try:
         time.sleep(3.0)  # stand up, first images
-        start = len(lines)
+        start, first = len(lines), cpu_use.sample(process.pid)
         time.sleep(args.seconds)
-        without = status_rates(lines[start + 1:])
+        without, use_without = status_rates(lines[start + 1:]), cpu_use.between(first, cpu_use.sample(process.pid))
         attack = Attack("127.0.0.1", port, http_victim=str(victim), foxglove_port=foxglove_port,
                         bombs=[memory_bomb(bombs / "memory.mcap"), cpu_bomb(bombs / "cpu.mcap")])
         started = time.perf_counter()
         attack.start()
-        start = len(lines)
+        start, first = len(lines), cpu_use.sample(process.pid)
         time.sleep(args.seconds)
-        during = status_rates(lines[start + 1:])
+        during, use_during = status_rates(lines[start + 1:]), cpu_use.between(first, cpu_use.sample(process.pid))
         report = attack.stop()
         attack_s = time.perf_counter() - started
     finally:
@@ -71,9 +75,13 @@ def main() -> None:
         return {f"{name}_{what}_hz": round(func(values), 2) for name, values in rates.items() if values
                 for what, func in (("mean", statistics.fmean), ("min", min))}
 
+    def cores(use: cpu_use.CpuUse) -> dict[str, float]:
+        return {"program_cores": round(use.tree_cores, 2), "busiest_process_cores": round(use.busiest_process_cores, 2),
+                "machine_idle_cores": round(use.machine_idle_cores, 2)}
+
     print(json.dumps({
         "benchmark": "debug_attack", "platform": "mujoco", "speed": 1, "phase_s": args.seconds,
-        "without_attack": summary(without), "during_attack": summary(during),
+        "without_attack": summary(without) | cores(use_without), "during_attack": summary(during) | cores(use_during),
         "targets": {"motion_min_hz": 95.0, "cognition_min_hz": 28.0},
         "attack": {"pipelined_answers": report.answers, "answers_per_s": round(report.answers / attack_s),
                    "streamed_mb": round(report.streamed_bytes / 2**20, 1), "refused_over_limit": report.refused,
