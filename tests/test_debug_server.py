@@ -140,6 +140,7 @@ def test_modules_store_writes_the_private_layer(program: Program, config_dir: Pa
     program.ask("modules:provider -representation BallModel -module KalmanBallModeler")
 
 
+@pytest.mark.slow
 def test_modules_store_keeps_only_the_choices_made_at_run_time(tmp_path: Path) -> None:
     """On dummy, whose layer disables the perception, the stored layer holds only what the user switched:
     the next start on another platform keeps its perception (a new user's report)."""
@@ -323,6 +324,7 @@ def test_twenty_clients_pipelining_500_commands_each_get_every_answer_in_order(p
     assert frame_of(program, "cognition") > 0
 
 
+@pytest.mark.slow
 def test_token_authentication() -> None:
     secured = Program("--debug-token", "s3cret")
     try:
@@ -364,6 +366,7 @@ def test_replay_commands(tmp_path: Path) -> None:
         replay.stop()
 
 
+@pytest.mark.slow
 @pytest.mark.alone
 def test_concurrent_runtime_answers_commands_from_both_processes() -> None:
     concurrent = Program("--concurrent")
@@ -417,6 +420,7 @@ def read_until_closed(connection: socket.socket, timeout: float = 10.0) -> bytes
     return received
 
 
+@pytest.mark.slow
 def test_an_http_post_with_a_request_line_over_64_kib_runs_nothing(tmp_path: Path) -> None:
     """A page on another origin can make a browser POST here with a request line longer than a command
     line may be: it arrived as "too long", took the first place in the order, and the body ran."""
@@ -439,6 +443,7 @@ def test_an_http_post_with_a_request_line_over_64_kib_runs_nothing(tmp_path: Pat
     assert any("speaks HTTP" in line for line in running.errors), running.errors
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("token", [None, "right"])
 def test_connections_that_never_authenticate_are_closed_and_free_their_place(tmp_path: Path, token: str | None) -> None:
     """32 connections held open idle locked every console user out. Now one that has not authenticated

@@ -189,6 +189,7 @@ def install_fake_package(site: Path, entry: str) -> None:
     (info / "entry_points.txt").write_text(f"[tafel.modules]\nteam = {entry}\n")
 
 
+@pytest.mark.slow
 def test_an_installed_package_announces_its_modules_by_entry_point(own: tuple[Path, Path], tmp_path: Path) -> None:
     _, config = own
     site = tmp_path / "site"
@@ -198,6 +199,7 @@ def test_an_installed_package_announces_its_modules_by_entry_point(own: tuple[Pa
     assert "BallSightingCounter" in order(result.stdout, "cognition")
 
 
+@pytest.mark.slow
 def test_a_broken_entry_point_is_reported_and_does_not_stop_other_programs(tmp_path: Path) -> None:
     site = tmp_path / "site"
     install_fake_package(site, "team_modules.missing_file")

@@ -83,6 +83,7 @@ def test_log_start_records_into_the_recordings_folder(program: Program, tmp_path
     assert (tmp_path / "logs" / "run1.mcap").stat().st_size > 0
 
 
+@pytest.mark.slow
 def test_the_recordings_folder_is_chosen_with_record_dir(tmp_path: Path) -> None:
     running = Program("--platform", "dummy", "--record-dir", str(tmp_path / "recordings"), cwd=tmp_path)
     try:
@@ -133,6 +134,7 @@ def test_a_client_streaming_bytes_without_newlines_cannot_slow_the_loops(often_r
 
 
 # ------------------------------------------------------------------------------------- connections
+@pytest.mark.slow
 def test_connections_over_the_limit_get_one_error_line_and_are_closed(tmp_path: Path) -> None:
     running = Program("--platform", "dummy", "--debug-max-connections", "4", cwd=tmp_path)
     try:
@@ -190,6 +192,7 @@ def test_running_out_of_file_descriptors_logs_one_line_not_tracebacks(tmp_path: 
 
 
 # ------------------------------------------------------------------------------------------ token
+@pytest.mark.slow
 def test_the_token_comes_from_a_file_and_never_shows_in_ps(tmp_path: Path) -> None:
     token_file = tmp_path / "token"
     token_file.write_text("s3cret-from-file\n")
@@ -295,6 +298,7 @@ def test_a_fitting_value_is_taken(program: Program) -> None:
         assert client.ask("representation:set -name InertialModel -field roll -value 0.25").endswith("= 0.25")
 
 
+@pytest.mark.slow
 def test_a_modify_value_keeps_its_kind(tmp_path: Path) -> None:
     running = Program("--platform", "dummy", "--add-module", f"cognition:{DEBUG_USER}", cwd=tmp_path)
     try:
@@ -563,6 +567,7 @@ def test_a_broken_private_configuration_is_an_error_not_a_traceback(tmp_path: Pa
 
 
 # ------------------------------------------------------------------------------ clients never destroy recordings
+@pytest.mark.slow
 def test_log_start_never_replaces_a_file_but_records_under_the_next_free_name(tmp_path: Path) -> None:
     from tafel.core.logs import read_log
 
