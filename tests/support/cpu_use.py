@@ -12,17 +12,17 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-TICKS_PER_S = os.sysconf("SC_CLK_TCK")
+from tafel.tools.simulation.match import cpu_seconds
 
 
 @dataclass(frozen=True)
 class CpuSample:
-    """Counters at one moment: monotonic time (s), the machine's idle and total ticks, each process's ticks."""
+    """Counters at one moment: monotonic time (s), the machine's idle and total ticks, each process's CPU s so far."""
 
     at_s: float
     machine_idle_ticks: int
     machine_total_ticks: int
-    process_ticks: dict[int, int]
+    process_cpu_s: dict[int, float]
 
 
 @dataclass(frozen=True)
@@ -54,21 +54,13 @@ def _tree(pid: int) -> list[int]:
     return found
 
 
-def _process_ticks(pid: int) -> int:
-    try:
-        stat = Path(f"/proc/{pid}/stat").read_text()
-    except OSError:  # ended meanwhile
-        return 0
-    fields = stat[stat.rindex(")") + 2:].split()  # after "pid (name) "; the name may hold spaces
-    return int(fields[11]) + int(fields[12])  # utime, stime
-
-
 def sample(pid: int) -> CpuSample:
     """The counters now, for the process tree under ``pid``."""
     with open("/proc/stat") as stat:
         ticks = [int(value) for value in stat.readline().split()[1:]]
     idle = ticks[3] + ticks[4]  # idle, iowait
-    return CpuSample(time.monotonic(), idle, sum(ticks[:8]), {p: _process_ticks(p) for p in _tree(pid)})
+    used = {p: cpu_seconds(p) for p in _tree(pid)}
+    return CpuSample(time.monotonic(), idle, sum(ticks[:8]), {p: s for p, s in used.items() if s is not None})
 
 
 def between(first: CpuSample, last: CpuSample) -> CpuUse:
@@ -78,6 +70,5 @@ def between(first: CpuSample, last: CpuSample) -> CpuUse:
     total = max(last.machine_total_ticks - first.machine_total_ticks, 1)
     cores = os.cpu_count() or 1
     idle_cores = cores * (last.machine_idle_ticks - first.machine_idle_ticks) / total
-    used = [(ticks - first.process_ticks[pid]) / TICKS_PER_S / seconds
-            for pid, ticks in last.process_ticks.items() if pid in first.process_ticks]
+    used = [(cpu_s - first.process_cpu_s[pid]) / seconds for pid, cpu_s in last.process_cpu_s.items() if pid in first.process_cpu_s]
     return CpuUse(seconds, idle_cores, sum(used), max(used, default=0.0))
