@@ -53,18 +53,20 @@ def main() -> None:
     lines: list[str] = []
     threading.Thread(target=lambda: lines.extend(process.stderr), daemon=True).start()
     threading.Thread(target=lambda: [None for _ in process.stdout], daemon=True).start()
+
+    def phase_rates() -> dict[str, list[float]]:
+        """The status lines' rates over the next ``args.seconds`` (the first line's interval began before)."""
+        start = len(lines)
+        time.sleep(args.seconds)
+        return status_rates(lines[start + 1:])
     try:
         time.sleep(3.0)  # stand up, first images
-        start, first = len(lines), cpu_use.sample(process.pid)
-        time.sleep(args.seconds)
-        without, use_without = status_rates(lines[start + 1:]), cpu_use.between(first, cpu_use.sample(process.pid))
+        without, use_without = cpu_use.measured(process.pid, phase_rates)
         attack = Attack("127.0.0.1", port, http_victim=str(victim), foxglove_port=foxglove_port,
                         bombs=[memory_bomb(bombs / "memory.mcap"), cpu_bomb(bombs / "cpu.mcap")])
         started = time.perf_counter()
         attack.start()
-        start, first = len(lines), cpu_use.sample(process.pid)
-        time.sleep(args.seconds)
-        during, use_during = status_rates(lines[start + 1:]), cpu_use.between(first, cpu_use.sample(process.pid))
+        during, use_during = cpu_use.measured(process.pid, phase_rates)
         report = attack.stop()
         attack_s = time.perf_counter() - started
     finally:

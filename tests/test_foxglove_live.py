@@ -119,14 +119,10 @@ def test_with_everything_subscribed_the_loops_keep_their_rates(live: tuple[Progr
         return {context: (last[context] - first[context]) / (end - start) for context in first}
 
     pid = live[0].process.pid
-    first = cpu_use.sample(pid)
-    alone = rates(4.0)
-    alone_use = cpu_use.between(first, cpu_use.sample(pid))
+    alone, alone_use = cpu_use.measured(pid, lambda: rates(4.0))
     client.subscribe(*sorted(client.wait_for(client.topics)))
     client.pump(1.0)
-    first = cpu_use.sample(pid)
-    streaming = rates(6.0)
-    streaming_use = cpu_use.between(first, cpu_use.sample(pid))
+    streaming, streaming_use = cpu_use.measured(pid, lambda: rates(6.0))
     print("rates alone", alone, alone_use, "streaming", streaming, streaming_use)
     assert alone["motion"] > 30 and alone["cognition"] > 9, alone  # the program runs at all (60 Hz motion alone, once, on a slow machine)
     assert len(client.received["/camera/top"]) >= 5 * streaming["cognition"]  # about one image a cognition frame arrived

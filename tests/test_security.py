@@ -503,15 +503,13 @@ def test_the_default_simulation_holds_its_rates_under_every_attack_at_once(tmp_p
     running = Program("--platform", "mujoco", "--status-interval", "1", "--foxglove", f"127.0.0.1:{foxglove_port}", cwd=tmp_path)
     try:
         time.sleep(3.0)  # the robot stands up, the cameras render
-        first = cpu_use.sample(running.process.pid)
-        before = rates_during(running.errors, 5.0, forgive=1)  # the baseline: the program's rates on this machine
-        use_before = cpu_use.between(first, cpu_use.sample(running.process.pid))
+        # the baseline: the program's rates on this machine
+        before, use_before = cpu_use.measured(running.process.pid, lambda: rates_during(running.errors, 5.0, forgive=1))
         attack = Attack(running.host, running.port, http_victim=str(victim), limit=32, foxglove_port=foxglove_port,
                         bombs=[memory_bomb(bombs / "memory.mcap"), cpu_bomb(bombs / "cpu.mcap")])
         attack.start()
-        first = cpu_use.sample(running.process.pid)
-        during = rates_during(running.errors, 8.0, forgive=1)  # over 7 seconds, the second slowest
-        use_during = cpu_use.between(first, cpu_use.sample(running.process.pid))
+        # over 7 seconds, the second slowest
+        during, use_during = cpu_use.measured(running.process.pid, lambda: rates_during(running.errors, 8.0, forgive=1))
         report = attack.stop()
         with running.client() as client:
             assert client.ask("ping") == "pong"

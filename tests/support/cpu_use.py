@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 from tafel.tools.simulation.match import cpu_seconds
 
@@ -72,3 +74,13 @@ def between(first: CpuSample, last: CpuSample) -> CpuUse:
     idle_cores = cores * (last.machine_idle_ticks - first.machine_idle_ticks) / total
     used = [(cpu_s - first.process_cpu_s[pid]) / seconds for pid, cpu_s in last.process_cpu_s.items() if pid in first.process_cpu_s]
     return CpuUse(seconds, idle_cores, sum(used), max(used, default=0.0))
+
+
+T = TypeVar("T")
+
+
+def measured(pid: int, work: Callable[[], T]) -> tuple[T, CpuUse]:
+    """``work()``'s result and the use while it ran, for the process tree under ``pid``."""
+    first = sample(pid)
+    result = work()
+    return result, between(first, sample(pid))
