@@ -265,7 +265,10 @@ def test_concurrent_stop_with_a_stuck_cognition_ends_every_process_after_the_gra
 
 
 @pytest.mark.slow
-def test_context_processes_stop_when_the_supervisor_is_killed(tmp_path: Path) -> None:
+@pytest.mark.parametrize("recording_s", [0.0, 1.0], ids=["while-starting", "while-recording"])
+def test_context_processes_stop_when_the_supervisor_is_killed(tmp_path: Path, recording_s: float) -> None:
+    """Killed at once, the supervisor dies while its context processes still import: they must not mistake whoever
+    adopted them for their supervisor (they did, and ran on for ever)."""
     process = subprocess.Popen(
         [*TAFEL, "run", "--platform", "dummy", "--concurrent", "--no-debug", "--record", str(tmp_path / "orphan.mcap")],
         cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(REPO)},
@@ -276,7 +279,7 @@ def test_context_processes_stop_when_the_supervisor_is_killed(tmp_path: Path) ->
         time.sleep(0.2)
         children = [pid for pid in child_pids(process.pid) if "spawn_main" in cmdline(pid)]
     assert len(children) == 2, children
-    time.sleep(1.0)  # recording under way
+    time.sleep(recording_s)
     process.kill()
     process.wait(timeout=5)
     gone = time.monotonic() + 10.0  # they notice within 2 s; then they close the recording (slow on a loaded machine)

@@ -107,8 +107,9 @@ DUMP_SIGNAL = signal.SIGUSR1
 
 
 def _watch_parent(stop: Any, parent: int, record_queue: Any) -> None:
-    """End this process when the supervisor is gone (killed with SIGKILL, say): first the clean stop,
-    then, if a module is stuck, for good. Linux also sends SIGTERM at once (PR_SET_PDEATHSIG)."""
+    """End this process when the supervisor ``parent`` is gone (killed with SIGKILL, say): first the clean stop,
+    then, if a module is stuck, for good. Linux also sends SIGTERM at once (PR_SET_PDEATHSIG), but only for a death
+    after this call: the poll below also sees a supervisor that died while this process was still starting."""
     _die_with_parent()
     while os.getppid() == parent:  # also while stopping normally: the supervisor still reads the queue
         time.sleep(0.2)
