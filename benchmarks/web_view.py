@@ -38,6 +38,7 @@ from typing import Any
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
+from tafel.tools.simulation.match import cpu_seconds as process_cpu_seconds  # noqa: E402
 from tests.support.attack import status_rates  # noqa: E402
 from tests.support.browser import WebProgram, launch, missing_browser  # noqa: E402
 
@@ -45,9 +46,8 @@ RATES = {"cognition": 30.0, "motion": 100.0}
 
 
 def cpu_seconds(pid: int) -> float:
-    """User and system CPU time of a process (all its threads), in seconds."""
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    """User and system CPU time of a process (all its threads), in seconds; 0 for one that is gone."""
+    return process_cpu_seconds(pid) or 0.0
 
 
 def browser_cpu_seconds() -> float:
