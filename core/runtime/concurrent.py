@@ -54,6 +54,9 @@ class WorkerSpec:
     inbox_name: str | None
     outbox_name: str | None
     stall_timeout_s: float
+    #: the supervisor's process id, taken in the supervisor: a context process that starts slowly may find it already
+    #: gone, and its own parent id then names whoever adopted it
+    supervisor_pid: int
     realtime_priority: int = 50
     record: list[Any] = field(default_factory=list)
     record_queue: Any = None
@@ -73,9 +76,6 @@ class WorkerSpec:
     blackbox_queue: Any = None
     #: every context waits here until all are ready, so they start together (a barrier, or None)
     start_together: Any = None
-    #: the supervisor's process id, taken in the supervisor: a context process that starts slowly may find it already
-    #: gone, and its own parent id then names whoever adopted it
-    supervisor_pid: int = 0
 
 
 
@@ -113,7 +113,7 @@ def _worker_main(spec: WorkerSpec, stop: Any, reports: Any) -> None:
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     faulthandler.register(DUMP_SIGNAL, all_threads=True)
     keep_freed_memory()  # the frames' large arrays reuse the heap instead of faulting in fresh pages
-    threading.Thread(target=_watch_parent, args=(stop, spec.supervisor_pid or os.getppid(), spec.record_queue), name="tafel-parent-watch",
+    threading.Thread(target=_watch_parent, args=(stop, spec.supervisor_pid, spec.record_queue), name="tafel-parent-watch",
                      daemon=True).start()
     clock.set_origin(spec.clock_origin_ns)
     logging.basicConfig(level=logging.WARNING, format=f"[{spec.plan.name}] %(levelname)s %(message)s")
@@ -242,12 +242,12 @@ class ConcurrentRuntime:
                     plan=plan, platform_class=self.platform_class, platform_options=self.platform_options,
                     strict=self.strict, limits=limits, is_main=name == self.main,
                     inbox_name=channels[other].name if (plan.handover_in or watch_cognition) and other in channels else None,
-                    outbox_name=channels[name].name, stall_timeout_s=self.stall_timeout_s,
+                    outbox_name=channels[name].name, stall_timeout_s=self.stall_timeout_s, supervisor_pid=os.getpid(),
                     record=self.recorder.by_context.get(name, []) if self.recorder else [], record_queue=record_queue,
                     record_switch=self.record_switch, setup=self.worker_setup, clock_origin_ns=clock.origin_ns(),
                     imports=tuple(defining_modules()), module_paths=tuple(loaded_folders()), stuck_timeout_s=self.stuck_timeout_s,
                     blackbox_record=self.blackbox_record.get(name, []), blackbox_queue=box_queue,
-                    start_together=self.start_together, supervisor_pid=os.getpid(),
+                    start_together=self.start_together,
                 )
                 receiver, sender = self._mp.Pipe(duplex=False)
                 process = self._mp.Process(target=_worker_main, args=(spec, self.stop, sender), name=f"tafel-{name}", daemon=True)
