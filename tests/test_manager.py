@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import logging
 import re
+import typing
 from dataclasses import dataclass
 
 import pytest
@@ -24,7 +25,7 @@ from tafel.core import (
     requires,
     uses,
 )
-from tafel.core.framework.parameters import ParameterError
+from tafel.core.framework.parameters import ParameterError, set_parameter
 
 
 @representation
@@ -398,6 +399,30 @@ def test_parameters_are_typed_and_checked() -> None:
         ModuleManager([Tunable], parameters={"Tunable": {"steps": "many"}})
     with pytest.raises(UnknownModuleError):
         ModuleManager([Tunable], parameters={"Tunabel": {"gain": 1}})
+
+
+def test_each_parameters_class_is_checked_by_its_own_types_worked_out_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A client's parameter:set checks the value against the field's type: the types are worked out once per class
+    (anew each time, the value-range tests took 10 s), and a class of the same name defined again with other types
+    (a module reloaded) is checked by its own."""
+    @dataclass
+    class FloatGain:
+        gain: float = 1.0
+
+    @dataclass
+    class IntGain:
+        gain: int = 1
+
+    resolved: list[type] = []
+    real = typing.get_type_hints
+    monkeypatch.setattr(typing, "get_type_hints", lambda cls, *args, **kwargs: resolved.append(cls) or real(cls, *args, **kwargs))
+    instance = FloatGain()
+    for value in ("0.5", 2, "2.5"):
+        set_parameter("Tunable", instance, "gain", value, client=True)
+    assert instance.gain == 2.5 and resolved == [FloatGain]
+    with pytest.raises(ParameterError, match="Tunable.gain takes a whole number"):
+        set_parameter("Tunable", IntGain(), "gain", "2.5", client=True)
+    assert resolved == [FloatGain, IntGain]
 
 
 def test_prune_unsatisfiable_is_transitive() -> None:
