@@ -6,6 +6,7 @@ that the filter is tested apart from the images.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -31,19 +32,32 @@ def visible(points: np.ndarray, head: float = 0.0, reach: float = REACH) -> np.n
     return (distance > 200.0) & (distance < reach) & (bearing < VIEW)
 
 
-def line_percept(pose: tuple[float, float, float], rng: np.random.Generator, noise: float = 20.0, head: float = 0.0) -> LinePercept:
-    """Points every 100 mm along every marking the robot sees, with the segments they form."""
-    percept = LinePercept(segments=[])
-    points = []
+@functools.cache
+def marking_samples() -> tuple[np.ndarray, tuple[int, ...], tuple[bool, ...]]:
+    """Points every 100 mm along every marking (field mm, all markings in one array), where each marking's points
+    start (and the last one's end), and which markings are straight lines: the same every frame, so worked out once."""
+    samples, starts, straight = [], [0], []
+    lines = set(field.line_segments())
     for x1, y1, x2, y2 in field.all_markings():
         steps = max(2, int(math.hypot(x2 - x1, y2 - y1) / 100.0))
         along = np.linspace(0.0, 1.0, steps)[:, None]
-        seen = to_robot(pose, np.array([x1, y1]) + along * np.array([x2 - x1, y2 - y1]))
-        seen = seen[visible(seen, head)]
-        points.append(seen)
-        if len(seen) >= 5 and (x1, y1, x2, y2) in field.line_segments():
-            percept.segments.append(LineSegment(*seen[0], *seen[-1]))
-    all_points = np.concatenate(points)
+        samples.append(np.array([x1, y1]) + along * np.array([x2 - x1, y2 - y1]))
+        starts.append(starts[-1] + steps)
+        straight.append((x1, y1, x2, y2) in lines)
+    return np.concatenate(samples), tuple(starts), tuple(straight)
+
+
+def line_percept(pose: tuple[float, float, float], rng: np.random.Generator, noise: float = 20.0, head: float = 0.0) -> LinePercept:
+    """Points every 100 mm along every marking the robot sees, with the segments they form."""
+    percept = LinePercept(segments=[])
+    samples, starts, straight = marking_samples()
+    seen = to_robot(pose, samples)
+    shown = visible(seen, head)
+    for start, end, line in zip(starts, starts[1:], straight):
+        part = seen[start:end][shown[start:end]]
+        if len(part) >= 5 and line:
+            percept.segments.append(LineSegment(*part[0], *part[-1]))
+    all_points = seen[shown]
     percept.points = (all_points + rng.normal(0.0, noise, all_points.shape)).astype(np.float32)
     centre = to_robot(pose, np.zeros((1, 2)))
     if visible(centre, head)[0]:
