@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tafel.core import Module, ModuleManager, provides, representation
-from tafel.core.framework.access import AccessMark, read_view
+from tafel.core.framework.access import AccessMark, protect, read_view
 from tafel.core.runtime.handover import HandoverError, LocalChannel, SharedChannel, apply_bundle, make_bundle, private_copy, snapshot
 
 
@@ -136,8 +136,9 @@ class HoSeen:
 
 
 def test_snapshots_of_nested_values_are_private_and_views_in_them_become_plain_copies() -> None:
-    """The pickle round trip of ``private_copy`` copies lists of dataclasses deeply; a read-only view a module
-    stored in its output (its class is made at run time, so pickle refuses it) falls back to ``deepcopy``."""
+    """The pickle round trip of ``private_copy`` copies lists of dataclasses deeply; a read-only view or list a module
+    stored in its output copies to the plain value, as ``deepcopy`` gives it (a view's class is made at run time and
+    cannot be pickled itself; the module harness copies its history so too)."""
     inner = HoConsistent(a=1, b=2, samples=np.ones(2, dtype=np.int64), label="1")
     rep = HoSeen(robots=[inner, inner])
     copied = snapshot(rep)["robots"]
@@ -148,6 +149,11 @@ def test_snapshots_of_nested_values_are_private_and_views_in_them_become_plain_c
     plain = private_copy([view])[0]
     assert type(plain) is HoConsistent and plain.a == 3
     plain.samples[0] = 1  # writeable: a private copy, not a view
+    items = protect([inner, [1, 2]], "list", "M", "HoSeen", ".robots", AccessMark())
+    listed = private_copy({"robots": items})["robots"]
+    assert type(listed) is list and type(listed[0]) is HoConsistent and listed[1] == [1, 2]
+    listed[1].append(3)  # a private list: the module's input is untouched
+    assert items[1] == [1, 2]
 
 
 def test_oversized_bundles_are_refused_with_advice() -> None:

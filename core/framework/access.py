@@ -145,6 +145,9 @@ class ReadOnlySequence(Sequence):
     def __deepcopy__(self, memo: Any) -> list:
         return copy.deepcopy(self._items, memo)
 
+    def __reduce__(self) -> Any:  # a pickle copy is the plain list too (``private_copy``)
+        return list, (self._items,)
+
 
 def protect(value: Any, kind: str, owner: str, rep: str, path: str, mark: AccessMark | None) -> Any:
     """Wrap one field value for read-only access."""
@@ -206,6 +209,9 @@ class ReadOnlyView:
     def __deepcopy__(self, memo: Any) -> Any:
         """``copy.deepcopy(self.ball_percept)`` gives a private, writeable copy."""
         return copy.deepcopy(self._t, memo)
+
+    def __reduce_ex__(self, protocol: Any) -> Any:  # a pickle copy is the plain value too (``private_copy``)
+        return self._t.__reduce_ex__(protocol)
 
 
 def _compile(source: str, name: str, globals_: dict[str, Any] | None = None) -> Any:
@@ -307,6 +313,9 @@ class WriterView:
 
     def __deepcopy__(self, memo: Any) -> Any:
         return copy.deepcopy(self._t, memo)
+
+    def __reduce_ex__(self, protocol: Any) -> Any:  # a pickle copy is the plain value too (``private_copy``)
+        return self._t.__reduce_ex__(protocol)
 
 
 def undo_writes(undo: list) -> None:
