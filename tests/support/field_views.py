@@ -44,7 +44,9 @@ def marking_samples() -> tuple[np.ndarray, tuple[int, ...], tuple[bool, ...]]:
         samples.append(np.array([x1, y1]) + along * np.array([x2 - x1, y2 - y1]))
         starts.append(starts[-1] + steps)
         straight.append((x1, y1, x2, y2) in lines)
-    return np.concatenate(samples), tuple(starts), tuple(straight)
+    points = np.concatenate(samples)
+    points.flags.writeable = False  # shared by every call
+    return points, tuple(starts), tuple(straight)
 
 
 def line_percept(pose: tuple[float, float, float], rng: np.random.Generator, noise: float = 20.0, head: float = 0.0) -> LinePercept:
