@@ -38,6 +38,7 @@ class Program:
     """A ``tafel run`` subprocess with its debug server address."""
 
     def __init__(self, *args: str, cwd: Path = REPO) -> None:
+        self.cwd = cwd  # where the program runs: its recordings folder lies below it
         self.process = subprocess.Popen(
             [sys.executable, "-m", "tafel.tools.cli", "run", "--debug-port", "0", *args]
             + ([] if "--platform" in args else ["--platform", "dummy"])

@@ -69,10 +69,11 @@ def test_an_http_post_runs_nothing_and_is_closed(program: Program, tmp_path: Pat
 
 
 @pytest.mark.parametrize("name", ["../escape.mcap", "/tmp/absolute.mcap", "sub/dir.mcap", "..", "notes.txt"])
-def test_log_start_refuses_names_that_leave_the_recordings_folder(program: Program, tmp_path: Path, name: str) -> None:
-    answer = program.ask(f'log:start -file "{name}"')
+def test_log_start_refuses_names_that_leave_the_recordings_folder(refusing_program: Program, name: str) -> None:
+    answer = refusing_program.ask(f'log:start -file "{name}"')
     assert answer.startswith("error:") and ("plain file name" in answer or "MCAP files" in answer), answer
-    assert not (tmp_path / "escape.mcap").exists() and not Path("/tmp/absolute.mcap").exists()
+    assert not (refusing_program.cwd / "escape.mcap").exists() and not Path("/tmp/absolute.mcap").exists()
+    assert json.loads(refusing_program.ask("log:status"))["recording"] is False
 
 
 def test_log_start_records_into_the_recordings_folder(program: Program, tmp_path: Path) -> None:
@@ -262,8 +263,8 @@ def test_listening_beyond_loopback_without_a_token_warns(tmp_path: Path) -> None
 # ------------------------------------------------------------------------------- values from clients
 @pytest.fixture(scope="module")
 def refusing_program(tmp_path_factory: pytest.TempPathFactory):
-    """One program for every refused value below: a refusal changes nothing, so they share it, and the
-    program has to come through all of them in a row."""
+    """One program for every refused value and recording name: a refusal changes nothing, so they share it, and
+    the program has to come through all of them in a row."""
     running = Program("--platform", "dummy", cwd=tmp_path_factory.mktemp("refusing"))
     yield running
     running.stop()
