@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 
 from tafel.core.framework.manager import ModuleManager
 from tafel.core.framework.module import Module
-from tafel.core.framework.parameters import ParameterError, make_parameters, parameters_class, set_parameter
+from tafel.core.framework.parameters import ParameterError, make_parameters, parameter_hints, parameters_class, set_parameter
 from tafel.core.framework.representation import fields_of, registered_representations
 from tafel.core.framework.validation import MAX_MAGNITUDE, ValueCheckError, check_field, check_number
 from tafel.core.testing import ModuleHarness
@@ -138,7 +138,7 @@ def test_no_parameter_of_any_module_takes_a_non_finite_or_huge_number_from_a_cli
     assert {"InertialFilter", "KalmanBallModeler", "LookAtBallBehavior", "HeadMotion", "StandMotion"} <= {m.__name__ for m in modules}
     for module in modules:
         instance = make_parameters(module)
-        hints = typing.get_type_hints(type(instance))
+        hints = parameter_hints(type(instance))
         for field in dataclasses.fields(instance):
             hint = hints[field.name]
             element = typing.get_args(hint)[0] if typing.get_origin(hint) is list else hint
