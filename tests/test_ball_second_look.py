@@ -4,51 +4,23 @@ fails the checks; it is a ball when it passes looser checks and the classifier i
 from __future__ import annotations
 
 import math
-from types import SimpleNamespace
 
 import cv2
 import numpy as np
 import pytest
 
-from tafel.modules.perception.image_geometry import ImageProjection
-from tafel.representations.field import BALL_RADIUS
-from tafel.representations.motion import CameraMatrix
-from tafel.representations.perception import BallCandidate, BallImagePercept
-from tafel.tools.simulation.scene_frames import Perception
-
-FOV = (math.radians(56.3), math.radians(43.7))
-WIDTH, HEIGHT = 320, 240
-PITCH = 0.4
-
-
-class SureModel:
-    """A classifier stub with one score for every candidate (a logit)."""
-
-    def __init__(self, score: float) -> None:
-        self.score = score
-
-    def scores(self, rows: np.ndarray) -> np.ndarray:
-        return np.full(len(np.atleast_2d(rows)), self.score, np.float32)
-
-
-def camera() -> CameraMatrix:
-    """A standing NAO's top camera, level, pitched down by ``PITCH``."""
-    c, s = math.cos(PITCH), math.sin(PITCH)
-    return CameraMatrix(np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]), np.array([0.0, 0.0, 503.0]), True)
+from tests.support.painted_balls import CARPET, HEIGHT, WIDTH, SureModel, ball_radius, found
 
 
 def blurred_ball_image(patch_grey: int) -> tuple[np.ndarray, tuple[float, float, float]]:
-    """A carpet with a line far off and a ball of the size a ball has there, its patches ``patch_grey`` (the white is
-    230), smeared sideways by a head turn; the ball's centre and radius (px)."""
+    """A carpet with a ball of the size a ball has there, its patches ``patch_grey`` (the white is 230), smeared
+    sideways by a head turn; the ball's centre and radius (px)."""
     rng = np.random.default_rng(3)
     image = np.empty((HEIGHT, WIDTH, 3), np.uint8)
-    image[:] = (45, 140, 50)
+    image[:] = CARPET
     image[:] = np.clip(image.astype(int) + rng.normal(0, 4, image.shape), 0, 255).astype(np.uint8)
     x, y = 160.0, 150.0
-    projection = ImageProjection(camera(), WIDTH, HEIGHT, *FOV)
-    centre, hit = projection.to_ground(np.array([x]), np.array([y]), BALL_RADIUS)
-    assert hit[0]
-    radius = projection.fx * BALL_RADIUS / float(np.linalg.norm(np.append(centre[0], BALL_RADIUS) - projection.translation))
+    radius = ball_radius(x, y)
     cv2.circle(image, (int(x), int(y)), int(round(radius)), (230, 230, 230), -1)
     for angle in np.linspace(0, 2 * math.pi, 5, endpoint=False):
         cv2.circle(image, (int(x + 0.55 * radius * math.cos(angle)), int(y + 0.55 * radius * math.sin(angle))), max(1, int(0.3 * radius)),
@@ -56,21 +28,6 @@ def blurred_ball_image(patch_grey: int) -> tuple[np.ndarray, tuple[float, float,
     cv2.circle(image, (int(x), int(y)), max(1, int(0.3 * radius)), (patch_grey,) * 3, -1)
     kernel = np.full((1, 3), 1 / 3, np.float32)  # a short smear sideways
     return cv2.filter2D(image, -1, kernel), (x, y, radius)
-
-
-def found(image: np.ndarray, model: SureModel | None, **parameters: object) -> list[BallCandidate]:
-    """The detector's candidates in ``image`` (top camera) with the classifier ``model`` (None: the classifier off)."""
-    perception = Perception()
-    detector = perception.manager.module("SPLBallDetector")
-    detector.parameters.classifier = model is not None
-    detector.model = model
-    for name, value in parameters.items():
-        setattr(detector.parameters, name, value)
-    view = SimpleNamespace(image=image, horizontal_fov=FOV[0], vertical_fov=FOV[1], matrix=camera())
-    empty = SimpleNamespace(image=np.zeros((0, 0, 3), np.uint8), horizontal_fov=0.0, vertical_fov=0.0, matrix=CameraMatrix())
-    for _ in range(2):
-        board = perception({"top": view, "bottom": empty})  # type: ignore[dict-item]
-    return board[BallImagePercept].candidates
 
 
 def test_a_blurred_ball_with_grey_patches_fails_the_checks_alone() -> None:

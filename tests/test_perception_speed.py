@@ -23,7 +23,16 @@ from tafel.modules.modeling.field_model import FIELD_MODEL
 from tafel.modules.modeling.particle_filter import seen_from
 from tafel.modules.modeling.pose_measurements import robust
 from tafel.modules.perception import ball_checks, ball_spots
-from tafel.modules.perception.ball_checks import LOOSER_TESTS, beside_post, check, post_columns, under_post, verdict
+from tafel.modules.perception.ball_checks import (
+    LOOSER_TESTS,
+    alone_on_dark_carpet,
+    beside_post,
+    carpet_below_post,
+    check,
+    post_columns,
+    under_post,
+    verdict,
+)
 from tafel.modules.perception.ball_spots import (
     Spot,
     ball_ranges,
@@ -311,10 +320,12 @@ def reference_check(self: SPLBallDetector, hsv: np.ndarray, green: np.ndarray, s
     black = value[value < p.dark_ratio * bright]
     darkest = float(black.mean()) if black.size else math.inf
     first, posts = post_columns(hsv, green, spot, white, self.parameters)
-    if not beside_post and 0 <= int(spot.x) - first < len(posts) and posts[int(spot.x) - first]:
+    if (not beside_post and 0 <= int(spot.x) - first < len(posts) and posts[int(spot.x) - first]
+            and not carpet_below_post(green, spot)):
         return 0.0, True
     if (green_inside > p.green_inside_max or green_around < p.green_around_min or not p.dark_share_min <= dark <= p.dark_share_max
-            or saturation > p.saturation_max or darkest > p.black_contrast * field_value):
+            or saturation > p.saturation_max
+            or (darkest > p.black_contrast * field_value and not alone_on_dark_carpet(green, spot, bright, field_value, green_around, p))):
         return 0.0, False
     return float(min(1.0, 0.5 + dark + 0.3 * green_around - green_inside)), False
 
@@ -1281,7 +1292,7 @@ def reference_verdict(self: SPLBallDetector, hsv: np.ndarray, green: np.ndarray,
     field_value = byte_median(carpet if carpet.size >= 3 else patch[..., 2][around])
     black = value[is_dark]
     darkest = float(black.mean()) if black.size else math.inf
-    if darkest > p.black_contrast * field_value:
+    if darkest > p.black_contrast * field_value and not alone_on_dark_carpet(green, spot, bright, field_value, green_around, p):
         return 0.0, False, "black"
     return float(min(1.0, 0.5 + dark + 0.3 * green_around - green_inside)), False, ""
 
@@ -1298,7 +1309,7 @@ def test_spl_verdicts_from_the_histogram_are_the_gathered_pixels(painted: tuple[
     self = detector()
     drawn = SPLBallDetector.Parameters(dark_ratio=data.draw(st.floats(0.0, 1.5)), dark_share_min=data.draw(st.floats(0.0, 0.5)),
                                        dark_share_max=data.draw(st.floats(0.3, 1.0)), black_contrast=data.draw(st.floats(0.0, 2.0)),
-                                       green_inside_max=1.0, green_around_min=0.0, saturation_max=255.0)
+                                       white_over_dark_carpet=data.draw(st.floats(1.0, 10.0)), green_inside_max=1.0, green_around_min=0.0, saturation_max=255.0)
     for _ in range(5):
         x, y = data.draw(st.floats(-3.0, width + 2.0)), data.draw(st.floats(-3.0, height + 2.0))
         spot = Spot(x, y, data.draw(st.floats(0.5, 25.0)), data.draw(st.floats(0.5, 25.0)))

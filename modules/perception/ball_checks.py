@@ -11,13 +11,14 @@ from typing import Protocol
 import numpy as np
 
 from tafel.modules.perception.ball_spots import Spot
-from tafel.modules.perception.pixel_statistics import byte_median, histogram_percentile
+from tafel.modules.perception.pixel_statistics import byte_median, byte_percentile, histogram_percentile
 
 
 class CheckParameters(Protocol):
     """What these functions read of SPLBallDetector.Parameters."""
 
     black_contrast: float
+    white_over_dark_carpet: float
     dark_ratio: float
     dark_share_max: float
     dark_share_min: float
@@ -91,9 +92,30 @@ def verdict(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: Che
     carpet = patch[..., 2][around & patch_green]
     field_value = byte_median(carpet if carpet.size >= 3 else patch[..., 2][around])
     darkest = int(counts[:dark_bytes] @ BYTE_VALUES[:dark_bytes]) / n_dark if n_dark else math.inf  # the black patches' mean
-    if darkest > thresholds.black_contrast * field_value:
+    if darkest > thresholds.black_contrast * field_value and not alone_on_dark_carpet(green, spot, bright, field_value, green_around,
+                                                                                      thresholds):
         return 0.0, False, "black"
     return float(min(1.0, 0.5 + dark + 0.3 * green_around - green_inside)), False, ""
+
+
+def alone_on_dark_carpet(green: np.ndarray, spot: Spot, bright: float, field_value: float, green_around: float,
+                         p: CheckParameters) -> bool:
+    """Whether the spot's white (``bright``) vouches for its black patches though they are no darker than the carpet
+    (``field_value``): on a dark carpet, a white ``white_over_dark_carpet`` times the carpet's value, with the carpet
+    round twice ``green_around_min`` of its edge (``green_around``) and right above it (rows 1.2 to 2 radii up, its
+    middle). Shadows and dark corners have no such white, a robot's foot has its leg above it."""
+    return (bright >= p.white_over_dark_carpet * field_value and green_around >= 2 * p.green_around_min
+            and green_above(green, spot, 1.2, 2.0, 0.5) >= 0.8)
+
+
+def green_above(green: np.ndarray, spot: Spot, nearest: float, farthest: float, half_width: float) -> float:
+    """The carpet's share of the rows ``nearest`` to ``farthest`` radii above the spot, ``half_width`` radii to either
+    side of its column (the larger of its radius and the expected one); 0 where none of them is in the image."""
+    size = max(spot.radius, spot.expected)
+    y0, y1 = int(max(0, spot.y - farthest * size)), int(max(0, spot.y - nearest * size))
+    x0, x1 = int(max(0, spot.x - half_width * size)), int(spot.x + half_width * size) + 1
+    above = green[y0:y1, x0:x1]
+    return np.count_nonzero(above) / above.size if above.size else 0.0
 
 
 def under_post(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: CheckParameters) -> bool:
@@ -108,7 +130,14 @@ def under_post(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: 
     white = max(white, float(own.max())) if own.size else white
     above = hsv[y0:y1, column]
     whites = (above[:, 2] >= p.post_white * white) & (above[:, 1] <= p.saturation_max) & ~green[y0:y1, column]
-    return bool(np.count_nonzero(whites) / len(whites) >= p.post_share)
+    return bool(np.count_nonzero(whites) / len(whites) >= p.post_share) and not carpet_below_post(green, spot)
+
+
+def carpet_below_post(green: np.ndarray, spot: Spot) -> bool:
+    """Whether the carpet shows between the spot's top and what rises above it (its column, 1.1 to 1.6 radii up): then
+    the spot is no post's foot, which is the post itself, but a ball in front of a farther post or below a line running
+    away from the camera (near-vertical in the image)."""
+    return green_above(green, spot, 1.1, 1.6, 0.0) >= 0.5
 
 
 def post_columns(hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, p: CheckParameters) -> tuple[int, np.ndarray]:
@@ -187,7 +216,7 @@ def fit_visible(hsv: np.ndarray, green: np.ndarray, spot: Spot, rays: int = 24) 
     inner = (np.hypot(xi - spot.x, yi - spot.y) <= 0.9 * r) & ~green[yi, xi]
     if inner.sum() < 3:
         return None
-    bright = float(np.percentile(hsv[yi, xi, 2][inner], 90))
+    bright = byte_percentile(hsv[yi, xi, 2][inner], 90)
     ball = seen & ~green[yi, xi] & (hsv[yi, xi, 2] >= 0.6 * bright)
     last = np.where(ball.any(axis=1), steps.size - 1 - np.argmax(ball[:, ::-1], axis=1), -1)
     index = np.arange(rays)
@@ -196,24 +225,34 @@ def fit_visible(hsv: np.ndarray, green: np.ndarray, spot: Spot, rays: int = 24) 
     points = np.column_stack([xs[index, np.maximum(last, 0)], ys[index, np.maximum(last, 0)]])[ends]
     if len(points) < rays // 4:
         return None
-    centre = np.array([spot.x, spot.y])
+    cx, cy = spot.x, spot.y
     for keep in (1.0, 0.8):
         for _ in range(10):
-            offset = points - centre
-            distance = np.maximum(np.linalg.norm(offset, axis=1), 1e-6)
-            residual = distance - r
-            jacobian = -offset / distance[:, None]
-            step = np.linalg.lstsq(jacobian, -residual, rcond=None)[0]
-            centre = centre + step
-            if np.linalg.norm(step) < 0.05:
+            dx, dy = points[:, 0] - cx, points[:, 1] - cy
+            distance = np.maximum(np.hypot(dx, dy), 1e-6)
+            ux, uy, residual = dx / distance, dy / distance, distance - r
+            # the Gauss-Newton step: the least-squares solution of (the unit vectors) . step = residual, by the 2x2
+            # normal equations (numpy's lstsq costs more than the fit)
+            a, b, c = float(ux @ ux), float(ux @ uy), float(uy @ uy)
+            determinant = a * c - b * b
+            if determinant <= 1e-9 * max(a * c, 1e-12):  # the points on one line through the centre: no step is sure
+                break
+            gx, gy = float(ux @ residual), float(uy @ residual)
+            sx, sy = (c * gx - b * gy) / determinant, (a * gy - b * gx) / determinant
+            cx, cy = cx + sx, cy + sy
+            if math.hypot(sx, sy) < 0.05:
                 break
         if keep < 1.0:
             break
-        residual = np.abs(np.linalg.norm(points - centre, axis=1) - r)
-        points = points[residual <= np.quantile(residual, 0.8)]
-    if np.hypot(*(centre - (spot.x, spot.y))) > r:
+        residual = np.abs(np.hypot(points[:, 0] - cx, points[:, 1] - cy) - r)
+        ordered = np.sort(residual)  # np.quantile(residual, 0.8), its linear interpolation, without its overhead
+        virtual = 0.8 * (len(ordered) - 1)
+        low = int(virtual)
+        worst = ordered[low] + (ordered[min(low + 1, len(ordered) - 1)] - ordered[low]) * (virtual - low)
+        points = points[residual <= worst]
+    if math.hypot(cx - spot.x, cy - spot.y) > r:
         return None  # not the spot's ball any more
-    return Spot(float(centre[0]), float(centre[1]), r, spot.expected)
+    return Spot(float(cx), float(cy), r, spot.expected)
 
 
 def square_inside(spot: Spot, shape: tuple[int, ...]) -> bool:

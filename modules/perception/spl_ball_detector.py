@@ -3,6 +3,7 @@ found is ``ball_spots`` (and ``far_ball_spots`` for far balls on the field's edg
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -26,6 +27,11 @@ from tafel.representations.perception import (
     SegmentedImage,
 )
 
+#: the tests after whose failure a candidate is centred on its visible outline and checked again (``recentred``): the
+#: dark-patch test (off a blurred ball's centre its patches are faint) and the post's (a ball touching a line above it
+#: makes one blob with it, whose peak lies between them, and the line reads as a post rising from it)
+RECENTRE_TESTS = ("dark", "post")
+
 
 @requires(CameraImageTop, CameraImageBottom, SegmentedImage, FieldColor, FieldBoundary, CameraMatrixBuffer)
 @provides(BallImagePercept)
@@ -45,6 +51,11 @@ class SPLBallDetector(Module):
       Real light needs the field as the measure: the ball's black patches are darker than the carpet
       around it (``black_contrast``); dark image corners, shadows and the hall's dark floor are
       uniformly dark and have no patches darker than the carpet beside them.
+    - Real light (held-out competition frames): a candidate that fails the dark-patch or the post's test is centred on
+      its visible outline and checked again (``recentre``: a blurred ball's candidate, or one of a ball touching a line,
+      lies off its centre); on a dark carpet a ball's black is no darker than the carpet, and a white far brighter
+      than the carpet vouches for it where the ball lies alone (``white_over_dark_carpet``); a ball in front of a
+      farther post, with the carpet between them, is no post's foot.
     - Second look: a small ball smeared by the head's turn has grey patches, not black ones, and a cast gives
       its white a little colour; a candidate that fails only so passes looser checks (``second_*``) and is a
       ball if the classifier is sure of it (``second_look_min``).
@@ -88,6 +99,10 @@ class SPLBallDetector(Module):
         """share of the carpet's median saturation a pixel needs to hide a ball candidate as green"""
         black_contrast: float = bounded(0.1, 1.5, 0.85)
         """the black patches (mean value) must be darker than this share of the carpet's value around"""
+        white_over_dark_carpet: float = bounded(1.0, 10.0, 3.0)
+        """on a dark carpet a ball's black is no darker than the carpet: a white at least this many times the carpet's
+        value around vouches for its patches instead, for a ball lying alone (carpet above it and round twice
+        ``green_around_min`` of its edge; shadows and dark corners have no such white, robots' feet a leg above)"""
         dark_spot_min: float = bounded(0.0, 1.0, 0.02)
         """share of dark pixels a candidate needs round its centre (a square of its thickness)"""
         classifier: bool = True
@@ -107,6 +122,9 @@ class SPLBallDetector(Module):
         """the second look's looser check: the mean saturation inside at most this"""
         second_look_min: float = bounded(-5.0, 10.0, 3.0)
         """the classifier's score (a logit) a candidate that passed only the looser checks needs"""
+        recentre: bool = True
+        """a candidate that fails the dark-patch or the post's test is centred on its visible outline and checked again
+        (``recentred``, ``RECENTRE_TESTS``)"""
         edge_search: bool = True
         """far balls on the field's edge: also look for ball-coloured blobs in a band round the field boundary"""
         edge_above: int = bounded(0, 60, 14)
@@ -158,6 +176,10 @@ class SPLBallDetector(Module):
                 light: tuple[float, float] | None = None
                 for spot in candidates:
                     score, under_post, failed = verdict(hsv, green, spot, white, p)
+                    if failed in RECENTRE_TESTS and p.recentre:
+                        moved, moved_score, moved_failed = self.recentred(hsv, green, spot, white, failed)
+                        if moved is not spot:  # the fitted spot is no post's foot
+                            spot, score, failed, under_post = moved, moved_score, moved_failed, False
                     if under_post:  # perhaps a ball behind a post, merged with it in the image: look beside it
                         beside = beside_post(hsv, green, spot, white, p)
                         score = check(hsv, green, beside, white, p, beside_post=True)[0] if beside else 0.0
@@ -179,6 +201,19 @@ class SPLBallDetector(Module):
                     if score:
                         found.append(self.candidate(camera, image, spot, score))
         found.sort(key=lambda c: -c.fill)
+
+    def recentred(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, white: float, failed: str) -> tuple[Spot, float, str]:
+        """The spot centred on the visible outline of what it found (``fit_visible``) and checked again: (spot, score, the
+        test failed). A blurred ball, or one with its shadow beside it, makes a blob wider than the ball whose
+        distance-transform peak lies off its centre, with a thickness below its radius; the square checked there holds
+        too little of its faint patches. The fitted spot is kept where it passes or fails only a test the second look
+        loosens (``LOOSER_TESTS``); else ``spot`` is returned with 0 and ``failed``, as it is where fitting moves it by
+        less than a pixel or finds too little outline."""
+        moved = fit_visible(hsv, green, spot)
+        if moved is None or math.hypot(moved.x - spot.x, moved.y - spot.y) < 1.0:
+            return spot, 0.0, failed
+        score, _, again = verdict(hsv, green, moved, white, self.parameters)
+        return (moved, score, again) if score or again in LOOSER_TESTS else (spot, 0.0, failed)
 
     def classify(self, hsv: np.ndarray, green: np.ndarray, spot: Spot, score: float, light: tuple[float, float] | None = None) -> float:
         """``score`` if the classifier takes the spot for a ball, else 0. A ball cut by the image's edge is
@@ -212,9 +247,12 @@ class SPLBallDetector(Module):
         return self.decide(hsv, green, spot, score, light, least=p.second_look_min) if score else 0.0
 
     def looser(self) -> SPLBallDetector.Parameters:
-        """The second look's thresholds: the module's with ``second_*`` for the tests of ``LOOSER_TESTS``."""
+        """The second look's thresholds: the module's with ``second_*`` for the tests of ``LOOSER_TESTS``. Its grey
+        patches need black darker than the carpet: a white over a dark carpet vouches for black patches only (the
+        first look's ``white_over_dark_carpet``), or a robot's toe on a dark carpet would pass."""
         p = self.parameters
-        return replace(p, dark_ratio=p.second_dark_ratio, black_contrast=p.second_black_contrast, saturation_max=p.second_saturation_max)
+        return replace(p, dark_ratio=p.second_dark_ratio, black_contrast=p.second_black_contrast,
+                       white_over_dark_carpet=math.inf, saturation_max=p.second_saturation_max)
 
     @staticmethod
     def candidate(camera: str, image: CameraImage, spot: Spot, score: float) -> BallCandidate:
