@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 import pytest
 
-from tests.support.painted_balls import CARPET, HEIGHT, WIDTH, SureModel, ball_radius, found
+from tests.support.painted_balls import CARPET, HEIGHT, WIDTH, SureModel, ball_radius, found, paint_ball
 
 
 def blurred_ball_image(patch_grey: int) -> tuple[np.ndarray, tuple[float, float, float]]:
@@ -21,11 +21,7 @@ def blurred_ball_image(patch_grey: int) -> tuple[np.ndarray, tuple[float, float,
     image[:] = np.clip(image.astype(int) + rng.normal(0, 4, image.shape), 0, 255).astype(np.uint8)
     x, y = 160.0, 150.0
     radius = ball_radius(x, y)
-    cv2.circle(image, (int(x), int(y)), int(round(radius)), (230, 230, 230), -1)
-    for angle in np.linspace(0, 2 * math.pi, 5, endpoint=False):
-        cv2.circle(image, (int(x + 0.55 * radius * math.cos(angle)), int(y + 0.55 * radius * math.sin(angle))), max(1, int(0.3 * radius)),
-                   (patch_grey,) * 3, -1)
-    cv2.circle(image, (int(x), int(y)), max(1, int(0.3 * radius)), (patch_grey,) * 3, -1)
+    paint_ball(image, x, y, radius, 230, patch_grey)
     kernel = np.full((1, 3), 1 / 3, np.float32)  # a short smear sideways
     return cv2.filter2D(image, -1, kernel), (x, y, radius)
 

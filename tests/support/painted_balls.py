@@ -60,13 +60,18 @@ def painted_ball(patch_grey: int, white: int = 230, carpet: tuple[int, int, int]
     radius = ball_radius(x, y)
     if behind is not None:
         behind(image, x, y, radius)
+    paint_ball(image, x, y, radius, white, patch_grey)
+    image[:] = np.clip(image.astype(int) + rng.normal(0, noise, image.shape), 0, 255).astype(np.uint8)
+    return image, (x, y, radius)
+
+
+def paint_ball(image: np.ndarray, x: float, y: float, radius: float, white: int, patch_grey: int) -> None:
+    """A ball at (x, y) (px) into ``image``: a disc ``white`` with six patches ``patch_grey``, five round the middle."""
     cv2.circle(image, (int(x), int(y)), int(round(radius)), (white,) * 3, -1)
     for angle in np.linspace(0, 2 * math.pi, 5, endpoint=False):
         cv2.circle(image, (int(x + 0.55 * radius * math.cos(angle)), int(y + 0.55 * radius * math.sin(angle))), max(1, int(0.3 * radius)),
                    (patch_grey,) * 3, -1)
     cv2.circle(image, (int(x), int(y)), max(1, int(0.3 * radius)), (patch_grey,) * 3, -1)
-    image[:] = np.clip(image.astype(int) + rng.normal(0, noise, image.shape), 0, 255).astype(np.uint8)
-    return image, (x, y, radius)
 
 
 def found(image: np.ndarray, model: SureModel | None, **parameters: object) -> list[BallCandidate]:
