@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 
-import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -85,20 +84,6 @@ def test_a_robot_left_behind_is_remembered_longer_than_one_in_view_that_is_no_lo
         assert (len(harness[Obstacles].obstacles) == 1) is kept, turned
     harnesses[math.pi].advance(p.unseen_memory_s)  # and then forgotten too
     assert harnesses[math.pi][Obstacles].obstacles == []
-
-
-def test_an_opponent_left_standing_behind_is_still_kept_from_seven_seconds_later() -> None:
-    """Recorded in a 5v5 (seed 1, 625.9 s): an opponent last seen 0.6 m away stood still while the robot turned from
-    it; 5 s later the robot forgot it, and 2 s after that walked into it sideways (the referee called pushing). A
-    robot behind, where nothing is seen, is kept for 10 s."""
-    harness = ModuleHarness(ObstacleModeler, RobotPose(valid=True), RobotsPercept(robots=[SeenRobot(600.0, 0.0)]))
-    harness.execute()
-    harness.set(RobotsPercept(robots=[]), RobotPose(valid=True, rotation=math.radians(110.0)))  # just beyond the view
-    harness.advance(7.0)
-    obstacles = harness[Obstacles].obstacles
-    assert len(obstacles) == 1 and math.hypot(obstacles[0].x, obstacles[0].y) == pytest.approx(600.0, abs=1.0), obstacles
-    harness.advance(3.5)
-    assert harness[Obstacles].obstacles == []  # then it may have gone
 
 
 def test_a_way_brought_back_onto_the_field_does_not_lead_into_the_opponent_beside_the_robot() -> None:

@@ -57,9 +57,8 @@ class ObstacleModeler(Module):
         view_angle: float = bounded(0.0, math.pi, 1.75)
         """rad either side of the heading within which robots are seen (``tafel match --cameras off``: 100
         degrees); one remembered beyond it is not looked for"""
-        unseen_memory_s: float = bounded(0.0, 30.0, 10.0)
-        """s a robot remembered beyond ``view_angle`` is kept after it was last seen (5 s was too short: in a 5v5 an
-        opponent standing behind was forgotten, and walked into sideways 2 s later)"""
+        unseen_memory_s: float = bounded(0.0, 30.0, 5.0)
+        """s a robot remembered beyond ``view_angle`` is kept after it was last seen"""
         mate_timeout: float = bounded(0.0, 30.0, 6.0)
         """s after a teammate's message that its position is still used"""
         mate_spread: float = bounded(0.0, 500.0, 60.0)
