@@ -53,6 +53,9 @@ class Obstacles:
     """Every robot this one knows to be near (robot frame), nearest first."""
 
     obstacles: list[Obstacle]
+    faint: list[Obstacle]
+    """robots remembered beside or behind (where they cannot be seen again) for longer than the obstacles keep
+    them: where one may still stand, not walked round but not walked into faster than the rules' pushing"""
     clearance: float = bounded(0.0, 2000.0, 0.0)
     """mm between this robot's centre and the nearest obstacle's edge (0: none near or touching)"""
 

@@ -176,6 +176,25 @@ def test_a_far_target_behind_to_be_faced_is_turned_to_first_not_walked_to_backwa
         assert forward < -0.8 * limits.max_backward
 
 
+@pytest.mark.parametrize("degrees, faces_first", [(80.0, True), (-95.0, True), (50.0, False), (-30.0, False)])
+def test_a_far_target_beside_is_faced_first_not_walked_to_sideways(degrees: float, faces_first: bool) -> None:
+    """A target 1.5 m away beside the heading by more than ``face_beside_beyond``: sideways at full speed, the turn
+    to face it gets only what the sideways speed leaves (the ellipsoid), and a robot just beyond the way, beyond
+    the 100 degrees seen, was walked into (5v5 seed 1, 79.5 s). So it is faced nearly in place first; one less
+    beside is walked to while turning, as before."""
+    angle = math.radians(degrees)
+    harness = walking(MotionRequest(motion=MotionType.walk_to, target_x=1500.0 * math.cos(angle), target_y=1500.0 * math.sin(angle)))
+    harness.execute()
+    (forward, sideways, turn), _ = harness.module.requested_velocity()
+    limits = WalkingEngine.Parameters()
+    assert math.copysign(1.0, turn) == math.copysign(1.0, angle)
+    if faces_first:  # at full turning speed, hardly a step on the way
+        assert math.hypot(forward, sideways) <= limits.turn_in_place_step * limits.target_gain + 1e-6
+        assert abs(turn) > 0.8 * limits.max_turn
+    else:  # on its way at more than half the walk's speed
+        assert math.hypot(forward, sideways) > 0.5 * limits.max_sideways
+
+
 # ------------------------------------------------------------------------------- selection, blending
 def selector(*inputs: object) -> ModuleHarness:
     harness = ModuleHarness(MotionSelector, *inputs, parameters={"startup": 0.0}, context="motion")

@@ -9,11 +9,14 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tafel.core.testing import ModuleHarness
+from tafel.modules.behavior.fair_walk import keep_from_pushing
 from tafel.modules.behavior.options.soccer import OWN_GOAL_X
 from tafel.modules.behavior.soccer_behavior import SoccerBehavior
 from tafel.modules.modeling.obstacle_modeler import ObstacleModeler
@@ -46,6 +49,22 @@ def approach(track: deque[tuple[float, float, float]], other: tuple[float, float
     return ((x1 - x0) * (other[0] - x1) + (y1 - y0) * (other[1] - y1)) / distance / max(t1 - t0, 1e-9)
 
 
+def walk(out: MotionRequest, pose: RobotPose, vx: float, vy: float) -> tuple[float, float, float, float, float]:
+    """One frame of the walk as asked (kinematically): the new pose (field mm, mm, rad) and velocity (mm/s)."""
+    wanted_x = wanted_y = turn = 0.0
+    if out.motion is MotionType.walk_to:
+        wanted_x, wanted_y = (GAIN * v for v in pose.to_field(out.target_x, out.target_y))
+        wanted_x, wanted_y = wanted_x - GAIN * pose.x, wanted_y - GAIN * pose.y
+        turn = max(-MAX_TURN, min(MAX_TURN, GAIN * out.target_rotation))
+    speed = math.hypot(wanted_x, wanted_y)
+    if speed > MAX_SPEED:
+        wanted_x, wanted_y = wanted_x * MAX_SPEED / speed, wanted_y * MAX_SPEED / speed
+    change = math.hypot(wanted_x - vx, wanted_y - vy)
+    step = min(1.0, ACCELERATION * FRAME_S / max(change, 1e-9))
+    vx, vy = vx + (wanted_x - vx) * step, vy + (wanted_y - vy) * step
+    return pose.x + vx * FRAME_S, pose.y + vy * FRAME_S, math.remainder(pose.rotation + turn * FRAME_S, math.tau), vx, vy
+
+
 def play(start: tuple[float, float, float], ball: tuple[float, float], opponent: tuple[float, float], seconds: float = 6.0,
          role: Role = Role.striker, challenge: bool = False) -> tuple[float, float]:
     """The robot walks from ``start`` (field mm, mm, rad) as ``SoccerBehavior`` asks (walk_to, kinematically), the
@@ -64,18 +83,7 @@ def play(start: tuple[float, float, float], ball: tuple[float, float], opponent:
         ox, oy = robot_frame(pose, *opponent)
         harness.set(pose, BallModel(valid=True, seen=True, x=bx, y=by), Obstacles(obstacles=[Obstacle(x=ox, y=oy, kind=ObstacleKind.robot)]))
         out = harness.execute()[MotionRequest]
-        wanted_x = wanted_y = turn = 0.0
-        if out.motion is MotionType.walk_to:
-            wanted_x, wanted_y = (GAIN * v for v in pose.to_field(out.target_x, out.target_y))
-            wanted_x, wanted_y = wanted_x - GAIN * x, wanted_y - GAIN * y
-            turn = max(-MAX_TURN, min(MAX_TURN, GAIN * out.target_rotation))
-        speed = math.hypot(wanted_x, wanted_y)
-        if speed > MAX_SPEED:
-            wanted_x, wanted_y = wanted_x * MAX_SPEED / speed, wanted_y * MAX_SPEED / speed
-        change = math.hypot(wanted_x - vx, wanted_y - vy)
-        step = min(1.0, ACCELERATION * FRAME_S / max(change, 1e-9))
-        vx, vy = vx + (wanted_x - vx) * step, vy + (wanted_y - vy) * step
-        x, y, heading = x + vx * FRAME_S, y + vy * FRAME_S, math.remainder(heading + turn * FRAME_S, math.tau)
+        x, y, heading, vx, vy = walk(out, pose, vx, vy)
         now = frame * FRAME_S
         track.append((now, x, y))
         while len(track) > 2 and now - track[1][0] >= PUSH_WINDOW_S:
@@ -179,3 +187,69 @@ def test_a_keeper_seen_by_its_goal_post_is_kept_from_and_a_walk_backwards_is_slo
             assert math.hypot(out.target_x, out.target_y) <= 45.0 + 1e-6
         else:
             assert abs(math.remainder(out.target_rotation - way, math.tau)) < 0.01
+
+
+def test_a_robot_remembered_behind_fades_to_faint_before_it_is_forgotten() -> None:
+    """5v5 seed 1, 625.9 s: an opponent seen 0.6 m away, then beside and behind the robot (beyond the 100 degrees it
+    sees) was dropped after ``unseen_memory_s`` (5 s) and pushed 2 s later. Now it stays, ``faint``, until
+    ``faint_memory_s``; in view again and not seen, it is gone (as any robot not seen for ``memory_s``)."""
+    p = ObstacleModeler.Parameters()
+    harness = ModuleHarness(ObstacleModeler, RobotPose(valid=True), RobotsPercept(robots=[SeenRobot(100.0, -590.0)]))  # -80 degrees
+    harness.execute()
+    harness.set(RobotsPercept(robots=[]), RobotPose(valid=True, rotation=0.5))  # turned left: the opponent at -109 degrees
+    held = {}
+    for at_s in (3.0, 7.1, p.faint_memory_s - 0.5, p.faint_memory_s + 0.5):
+        found = harness.advance(at_s - harness.time_s)[Obstacles]
+        held[at_s] = (len(found.obstacles), len(found.faint))
+        if at_s == 7.1:
+            assert math.degrees(math.atan2(found.faint[0].y, found.faint[0].x)) == pytest.approx(-109.0, abs=0.5)
+            assert found.faint[0].age == pytest.approx(7.1, abs=0.05) and found.clearance == 0.0  # no obstacle near
+    assert held == {3.0: (1, 0), 7.1: (0, 1), p.faint_memory_s - 0.5: (0, 1), p.faint_memory_s + 0.5: (0, 0)}
+    harness.set(RobotsPercept(robots=[SeenRobot(100.0, -590.0)]), RobotPose(valid=True))  # seen again: an obstacle again
+    harness.execute()
+    harness.set(RobotsPercept(robots=[]), RobotPose(valid=True, rotation=0.5))
+    harness.advance(7.0)
+    assert len(harness.execute()[Obstacles].faint) == 1
+    harness.set(RobotPose(valid=True))  # in view again and not seen there: gone (seen longer than memory_s ago)
+    found = harness.execute()[Obstacles]
+    assert found.obstacles == [] and found.faint == []
+
+
+def walk_past(target: tuple[float, float], other: tuple[float, float], obstacles: Callable[[Obstacle], Obstacles],
+              heading: float = 0.0, seconds: float = 10.0) -> tuple[float, float]:
+    """From (0, 0) facing ``heading`` (rad), the walk to ``target`` (field mm) as ``keep_from_pushing`` leaves it, with
+    a robot standing at ``other`` (field mm) that the obstacle model reports as ``obstacles`` of it (robot frame).
+    Returns the fastest approach to it while touching (mm/s over ``PUSH_WINDOW_S``, as the referee measures it) and
+    how far the walk ended from ``target`` (mm)."""
+    x, y, vx, vy = 0.0, 0.0, 0.0, 0.0
+    track: deque[tuple[float, float, float]] = deque()
+    worst = 0.0
+    for frame in range(int(seconds / FRAME_S)):
+        pose = RobotPose(valid=True, x=x, y=y, rotation=heading)
+        out = MotionRequest(motion=MotionType.walk_to)
+        out.target_x, out.target_y = pose.to_robot(*target)
+        keep_from_pushing(out, pose, playing(), obstacles(Obstacle(*pose.to_robot(*other), kind=ObstacleKind.robot, age=7.0)),
+                          RobotsPercept(), SoccerBehavior.Parameters())
+        x, y, _, vx, vy = walk(out, pose, vx, vy)
+        now = frame * FRAME_S
+        track.append((now, x, y))
+        while len(track) > 2 and now - track[1][0] >= PUSH_WINDOW_S:
+            track.popleft()
+        if math.hypot(other[0] - x, other[1] - y) < CONTACT and now >= PUSH_WINDOW_S:
+            worst = max(worst, approach(track, other))
+    return worst, math.hypot(target[0] - x, target[1] - y)
+
+
+def test_a_faint_robot_is_not_walked_into_fast_and_blocks_no_way() -> None:
+    """The 5v5 seed 1 push at 625.9 s, kinematically: walking forwards-right (45 degrees) to its place, the robot
+    passes 283 mm from an opponent it last saw 7 s before, at -104 degrees when they touch (beyond what it sees).
+    Forgotten, it was walked into (the premise); faint, it is approached slower than the rules' pushing, and the walk
+    still gets past. A faint
+    robot on the walk's target (it may have gone) holds the walk back no more than a slow step: the target is
+    reached, where a robot seen there holds the walk back at ``push_distance``."""
+    forgotten, _ = walk_past((2000.0, -2000.0), (620.0, -1020.0), lambda _: Obstacles())
+    faint, missed = walk_past((2000.0, -2000.0), (620.0, -1020.0), lambda o: Obstacles(faint=[o]))
+    assert forgotten > PUSH_SPEED and faint <= PUSH_SPEED and missed < 100.0
+    _, missed = walk_past((600.0, -300.0), (600.0, -300.0), lambda o: Obstacles(faint=[o]), seconds=15.0)
+    _, held = walk_past((600.0, -300.0), (600.0, -300.0), lambda o: Obstacles(obstacles=[o]), seconds=15.0)
+    assert missed < 50.0 and held == pytest.approx(SoccerBehavior.Parameters().push_distance, abs=30.0)

@@ -22,6 +22,9 @@ KEEPER_AREA_MARGIN = 150.0  # mm inside its penalty area's lines a goalkeeper is
 #: is nearer than BLIND_TURN mm; farther, the robot is to face its way (the walk turns to it first, nearly in place:
 #: ``WalkingEngine``'s turn_in_place_beyond)
 BLIND, BLIND_STEP, BLIND_TURN = math.radians(100.0), 45.0, 400.0
+#: mm (centre to centre) within which a faint robot (``Obstacles.faint``: remembered behind, may have gone) is walked
+#: towards no faster than BLIND_STEP allows (below the rules' pushing); beyond, the walk has room to slow down to it
+FAINT_NEAR = 700.0
 POST_SEEN = 300.0  # mm round a goal post within which ObstacleModeler takes what is seen for the post (its post_radius)
 KICK_HELD_BACK = 30.0  # mm a walk's target may be held back from a robot (``keep_from_pushing``) and the walk kick still be asked for
 
@@ -104,7 +107,9 @@ def keep_from_pushing(out: MotionRequest, pose: RobotPose, game: GameState, obst
     a walk's target is held back along the line to every robot (not a teammate) so that the way towards it
     ends ``push_distance`` from its centre, as near as the robot may come. Sideways to it the walk goes
     on; the walk slows as it nears its target, so it comes to rest there rather than at contact. One
-    already nearer steps back a little, straight away from it. Robots seen at a goal post count too
+    already nearer steps back a little, straight away from it. A faint robot (``Obstacles.faint``, remembered behind
+    the robot for longer than it is walked round) may have gone: the walk is not held back from it, but goes
+    towards it, within ``FAINT_NEAR``, no faster than ``BLIND_STEP`` allows. Robots seen at a goal post count too
     (``ObstacleModeler`` takes them for the post: a keeper by its post was walked into). A walk backwards,
     ``BLIND`` of the heading where nothing is seen, goes no faster than the rules' pushing (``BLIND_STEP``).
     The rules spare the goalkeeper in its own
@@ -123,13 +128,15 @@ def keep_from_pushing(out: MotionRequest, pose: RobotPose, game: GameState, obst
         robots += [(r.x, r.y) for r in percept.robots if any(
             math.dist(pose.to_field(r.x, r.y), (sx * pitch.LENGTH / 2, sy * (pitch.GOAL_INNER_WIDTH + pitch.GOAL_POST_DIAMETER) / 2)) < POST_SEEN
             for sx in (-1, 1) for sy in (-1, 1))]
+    limits = [(rx, ry, math.hypot(rx, ry) - p.push_distance) for rx, ry in robots]
+    limits += [(o.x, o.y, BLIND_STEP) for o in obstacles.faint if math.hypot(o.x, o.y) < FAINT_NEAR]
     for _ in range(3):  # held back from one, the target may lead further towards another: again
-        for rx, ry in robots:
+        for rx, ry, limit in limits:
             distance = math.hypot(rx, ry)
             if distance < 1.0:
                 continue
             ux, uy = rx / distance, ry / distance
-            towards, limit = x * ux + y * uy, distance - p.push_distance
+            towards = x * ux + y * uy
             if towards > limit:
                 x, y = x - (towards - limit) * ux, y - (towards - limit) * uy
     length, way = math.hypot(x, y), math.atan2(y, x)
