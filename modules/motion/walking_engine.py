@@ -299,9 +299,9 @@ class WalkingEngine(Module):
         distance = math.hypot(x, y)
         far = distance > 400.0  # far away: face the target first, then turn to its rotation
         heading = math.atan2(y, x) if far and x > -200 else turn
-        if far and x <= -200 and abs(turn) > p.turn_in_place_beyond:  # behind, to be faced: turn first (behind, nothing is seen)
-            x, y = x * p.turn_in_place_step / distance, y * p.turn_in_place_step / distance
-        elif far and x > -200 and abs(heading) > p.face_beside_beyond:  # beside: face it first (beside, little is seen)
+        behind = far and x <= -200 and abs(turn) > p.turn_in_place_beyond  # behind, to be faced: nothing is seen there
+        beside = far and x > -200 and abs(heading) > p.face_beside_beyond  # beside: little is seen beyond the way
+        if behind or beside:  # turn first
             x, y = x * p.turn_in_place_step / distance, y * p.turn_in_place_step / distance
         return np.array([x, y, heading]) * p.target_gain, False
 
