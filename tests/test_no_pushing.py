@@ -65,6 +65,13 @@ def walk(out: MotionRequest, pose: RobotPose, vx: float, vy: float) -> tuple[flo
     return pose.x + vx * FRAME_S, pose.y + vy * FRAME_S, math.remainder(pose.rotation + turn * FRAME_S, math.tau), vx, vy
 
 
+def keep_window(track: deque[tuple[float, float, float]], now: float, x: float, y: float) -> None:
+    """Adds the robot's (s, x mm, y mm) to ``track`` and keeps the last ``PUSH_WINDOW_S`` of it, as the referee does."""
+    track.append((now, x, y))
+    while len(track) > 2 and now - track[1][0] >= PUSH_WINDOW_S:
+        track.popleft()
+
+
 def play(start: tuple[float, float, float], ball: tuple[float, float], opponent: tuple[float, float], seconds: float = 6.0,
          role: Role = Role.striker, challenge: bool = False) -> tuple[float, float]:
     """The robot walks from ``start`` (field mm, mm, rad) as ``SoccerBehavior`` asks (walk_to, kinematically), the
@@ -85,9 +92,7 @@ def play(start: tuple[float, float, float], ball: tuple[float, float], opponent:
         out = harness.execute()[MotionRequest]
         x, y, heading, vx, vy = walk(out, pose, vx, vy)
         now = frame * FRAME_S
-        track.append((now, x, y))
-        while len(track) > 2 and now - track[1][0] >= PUSH_WINDOW_S:
-            track.popleft()
+        keep_window(track, now, x, y)
         nearest_ball = min(nearest_ball, math.hypot(ball[0] - x, ball[1] - y))
         if math.hypot(opponent[0] - x, opponent[1] - y) < CONTACT and now >= PUSH_WINDOW_S:
             worst = max(worst, approach(track, opponent))
@@ -232,9 +237,7 @@ def walk_past(target: tuple[float, float], other: tuple[float, float], obstacles
                           RobotsPercept(), SoccerBehavior.Parameters())
         x, y, _, vx, vy = walk(out, pose, vx, vy)
         now = frame * FRAME_S
-        track.append((now, x, y))
-        while len(track) > 2 and now - track[1][0] >= PUSH_WINDOW_S:
-            track.popleft()
+        keep_window(track, now, x, y)
         if math.hypot(other[0] - x, other[1] - y) < CONTACT and now >= PUSH_WINDOW_S:
             worst = max(worst, approach(track, other))
     return worst, math.hypot(target[0] - x, target[1] - y)

@@ -112,10 +112,13 @@ class ObstacleModeler(Module):
                 self.remembered(*odometry.to_local(ox, oy), now - when, obstacles, faint)
         if pose.valid:
             self.unplaced = []
-        obstacles, out.faint = (sorted((o for o in found if math.hypot(o.x, o.y) <= p.max_distance), key=lambda o: math.hypot(o.x, o.y))
-                                for found in (obstacles, faint))
-        out.obstacles = obstacles
-        out.clearance = max(0.0, min((math.hypot(o.x, o.y) - o.radius for o in obstacles), default=0.0))
+        out.obstacles, out.faint = self.nearest_first(obstacles), self.nearest_first(faint)
+        out.clearance = max(0.0, min((math.hypot(o.x, o.y) - o.radius for o in out.obstacles), default=0.0))
+
+    def nearest_first(self, found: list[Obstacle]) -> list[Obstacle]:
+        """``found`` within ``max_distance``, nearest first."""
+        near = (o for o in found if math.hypot(o.x, o.y) <= self.parameters.max_distance)
+        return sorted(near, key=lambda o: math.hypot(o.x, o.y))
 
     def claimed(self, places: list[tuple[float, float]], now: float) -> set[int]:
         """Which of ``self.seen`` are the teammates said to be at ``places`` (field mm; ``same_robots``). A teammate
@@ -133,8 +136,8 @@ class ObstacleModeler(Module):
     def memory(self, x: float, y: float) -> float:
         """s a robot remembered at (x, y) (robot frame mm) is kept: beyond ``view_angle``, where it is not looked
         for, as an obstacle for longer and then as ``faint``."""
-        beyond = abs(bearing(x, y)) > self.parameters.view_angle
-        return max(self.obstacle_memory(x, y), self.parameters.faint_memory_s) if beyond else self.obstacle_memory(x, y)
+        p = self.parameters
+        return p.memory_s if abs(bearing(x, y)) <= p.view_angle else max(p.memory_s, p.unseen_memory_s, p.faint_memory_s)
 
     def obstacle_memory(self, x: float, y: float) -> float:
         """s a robot remembered at (x, y) (robot frame mm) stays an obstacle (then faint, or forgotten)."""
