@@ -195,6 +195,33 @@ def test_a_far_target_beside_is_faced_first_not_walked_to_sideways(degrees: floa
         assert math.hypot(forward, sideways) > 0.5 * limits.max_sideways
 
 
+def arrival(request: MotionRequest, **parameters: float) -> tuple[float, Odometry]:
+    """s until ``request``'s walk_to target is reached, and the odometry there. The gyroscope reports the turn the
+    walk makes (in the harness nothing else turns the robot: odometry's rotation is the gyroscope's)."""
+    harness = ModuleHarness(WalkingEngine, request, MotionSelection(active=request.motion), context="motion", parameters=parameters)
+    for frame in range(1, 2001):
+        harness.set(InertialSensorData(gyroscope=np.array([0.0, 0.0, float(harness.module.velocity[2])])))
+        harness.advance(0.01)
+        if harness[WalkingEngineOutput].target_reached:
+            return frame * 0.01, harness[Odometry]
+    raise AssertionError(f"{request} not reached in 20 s")
+
+
+@pytest.mark.parametrize("degrees, rotation", [(90.0, 0.0), (-80.0, math.pi)])
+def test_facing_a_far_target_beside_first_costs_no_time(degrees: float, rotation: float) -> None:
+    """READY and the set plays' retreats ask for such targets: a place 1.5 m beside, keeping the heading or turning
+    round. Turned to first, the walk gets there no later than walking sideways (forward is the faster way)."""
+    angle = math.radians(degrees)
+    request = MotionRequest(motion=MotionType.walk_to, target_x=1500.0 * math.cos(angle), target_y=1500.0 * math.sin(angle),
+                            target_rotation=rotation)
+    faced, there = arrival(request)
+    sideways, _ = arrival(request, face_beside_beyond=math.pi)
+    assert faced <= sideways, (faced, sideways)
+    limits = WalkingEngine.Parameters()
+    assert math.hypot(there.x - request.target_x, there.y - request.target_y) < limits.target_tolerance
+    assert abs(math.remainder(there.rotation - rotation, math.tau)) < limits.target_tolerance / 400
+
+
 # ------------------------------------------------------------------------------- selection, blending
 def selector(*inputs: object) -> ModuleHarness:
     harness = ModuleHarness(MotionSelector, *inputs, parameters={"startup": 0.0}, context="motion")
