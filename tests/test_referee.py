@@ -99,8 +99,33 @@ def test_in_set_a_robot_in_the_other_half_is_penalized_15_s_counted_only_in_read
     until(referee, State.playing)
     run(referee, 15.1)
     assert robot.penalty is Penalty.none
-    x, y, _ = referee.world.robot_pose(1)
-    assert x > 0 and abs(abs(y) - 3000.0) < 10.0  # back on a touchline of its own half
+    # the rules' re-entry point: 0.5 m outside the touchline nearest to where it was taken off (its right, at
+    # world y > 0 for team 2), level with its own penalty mark (world x = 4500 - 1300), facing the field
+    assert referee.world.robot_pose(1) == pytest.approx((3200.0, 3500.0, -math.pi / 2), abs=1.0)
+
+
+def test_a_robot_put_back_where_another_stands_goes_along_the_touchline_and_standing_there_is_not_leaving_the_field(
+        referee: Referee) -> None:
+    until(referee, State.playing)
+    referee.world.move_robot(0, -2000.0, -1500.0, 0.0)  # team 1's robot, on its right
+    referee.penalize(referee.players[0], Penalty.request_for_pickup, referee.now)
+    run(referee, 44.0)
+    referee.game.teams[1].players[0].penalty, referee.players[1].penalized_until_s = Penalty.none, -1.0  # (inactive meanwhile)
+    referee.world.move_robot(1, -3200.0, -3500.0, 0.0)  # an opponent on its re-entry point
+    run(referee, 1.1)
+    assert referee.game.teams[0].players[0].penalty is Penalty.none
+    assert referee.world.robot_pose(0) == pytest.approx((-2800.0, -3500.0, math.pi / 2), abs=1.0)  # 0.4 m on, facing the field
+    run(referee, 1.0)
+    assert not [f for f in referee.fouls if f.penalty is Penalty.leaving_the_field]  # on the carpet, 0.5 m beyond the line
+
+
+@pytest.mark.parametrize("x, y, left", [(0.0, 3500.0, False), (0.0, -3750.0, True), (5150.0, 0.0, False), (5250.0, 1000.0, True)])
+def test_leaving_the_field_is_leaving_the_carpet_not_crossing_a_line(referee: Referee, x: float, y: float, left: bool) -> None:
+    """The rules' 10.4 x 7.4 m carpet: 0.7 m beyond the lines."""
+    until(referee, State.playing)
+    referee.world.move_robot(1, x, y, 0.0)
+    run(referee, TICK)
+    assert bool([f for f in referee.fouls if f.penalty is Penalty.leaving_the_field]) == left, referee.fouls
 
 
 def test_a_defender_in_the_centre_circle_at_the_kick_off_and_near_a_free_kick_is_penalized_45_s(referee: Referee) -> None:
@@ -140,6 +165,30 @@ def test_walking_into_an_opponent_is_pushing_by_the_rule_book_even_in_a_duel_for
     walk(referee, 0, (-2200.0, 2000.0), 0.0, (300.0, 0.0), 0.6)  # team 1's walks into its side at 300 mm/s
     foul = referee.fouls[-1]
     assert (foul.team, foul.player, foul.penalty) == (1, 1, Penalty.player_pushing) and "walked into team 2 player 1" in foul.reason
+    # within 0.5 m of the ball: a pushing free kick for the pushed team, the ball left where it is
+    assert referee.game.set_play is SetPlay.pushing_free_kick and referee.game.kicking_team == 2
+    assert referee.world.ball_position() == pytest.approx((-1800.0, 2250.0), abs=1.0)
+
+
+@pytest.mark.parametrize("case", ["far from the ball", "into the pusher's penalty area", "during a free kick"])
+def test_a_push_away_from_the_ball_or_into_the_own_penalty_area_or_in_a_free_kick_brings_no_free_kick(
+        referee: Referee, case: str) -> None:
+    """The rules: a pushing free kick only for a pusher within about 0.5 m of the ball; a push into the pusher's own
+    penalty area would be a penalty kick (this referee does not run one), and a push during a free kick brings none."""
+    until(referee, State.playing)
+    start, to, ball = (-2200.0, 2000.0), (-1700.0, 2000.0), (-1800.0, 2250.0)
+    if case == "far from the ball":
+        ball = (1000.0, 0.0)
+    elif case == "into the pusher's penalty area":  # a field player (the keeper there may touch)
+        start, to, ball = (-3900.0, 500.0), (-3400.0, 500.0), (-3500.0, 750.0)
+        referee.game.teams[0].goalkeeper = 2
+    referee.world.move_ball(*ball)
+    if case == "during a free kick":
+        referee.start_set_play(SetPlay.kick_in, 0, *ball, referee.now)
+    referee.world.move_robot(1, *to, math.pi / 2)
+    walk(referee, 0, start, 0.0, (300.0, 0.0), 0.6)
+    assert [(f.team, f.penalty) for f in referee.fouls] == [(1, Penalty.player_pushing)]
+    assert referee.game.set_play is (SetPlay.kick_in if case == "during a free kick" else SetPlay.none)
 
 
 @pytest.mark.parametrize("case", ["standing swaying", "front to front over the ball", "side on the way to the ball", "keeper in its area"])
@@ -524,7 +573,7 @@ def test_a_striker_leaving_the_field_before_its_kick_is_penalized_and_its_shot_e
     ref, _ = shoot_out
     _, striker, _ = penalty_shot_playing(ref)
     run(ref, 3.0)
-    ref.world.move_robot(striker, 3000.0, 3400.0, 0.0)
+    ref.world.move_robot(striker, 3000.0, 3800.0, 0.0)  # off the carpet
     run(ref, TICK)
     assert [(f.team, f.player, f.penalty) for f in ref.fouls] == [(1, 2, Penalty.leaving_the_field)]
     assert ref.shots[-1].outcome == "foul" and ref.game.state is State.finished

@@ -89,11 +89,13 @@ class FieldModel:
         return self.uniform(rng, count, (-field.LENGTH / 2, 0.0))
 
     def penalty_return(self, rng: np.random.Generator, count: int) -> np.ndarray:
-        """Where a referee puts a robot back after a penalty: on a touchline of its own half, facing the
-        field (the rules name the spot; this covers the whole own half's touchlines, either side)."""
+        """Where a referee puts a robot back after a penalty: by a touchline of its own half, facing the field.
+        The rules name a spot (about 0.5 m outside the touchline, level with the own penalty mark), referees
+        place by eye and older rules put the robot on the line: this covers the own half's touchlines from on
+        the line to the carpet's edge, either side."""
         side = rng.choice([-1.0, 1.0], count)
         return np.column_stack([rng.uniform(-field.LENGTH / 2 + 500.0, -500.0, count),
-                                side * field.WIDTH / 2 + rng.normal(0.0, 100.0, count),
+                                side * (field.WIDTH / 2 + rng.uniform(-100.0, field.BORDER_STRIP, count)),
                                 -side * math.pi / 2 + rng.normal(0.0, 0.15, count)])
 
     def poses_from_percepts(self, rng: np.random.Generator, count: int, lines: LinePercept, posts: GoalPostPercept) -> np.ndarray:

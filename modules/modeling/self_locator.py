@@ -53,8 +53,9 @@ class SelfLocator(Module):
       or slipped), part of the particles are made anew from what is seen (sensor resetting): around
       a seen post at its measured distance, on the centre circle's position, or on a field line.
       ``RobotPose.lost`` says so.
-    - When a penalty ends, the referee has carried the robot to a touchline of its own half: the
-      particles start anew there, facing the field.
+    - When a penalty ends, the referee has carried the robot to a touchline of its own half (the rules:
+      0.5 m outside it, level with the penalty mark): the particles start anew by those touchlines, facing
+      the field.
     - Told where it is (``KnownPose``, the simulator's ``sim:move_robot ... -reset on``): every particle
       starts there and the pose is valid at once. That is the only way out of the symmetric field's
       ambiguity for a robot carried into the other half, which the rules above put in its own half.

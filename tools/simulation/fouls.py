@@ -16,12 +16,13 @@ penalties they bring.
   5 s (its body's joints still, ``GET_UP_S``), or that is not up after 2 attempts (3 when another robot
   came near it meanwhile: disturbed); an upright robot that ceased activity for 10 s (``INACTIVE_S``: it
   neither walked nor turned, its head did not move, and the ball was in neither camera's view);
-- leaving the field, local game stuck (nobody touched the ball for 30 s with robots beside it).
+- leaving the field (the torso beyond the 10.4 x 7.4 m carpet, as the rules have it: over a line is no foul),
+  local game stuck (nobody touched the ball for 30 s with robots beside it).
 
 Penalties last the rules' times (``PENALTY_S``: 45 s, 15 s in SET; the incremental ones 10 s longer for
 each incremental penalty the team had before), counted in READY and PLAYING; a penalized robot is taken
-off the carpet, then put back on the touchline of its own half, on the side away from the ball, facing
-the field (motion in SET aside: in place). Every foul is a ``Foul`` (time, team, player, penalty, why).
+off the carpet, then put back where the rules put it (``Officiating.re_entry``: 0.5 m outside the touchline
+nearest to where it was, level with its own penalty mark, facing the field; motion in SET aside: in place). Every foul is a ``Foul`` (time, team, player, penalty, why).
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ from tafel.representations import field as pitch
 from tafel.representations.game import GamePhase, Penalty, State
 from tafel.representations.motion import JOINT_NAMES
 from tafel.representations.nao import CAMERAS, HORIZONTAL_FOV, VERTICAL_FOV
-from tafel.tools.simulation.officiating import HALF_LINE_X, HALF_LINE_Y, Event, Officiating, Player
+from tafel.tools.simulation.officiating import Event, Officiating, Player, in_own_penalty_area, left_the_carpet
 
 #: GameController3's penalty durations (s, its champions_cup parameters); the incremental ones grow
 PENALTY_S = {Penalty.player_pushing: 45.0, Penalty.illegal_position: 45.0, Penalty.illegal_position_in_set: 15.0,
@@ -112,6 +113,16 @@ class Foul:
     reason: str
 
 
+@dataclass
+class Push:
+    """A pushing foul: who pushed whom, and where their torsos were (world mm) before the pusher was taken off."""
+
+    pusher: Player
+    pushed: Player
+    pusher_at: tuple[float, float]
+    pushed_at: tuple[float, float]
+
+
 class Fouls(Officiating):
     """The referee's part that calls fouls and counts penalties down (its state is the ``Referee``'s)."""
 
@@ -173,7 +184,7 @@ class Fouls(Officiating):
         kicking = self.team_index(self.game.kicking_team)
         for player in self.on_field():
             x, y, _ = self.world.robot_pose(player.index)
-            if abs(x) > HALF_LINE_X + 300.0 or abs(y) > HALF_LINE_Y + 300.0:
+            if left_the_carpet(x, y):
                 self.penalize(player, Penalty.leaving_the_field, now, "left the field")
             elif player.team == kick_off_defender and math.hypot(x, y) < CENTRE_CIRCLE_R:
                 self.penalize(player, Penalty.illegal_position, now, "entered the centre circle at the opponents' kick-off")
@@ -187,13 +198,13 @@ class Fouls(Officiating):
                 self.penalize(self.players[near[0][1]], Penalty.local_game_stuck, now, f"nobody played the ball for {STUCK_S:g} s")
             self.last_touch_s = now
 
-    def judge_pushing(self, now: float, bx: float, by: float) -> None:
+    def judge_pushing(self, now: float, bx: float, by: float) -> Push | None:
         """The rules' pushing (forceful contact with an opponent): a robot whose torso approached a touching
         (``CONTACT``) opponent faster than ``PUSH_SPEED`` over the last ``PUSH_WINDOW_S`` (a step: a walk's
         sway alone reaches 250 mm/s for an instant) walked into it. Of two, only the one that approached
         faster pushed. The rules' exceptions: a stationary robot (also one kicking: its torso stays), one
         getting up (fallen), a goalkeeper in its own penalty area, front to front contact with the ball
-        between, and a robot proceeding to the ball that touches with its side."""
+        between, and a robot proceeding to the ball that touches with its side. Returns the push it called."""
         field = self.on_field()
         for index in set(self.tracks) - {player.index for player in field}:
             del self.tracks[index]  # taken off the field: its way back is no walk
@@ -216,8 +227,10 @@ class Fouls(Officiating):
                 # only the faster one can have pushed: excused, the other was pushed, not pushing
                 speed, pusher, pushed = max((self.approach(a, b), a, b), (self.approach(b, a), b, a), key=lambda t: t[0])
                 if speed > PUSH_SPEED and not self.may_touch(pusher, pushed, bx, by):
+                    push = Push(pusher, pushed, self.world.robot_pose(pusher.index)[:2], self.world.robot_pose(pushed.index)[:2])
                     self.penalize(pusher, Penalty.player_pushing, now, f"walked into team {self.team_numbers[pushed.team]} player {pushed.number}")
-                    return
+                    return push
+        return None
 
     def walked(self, player: Player) -> tuple[float, float, float]:
         """mm, mm, s: how far the robot's torso moved over its track (``PUSH_WINDOW_S``), and in what time."""
@@ -243,7 +256,7 @@ class Fouls(Officiating):
         x, y, heading = self.world.robot_pose(player.index)
         tx, ty, _ = self.team_pose(player)
         keeper = self.game.teams[player.team].goalkeeper == player.number
-        if keeper and tx < -HALF_LINE_X + pitch.PENALTY_AREA_LENGTH and abs(ty) < pitch.PENALTY_AREA_WIDTH / 2:
+        if keeper and in_own_penalty_area(tx, ty):
             return True
         ox, oy, other_heading = self.world.robot_pose(other.index)
         to_other = math.atan2(oy - y, ox - x)
@@ -352,6 +365,7 @@ class Fouls(Officiating):
             x, y, heading = self.placed.pop(player.index, self.world.robot_pose(player.index))
             self.world.move_robot(player.index, x, y, heading)
         else:
+            player.return_side = 1.0 if self.team_pose(player)[1] >= 0.0 else -1.0
             self.off_the_carpet(player)  # while it waits
         team = self.team_numbers[player.team]
         self.events.append(Event(now, f"PENALTY {penalty.name} team {team} player {player.number}"))
@@ -370,8 +384,5 @@ class Fouls(Officiating):
             robot.secs_till_unpenalised = max(0, int(math.ceil(player.penalty_left_s - 1e-6)))
             if player.penalty_left_s <= 1e-9 and counting:
                 if robot.penalty is not Penalty.illegal_motion_in_set:  # that one ends where the robot stands
-                    bx, by, _ = player.side.to_team(*self.world.ball_position())
-                    side = -1.0 if by > 0 else 1.0  # the touchline farther from the ball
-                    x, y, heading = player.side.to_world(-1500.0, side * HALF_LINE_Y, -side * math.pi / 2)
-                    self.world.move_robot(player.index, x, y, heading)
+                    self.world.move_robot(player.index, *self.re_entry(player))
                 robot.penalty, robot.secs_till_unpenalised, player.penalized_until_s = Penalty.none, 0, -1.0

@@ -5,6 +5,9 @@ kicks it calls when the ball goes out, and the ones it is told to call.
   goal kick (from the goal area's corner) or a corner kick, by who touched it last (the nearest robot).
   A free kick ends when the kicking team touches the ball or after 30 s; a goal straight from it
   (indirect) does not count;
+- a pushing free kick for the pushed team, the ball left where it is, when the pusher's torso was within
+  ``PUSHING_NEAR_BALL`` of the ball (the rules; not while a free kick runs; a push into the pusher's own
+  penalty area would be a penalty kick, which this referee does not run: the pusher's penalty alone);
 - set plays the referee calls when told (``calls``, for drills and tests: a kick-in, goal kick, corner
   kick or pushing free kick for a team at a given time, once PLAYING; the ball placed as the set play
   places it).
@@ -20,12 +23,13 @@ import math
 from dataclasses import dataclass
 
 from tafel.representations import field as pitch
-from tafel.representations.game import SetPlay, State
-from tafel.tools.simulation.fouls import Fouls
-from tafel.tools.simulation.officiating import HALF_LINE_X, HALF_LINE_Y, Event
+from tafel.representations.game import GamePhase, SetPlay, State
+from tafel.tools.simulation.fouls import Fouls, Push
+from tafel.tools.simulation.officiating import HALF_LINE_X, HALF_LINE_Y, Event, in_own_penalty_area
 
 KICK_OFF_S, FREE_KICK_S = 10.0, 30.0  # s: the rules
 FREE_KICKS = (SetPlay.goal_kick, SetPlay.pushing_free_kick, SetPlay.corner_kick, SetPlay.kick_in)
+PUSHING_NEAR_BALL = 500.0  # mm from the pusher's torso to the ball: the rules' "approximately 0.5 m"
 
 
 @dataclass
@@ -108,6 +112,16 @@ class SetPlays(Fouls):
             defending = 1 if bx > 0 else 0  # the team whose goal line it crossed
             play = SetPlay.goal_kick if kicking == defending else SetPlay.corner_kick
         self.start_set_play(play, kicking, *self.set_play_spot(play, kicking, bx, by), now)
+
+    def judge_pushing(self, now: float, bx: float, by: float) -> Push | None:
+        """Pushing (``Fouls``), and the pushing free kick it brings near the ball (the module's docstring)."""
+        push = super().judge_pushing(now, bx, by)
+        if push is None or self.game.set_play is not SetPlay.none or self.game.game_phase is GamePhase.penalty_shoot:
+            return push
+        near_ball = math.hypot(push.pusher_at[0] - bx, push.pusher_at[1] - by) <= PUSHING_NEAR_BALL
+        if near_ball and not in_own_penalty_area(*push.pusher.side.to_team(*push.pushed_at)[:2]):
+            self.start_set_play(SetPlay.pushing_free_kick, push.pushed.team, bx, by, now)
+        return push
 
     def take_call(self, bx: float, by: float, now: float) -> None:
         """The first of ``calls`` is due: start its set play, the ball last at (bx, by)."""

@@ -39,7 +39,7 @@ from tafel.platforms.match_world import Side
 from tafel.representations import field as pitch
 from tafel.representations.game import GamePhase, Penalty, SetPlay, State
 from tafel.tools.simulation.fouls import FALLEN_HEIGHT, Foul, Fouls
-from tafel.tools.simulation.officiating import HALF_LINE_X, HALF_LINE_Y, Event, Player
+from tafel.tools.simulation.officiating import HALF_LINE_X, HALF_LINE_Y, Event, Player, left_the_carpet
 
 #: GameController3 (champions_cup) and the rules: a penalty shot's time (s), shots per team, sudden-death shots per team
 PENALTY_SHOT_S, PENALTY_SHOTS, SUDDEN_DEATH_SHOTS = 30.0, 3, 3
@@ -275,7 +275,7 @@ class ShootOut(Fouls):
         keeper = self.shot_player(False)
         for player in self.on_field():
             x, y, _ = self.world.robot_pose(player.index)
-            if abs(x) > HALF_LINE_X + 300.0 or abs(y) > HALF_LINE_Y + 300.0:
+            if left_the_carpet(x, y):
                 self.penalize(player, Penalty.leaving_the_field, now, "left the field in a penalty shot")
         self.judge_pushing(now, bx, by)
         self.judge_activity(now, spared=keeper)
