@@ -134,7 +134,7 @@ def test_a_robot_on_the_place_to_go_stops_the_walk_short_of_it() -> None:
 
 def test_a_walk_never_leads_more_than_field_margin_beyond_a_line() -> None:
     """The ball on the touchline, the kick's spot behind it beyond the line: the walk stops at the margin
-    (the referee calls leaving the field 0.3 m beyond a line)."""
+    (leaving the carpet, 0.7 m beyond a line, is a foul)."""
     pose = RobotPose(valid=True, x=2000.0, y=2600.0, rotation=2.5)
     harness = striker(pose, (1000.0, 3120.0), [])
     out = harness.execute()[MotionRequest]

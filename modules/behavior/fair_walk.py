@@ -78,7 +78,7 @@ def avoid(b: Walker, x: float, y: float, zones: list[Disc] | None = None) -> tup
 
 def stay_on_field(out: MotionRequest, pose: RobotPose, obstacles: Obstacles, p: WalkParameters) -> None:
     """A walk's target beyond the lines by more than ``field_margin`` comes back to it: leaving the field
-    is a foul (the referee calls it 0.3 m beyond a line). When the way back runs into a robot's disc
+    is a foul (off the carpet, 0.7 m beyond a line; a real referee judges by eye). When the way back runs into a robot's disc
     (the way round it led beyond the line), the free direction nearest it that leads no further beyond
     the lines than the robot is; the robot stands if there is none: pushing is a foul too."""
     margin = p.field_margin

@@ -142,7 +142,7 @@ class SoccerBehavior(Module):
         defender_spread: float = bounded(0.0, 2000.0, 400.0)
         """mm a defender stands beside the line from the ball to the own goal (even numbers left, odd right)"""
         field_margin: float = bounded(0.0, 300.0, 150.0)
-        """mm beyond the field's lines a walk may lead at most (the torso 0.3 m beyond one has left the field)"""
+        """mm beyond the field's lines a walk may lead at most (leaving the carpet, 0.7 m beyond, is a foul)"""
         detour_memory_s: float = bounded(0.0, 10.0, 1.5)
         """s a side chosen round an obstacle is kept for one dead ahead (no zigzag)"""
         pass_decide_s: float = bounded(0.0, 10.0, 1.0)
