@@ -73,11 +73,12 @@ def keep_window(track: deque[tuple[float, float, float]], now: float, x: float, 
 
 
 def play(start: tuple[float, float, float], ball: tuple[float, float], opponent: tuple[float, float], seconds: float = 6.0,
-         role: Role = Role.striker, challenge: bool = False) -> tuple[float, float]:
+         role: Role = Role.striker, challenge: bool = False, seen_farther: float = 0.0) -> tuple[float, float]:
     """The robot walks from ``start`` (field mm, mm, rad) as ``SoccerBehavior`` asks (walk_to, kinematically), the
     ball and a standing opponent seen where they are (field mm). Returns the fastest approach to the opponent
     (mm/s over ``PUSH_WINDOW_S``) while touching it, and the nearest the robot's centre came to the ball (mm).
-    ``challenge``: a striker goes for the ball at once (``hold_max_s`` 0), the opponent nearer it or not."""
+    ``challenge``: a striker goes for the ball at once (``hold_max_s`` 0), the opponent nearer it or not.
+    ``seen_farther``: the opponent is seen that many mm farther than it is (the obstacle model's error)."""
     x, y, heading = start
     vx = vy = 0.0
     track: deque[tuple[float, float, float]] = deque()
@@ -88,6 +89,7 @@ def play(start: tuple[float, float, float], ball: tuple[float, float], opponent:
         pose = RobotPose(valid=True, x=x, y=y, rotation=heading)
         bx, by = robot_frame(pose, *ball)
         ox, oy = robot_frame(pose, *opponent)
+        ox, oy = (v * (1.0 + seen_farther / max(math.hypot(ox, oy), 1.0)) for v in (ox, oy))
         harness.set(pose, BallModel(valid=True, seen=True, x=bx, y=by), Obstacles(obstacles=[Obstacle(x=ox, y=oy, kind=ObstacleKind.robot)]))
         out = harness.execute()[MotionRequest]
         x, y, heading, vx, vy = walk(out, pose, vx, vy)
@@ -112,15 +114,17 @@ def test_the_striker_never_walks_backwards_to_a_kicking_spot_behind_it() -> None
 
 
 @settings(max_examples=20, deadline=None)
-@given(st.floats(-math.pi, math.pi), st.floats(300.0, 1200.0), st.floats(-math.pi, math.pi), st.floats(150.0, 450.0))
-def test_a_striker_never_walks_into_a_standing_opponent_near_the_ball(start_bearing: float, start_distance: float,
-                                                                      opponent_bearing: float, opponent_distance: float) -> None:
-    """From anywhere round the ball, with an opponent standing anywhere near it: never an approach faster than
-    the rules' 80 mm/s while touching (whatever the rule book's exceptions might still excuse), also when it
-    challenges an opponent nearer the ball."""
+@given(st.floats(-math.pi, math.pi), st.floats(300.0, 1200.0), st.floats(-math.pi, math.pi), st.floats(150.0, 450.0),
+       st.floats(0.0, 150.0))
+def test_a_striker_never_walks_into_a_standing_opponent_near_the_ball(start_bearing: float, start_distance: float, opponent_bearing: float,
+                                                                      opponent_distance: float, seen_farther: float) -> None:
+    """From anywhere round the ball, with an opponent standing anywhere near it and seen up to 150 mm farther than it
+    is: never an approach faster than the rules' 80 mm/s while touching (whatever the rule book's exceptions might
+    still excuse), also when it challenges an opponent nearer the ball. (5v5 seed 2, 627.5 s: a ball duel, the
+    opponent seen 400 mm away, touched at 330 mm; before ``SLOW_NEAR`` a 150 mm error let 9 of 40 such walks push.)"""
     start = (start_distance * math.cos(start_bearing), start_distance * math.sin(start_bearing), start_bearing + math.pi)
     opponent = (opponent_distance * math.cos(opponent_bearing), opponent_distance * math.sin(opponent_bearing))
-    worst, _ = play(start, (0.0, 0.0), opponent, seconds=4.0, challenge=True)
+    worst, _ = play(start, (0.0, 0.0), opponent, seconds=4.0, challenge=True, seen_farther=seen_farther)
     assert worst <= PUSH_SPEED
 
 

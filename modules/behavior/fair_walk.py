@@ -25,6 +25,9 @@ BLIND, BLIND_STEP, BLIND_TURN = math.radians(100.0), 45.0, 400.0
 #: mm (centre to centre) within which a faint robot (``Obstacles.faint``: remembered behind, may have gone) is walked
 #: towards no faster than BLIND_STEP allows (below the rules' pushing); beyond, the walk has room to slow down to it
 FAINT_NEAR = 700.0
+#: mm beyond ``push_distance`` within which a robot seen is walked towards no faster than BLIND_STEP allows: where it is
+#: seen may be 100 mm off, and the walk needs room to slow down; so a touch the error lets happen is no push
+SLOW_NEAR = 250.0
 POST_SEEN = 300.0  # mm round a goal post within which ObstacleModeler takes what is seen for the post (its post_radius)
 KICK_HELD_BACK = 30.0  # mm a walk's target may be held back from a robot (``keep_from_pushing``) and the walk kick still be asked for
 
@@ -106,7 +109,8 @@ def keep_from_pushing(out: MotionRequest, pose: RobotPose, game: GameState, obst
     """The rules' pushing is walking into a touching opponent (its torso approaching faster than 80 mm/s):
     a walk's target is held back along the line to every robot (not a teammate) so that the way towards it
     ends ``push_distance`` from its centre, as near as the robot may come. Sideways to it the walk goes
-    on; the walk slows as it nears its target, so it comes to rest there rather than at contact. One
+    on; within ``SLOW_NEAR`` beyond that it goes towards the robot no faster than ``BLIND_STEP`` allows (the
+    robot may be nearer than seen), so it comes to rest there slowly rather than at contact. One
     already nearer steps back a little, straight away from it. A faint robot (``Obstacles.faint``, remembered behind
     the robot for longer than it is walked round) may have gone: the walk is not held back from it, but goes
     towards it, within ``FAINT_NEAR``, no faster than ``BLIND_STEP`` allows. Robots seen at a goal post count too
@@ -128,7 +132,7 @@ def keep_from_pushing(out: MotionRequest, pose: RobotPose, game: GameState, obst
         robots += [(r.x, r.y) for r in percept.robots if any(
             math.dist(pose.to_field(r.x, r.y), (sx * pitch.LENGTH / 2, sy * (pitch.GOAL_INNER_WIDTH + pitch.GOAL_POST_DIAMETER) / 2)) < POST_SEEN
             for sx in (-1, 1) for sy in (-1, 1))]
-    limits = [(rx, ry, math.hypot(rx, ry) - p.push_distance) for rx, ry in robots]
+    limits = [(rx, ry, min(room, BLIND_STEP) if room < SLOW_NEAR else room) for rx, ry in robots for room in [math.hypot(rx, ry) - p.push_distance]]
     limits += [(o.x, o.y, BLIND_STEP) for o in obstacles.faint if math.hypot(o.x, o.y) < FAINT_NEAR]
     for _ in range(3):  # held back from one, the target may lead further towards another: again
         for rx, ry, limit in limits:
