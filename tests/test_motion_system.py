@@ -110,8 +110,8 @@ def test_the_reference_pose_of_hip_yaw_pitch_round_trips() -> None:
 
 
 # ---------------------------------------------------------------------------------------- walking
-def walking(request: MotionRequest, pressure_on: str = "swing") -> ModuleHarness:
-    return ModuleHarness(WalkingEngine, request, MotionSelection(active=request.motion), context="motion")
+def walking(request: MotionRequest, **parameters: float) -> ModuleHarness:
+    return ModuleHarness(WalkingEngine, request, MotionSelection(active=request.motion), context="motion", parameters=parameters)
 
 
 def test_the_walk_steps_forward_in_time_and_odometry_follows_the_feet() -> None:
@@ -198,7 +198,7 @@ def test_a_far_target_beside_is_faced_first_not_walked_to_sideways(degrees: floa
 def arrival(request: MotionRequest, **parameters: float) -> tuple[float, Odometry]:
     """s until ``request``'s walk_to target is reached, and the odometry there. The gyroscope reports the turn the
     walk makes (in the harness nothing else turns the robot: odometry's rotation is the gyroscope's)."""
-    harness = ModuleHarness(WalkingEngine, request, MotionSelection(active=request.motion), context="motion", parameters=parameters)
+    harness = walking(request, **parameters)
     for frame in range(1, 2001):
         harness.set(InertialSensorData(gyroscope=np.array([0.0, 0.0, float(harness.module.velocity[2])])))
         harness.advance(0.01)
