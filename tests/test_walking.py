@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from tafel.representations.motion_control import MotionRequest, MotionType
+from tafel.tools.simulation.fouls import CONTACT, PUSH_SPEED, PUSH_WINDOW_S
 from tests.support.driven import Driven
 from tests.test_debug_server import Program
 
@@ -177,5 +178,29 @@ def test_after_sitting_limp_the_robot_stands_up_and_walks_off_without_falling(en
             assert driven.falls == 0, f"seed {seed}: fell after sitting"
             assert driven.sim.platform.torso_height() > 280, f"seed {seed}: not standing"
             assert x1 - x0 > 300, f"seed {seed}: walked only {x1 - x0:.0f} mm"
+        finally:
+            driven.close()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+def test_turning_to_face_a_target_behind_does_not_push_a_robot_standing_there(engine: str) -> None:
+    """5v5 seed 1, 327 s: a robot turned to face a place behind it, stepping that way as it turned, into an opponent it
+    could not see there: the referee's pushing (the torso towards a touching robot faster than ``PUSH_SPEED`` over
+    ``PUSH_WINDOW_S``). Turning round in place, the torso still circles over the feet, slower than that (31 to 70
+    mm/s in both engines; with the steps 60 to 108)."""
+    for target in ((-1500.0, 0.0, math.pi), (-1200.0, 600.0, 2.2), (-1200.0, -600.0, -2.2)):
+        driven = Driven(engine)
+        try:
+            x0, y0, heading = driven.sim.platform.robot_pose()
+            behind = (x0 - CONTACT * math.cos(heading), y0 - CONTACT * math.sin(heading))  # touching its back
+            driven.request = MotionRequest(motion=MotionType.walk_to, target_x=target[0], target_y=target[1], target_rotation=target[2])
+            track: list[tuple[float, float]] = []
+            driven.sim.run(1.0, lambda sim, track=track: track.append(sim.platform.robot_pose()[:2]))  # the turn, not yet the walk
+            ticks = round(PUSH_WINDOW_S / driven.sim.tick_s)
+            approach = [((bx - ax) * (behind[0] - ax) + (by - ay) * (behind[1] - ay)) / math.dist(behind, (ax, ay)) / PUSH_WINDOW_S
+                        for (ax, ay), (bx, by) in zip(track, track[ticks:])]
+            assert max(approach) < PUSH_SPEED, f"{target}: towards the robot behind at {max(approach):.0f} mm/s"
+            assert abs(math.remainder(driven.sim.platform.robot_pose()[2] - heading, math.tau)) > 0.4, f"{target}: did not turn"
         finally:
             driven.close()

@@ -102,10 +102,11 @@ class WalkingEngine(Module):
         target_tolerance: float = bounded(5.0, 300.0, 40.0)
         """mm (and tolerance / 400 rad) within which walk_to has arrived"""
         turn_in_place_beyond: float = bounded(0.5, math.pi, math.pi / 2)
-        """rad: a walk_to target far behind whose rotation differs more than this from the heading is turned to nearly
-        in place first (at most ``turn_in_place_step`` mm of it at a time), not walked to backwards and blind"""
+        """rad: a walk_to target far behind whose rotation differs more than this from the heading is turned to in place
+        first, not walked to backwards and blind: not a step of the way (behind, nothing is seen; a step that way while
+        turning brought the torso 90 mm/s towards a robot standing there, the rules' pushing, in MuJoCo)"""
         turn_in_place_step: float = bounded(0.0, 400.0, 45.0)
-        """mm of the way to a target turned to in place (turn_in_place_beyond, face_beside_beyond) walked while turning"""
+        """mm of the way to a target beside (face_beside_beyond) walked while turning to face it: that way is seen"""
         face_beside_beyond: float = bounded(0.5, math.pi, math.radians(60.0))
         """rad: a walk_to target far (over 400 mm) beside the heading by more than this is faced nearly in place first
         (robots are seen within 100 degrees: a walk within 60 of the heading sees 40 beyond its way; walked to fast
@@ -302,7 +303,8 @@ class WalkingEngine(Module):
         behind = far and x <= -200 and abs(turn) > p.turn_in_place_beyond  # behind, to be faced: nothing is seen there
         beside = far and x > -200 and abs(heading) > p.face_beside_beyond  # beside: little is seen beyond the way
         if behind or beside:  # turn first
-            x, y = x * p.turn_in_place_step / distance, y * p.turn_in_place_step / distance
+            step = 0.0 if behind else p.turn_in_place_step
+            x, y = x * step / distance, y * step / distance
         return np.array([x, y, heading]) * p.target_gain, False
 
     def duration(self) -> float:
