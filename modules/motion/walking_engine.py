@@ -104,7 +104,7 @@ class WalkingEngine(Module):
         turn_in_place_beyond: float = bounded(0.5, math.pi, math.pi / 2)
         """rad: a walk_to target far behind whose rotation differs more than this from the heading is turned to in place
         first, not walked to backwards and blind: not a step of the way (behind, nothing is seen; a step that way while
-        turning brought the torso 90 mm/s towards a robot standing there, the rules' pushing, in MuJoCo)"""
+        turning brought the torso up to 108 mm/s towards a robot standing there, the rules' pushing, in both engines)"""
         turn_in_place_step: float = bounded(0.0, 400.0, 45.0)
         """mm of the way to a target beside (face_beside_beyond) walked while turning to face it: that way is seen"""
         face_beside_beyond: float = bounded(0.5, math.pi, math.radians(60.0))
